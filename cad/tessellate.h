@@ -1,0 +1,53 @@
+// Tessellation with vertices on the exact surface and normals from the surface derivatives (never averaged
+// from faces).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "cad/outline.h"
+#include "cad/surface.h"
+
+namespace pvrr::cad {
+
+using Triangle = glm::u32vec3;
+
+struct Tessellation {
+  std::vector<Vec3> positions;
+  std::vector<Vec3> normals;        // unit, oriented as the surface normal
+  std::vector<Vec2> params;         // (u, v) of each vertex
+  std::vector<Curvature> curvatures;  // filled only when asked for
+  std::vector<Triangle> triangles;  // counter-clockwise seen from the normal side
+  // Grid tessellations: vertex (i, j), i along u (0..grid_u-1), j along v, is at index i * grid_v + j.
+  int grid_u = 0, grid_v = 0;
+  size_t vertexCount() const { return positions.size(); }
+};
+
+struct TessellationOptions {
+  bool curvatures = false;
+};
+
+// A grid of n_u x n_v vertices (n >= 2). Without an outline the grid spans the whole parameter domain;
+// with one, the grid is the outline's fromSquare() image, so boundary vertices lie exactly on the outline.
+Tessellation tessellateGrid(const Surface& s, int n_u, int n_v, const Outline* outline = nullptr,
+                            TessellationOptions opt = {});
+
+// Adaptive: refines until every triangle's chordal deviation (surface vs. the flat triangle, sampled at
+// edge midpoints and centroid) is below chordal_tol and the normals of its vertices differ by less than
+// angle_tol_rad. Crack-free. Not a grid (grid_u = grid_v = 0).
+Tessellation tessellateAdaptive(const Surface& s, double chordal_tol, double angle_tol_rad,
+                                const Outline* outline = nullptr, TessellationOptions opt = {});
+
+// A block of a grid tessellation. Adjacent patches share their boundary vertices: the same indices into the
+// grid, hence bit-identical positions and normals.
+struct GridPatch {
+  int i0 = 0, i1 = 0, j0 = 0, j1 = 0;  // inclusive vertex ranges in the grid
+  std::vector<uint32_t> vertices;      // indices into the grid tessellation
+  std::vector<Triangle> triangles;     // indices into `vertices`
+};
+std::vector<GridPatch> splitGrid(const Tessellation& grid, int patches_u, int patches_v);
+// The whole grid as one patch.
+GridPatch wholeGrid(const Tessellation& grid);
+
+}  // namespace pvrr::cad
