@@ -1,5 +1,95 @@
 #include "app/cli.h"
+
 #include <cstdio>
+#include <exception>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "app/args.h"
+#include "app/commands.h"
+#include "cad/error.h"
+
 namespace pvrr::app {
-int runMain(int, char**) { std::fprintf(stderr, "pvrr: not built yet\n"); return 2; }
+
+namespace {
+
+struct Command {
+  int (*run)(const std::vector<std::string>&);
+  const char* summary;
+  const char* usage;
+};
+
+const std::map<std::string, Command>& commands() {
+  static const std::map<std::string, Command> table = {
+      {"render",
+       {cmdRender, "render a scene to PNG (default: models/car-mirror.json -> out/car-mirror.png)",
+        "pvrr render [SCENE] [--mode pvrr|raster|envmap|raytrace] [--size WxH] [--out FILE.png]\n"
+        "            [--gl auto|egl|osmesa] [--set PATH=VALUE]... [--stats FILE.json] [--frames N] [--orbit DEG]\n"
+        "  Renders SCENE (default models/car-mirror.json) and prints the output path and the frame time.\n"
+        "  --stats writes {\"frame_ms\", \"stages\":[{\"name\",\"ms\",\"ran\",\"reason\"}], \"elements\":[...]}.\n"
+        "  --frames N renders N frames (the observer turning by --orbit DEG in total about the vertical axis\n"
+        "  through the eye; elements attached to the observer turn with it) and reports per-stage counts."}},
+      {"gl-info",
+       {cmdGlInfo, "print the GL backend, GL_VERSION and GL_RENDERER",
+        "pvrr gl-info [--gl auto|egl|osmesa]\n  The backend can also be chosen with the PVRR_GL variable."}},
+      {"trace",
+       {cmdTrace, "trace one reference ray and print its path as JSON",
+        "pvrr trace SCENE (--ray OX,OY,OZ,DX,DY,DZ | --pixel X,Y [--size WxH]) [--wavelength NM] [--set PATH=VALUE]...\n"
+        "  Pixel centres are at +0.5, the origin is the top-left corner. Prints\n"
+        "  {\"segments\":[{\"origin\",\"direction\",\"event\",\"element\",\"point\",\"normal\",\"n1\",\"n2\"}]}."}},
+      {"vertices",
+       {cmdVertices, "write the per-vertex PVRR data of a scene as CSV (+ JSON cameras) or VTP",
+        "pvrr vertices SCENE [--element NAME] [--set PATH=VALUE]... --out FILE.csv|FILE.vtp\n"
+        "  CSV columns: element,patch,vertex,channel,px,py,pz,nx,ny,nz,dx,dy,dz,status,hx,hy,hz,s,t\n"
+        "  (+ ix,iy,iz,bx,by,bz,bnx,bny,bnz for lenses); FILE.json beside it holds each patch's camera."}},
+      {"compare",
+       {cmdCompare, "render the reference and each mode; write images, error heat maps and metrics.json",
+        "pvrr compare SCENE [--modes pvrr,envmap,raster] [--size WxH] [--frames N] [--gl B] [--set PATH=VALUE]... --out DIR"}},
+      {"mesh",
+       {cmdMesh, "tessellate a surface and write it as OBJ, PLY or VTP",
+        "pvrr mesh (SURFACE_FILE | SCENE --element NAME) [--tessellation N | --tolerance T] --out FILE.obj|.ply|.vtp"}},
+  };
+  return table;
 }
+
+void printHelp() {
+  std::printf("pvrr: per-vertex reflection and refraction for curved mirrors and lenses\n\nusage: pvrr COMMAND [ARGS]\n\n");
+  for (const auto& [name, c] : commands()) std::printf("  %-9s %s\n", name.c_str(), c.summary);
+  std::printf("\n  help CMD  usage of one command\n\nExit codes: 0 success, 1 usage or input error, 2 internal error.\n");
+}
+
+}  // namespace
+
+int runMain(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  try {
+    if (args.empty() || args[0] == "help" || args[0] == "--help" || args[0] == "-h") {
+      if (args.size() >= 2) {
+        auto it = commands().find(args[1]);
+        if (it == commands().end()) throw Error("pvrr help: unknown command \"" + args[1] + "\"");
+        std::printf("%s\n", it->second.usage);
+        return 0;
+      }
+      printHelp();
+      return args.empty() ? 1 : 0;
+    }
+    auto it = commands().find(args[0]);
+    if (it == commands().end()) {
+      std::vector<std::string> names;
+      for (const auto& kv : commands()) names.push_back(kv.first);
+      std::string hint = nearest(args[0], names);
+      throw Error("pvrr: unknown command \"" + args[0] + "\"" + (hint.empty() ? "" : "; did you mean \"" + hint + "\"?") +
+                  " (see: pvrr help)");
+    }
+    return it->second.run(std::vector<std::string>(args.begin() + 1, args.end()));
+  } catch (const Error& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "pvrr: internal error: %s\n", e.what());
+    return 2;
+  }
+}
+
+}  // namespace pvrr::app

@@ -15,6 +15,11 @@ struct ImportedFace {
   std::shared_ptr<const NurbsSurface> surface;  // in the file's own length unit
   std::optional<Outline> trim;                  // outer trim loop in (u, v), when the face is trimmed
   std::string source_type;                      // "b-spline", "plane", "sphere", "cylinder", "torus", ...
+  // Honesty about the sampled trim loop (0 when untrimmed): the largest distance between the exact trim curve,
+  // taken at the mid-parameter of each chord, and that chord; in (u, v) units and, on the surface, in the
+  // file's length unit.
+  double trim_chord_error_uv = 0;
+  double trim_chord_error = 0;
 };
 
 struct ImportedModel {

@@ -23,8 +23,10 @@ class NurbsSurface : public Surface {
 
   const NurbsDefinition& definition() const { return def_; }
   ParamDomain domain() const override;
-  SurfaceDerivs evaluate(double u, double v) const override;
+  SurfaceDerivs evaluate(double u, double v) const override;  // (u, v) outside domain() is clamped to it
   std::string describe() const override;
+  // One evaluation for position, normal and curvature (the defaults of Surface, bit-identical).
+  SurfacePoint sample(double u, double v, bool with_curvature) const override;
 
  private:
   NurbsDefinition def_;

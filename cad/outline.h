@@ -33,12 +33,17 @@ class Outline {
   // (radial scaling about the centre). Grid tessellations use it to put boundary vertices on the outline.
   Vec2 fromSquare(Vec2 s) const;
   std::string describe() const;
+  // Axis-aligned bounding box of the region (for a polygon it need not be centred on centre()).
+  Vec2 boundsMin() const;
+  Vec2 boundsMax() const;
 
  private:
   Shape shape_ = Shape::Rectangle;
   double width_ = 1, height_ = 1, corner_radius_ = 0;
   Vec2 centre_{0};
   std::vector<Vec2> loop_;
+  std::vector<double> loop_angles_;  // polygon: angle of each loop point about the centre, increasing
+  Vec2 lo_{-0.5}, hi_{0.5};          // bounding box
 };
 
 }  // namespace pvrr::cad

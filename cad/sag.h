@@ -37,6 +37,10 @@ class SagSurface : public Surface {
   ParamDomain domain() const override;
   SurfaceDerivs evaluate(double u, double v) const override;
   Vec3 normal(double u, double v) const override;  // exact, from the sag gradient
+  // From the fundamental forms with the exact normal (a sag graph has no poles).
+  Curvature curvature(double u, double v) const override;
+  // One sag evaluation for position, normal and curvature (bit-identical to the separate calls).
+  SurfacePoint sample(double u, double v, bool with_curvature) const override;
 
  private:
   Outline outline_;

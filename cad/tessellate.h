@@ -30,12 +30,18 @@ struct TessellationOptions {
 
 // A grid of n_u x n_v vertices (n >= 2). Without an outline the grid spans the whole parameter domain;
 // with one, the grid is the outline's fromSquare() image, so boundary vertices lie exactly on the outline.
+// Each quad is split along its (i, j)-(i+1, j+1) diagonal; a triangle with two coincident vertices (at a
+// pole or collapsed edge) is left out, so triangles.size() can be below 2 (n_u - 1)(n_v - 1).
 Tessellation tessellateGrid(const Surface& s, int n_u, int n_v, const Outline* outline = nullptr,
                             TessellationOptions opt = {});
 
 // Adaptive: refines until every triangle's chordal deviation (surface vs. the flat triangle, sampled at
 // edge midpoints and centroid) is below chordal_tol and the normals of its vertices differ by less than
 // angle_tol_rad. Crack-free. Not a grid (grid_u = grid_v = 0).
+// The deviation at a point of the flat triangle is its distance to its projection onto the surface: along z
+// for a SagSurface (so the z gap at that (x, y) is bounded), the closest point for other surfaces. Triangles
+// with two coincident vertices (at a pole) are left out. A periodic seam (e.g. a full-turn NURBS) is two
+// boundaries in (u, v), refined independently.
 Tessellation tessellateAdaptive(const Surface& s, double chordal_tol, double angle_tol_rad,
                                 const Outline* outline = nullptr, TessellationOptions opt = {});
 

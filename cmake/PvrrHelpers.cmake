@@ -16,6 +16,7 @@ function(pvrr_embed_shaders)
     OUTPUT ${out}
     COMMAND ${CMAKE_COMMAND} -DOUT=${out} "-DFILES=${shader_files}" -P ${CMAKE_SOURCE_DIR}/cmake/EmbedShaders.cmake
     DEPENDS ${shader_files} ${CMAKE_SOURCE_DIR}/cmake/EmbedShaders.cmake
-    COMMENT "Embedding shaders")
+    COMMENT "Embedding shaders"
+    VERBATIM)
   target_sources(${A_TARGET} PRIVATE ${out})
 endfunction()

@@ -1,0 +1,341 @@
+// Shared pieces of the subcommands, and `render`, `gl-info`, `trace`.
+#include "app/commands.h"
+
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <glm/gtc/matrix_transform.hpp>
+#include <random>
+
+#include "app/args.h"
+#include "app/report.h"
+#include "cad/error.h"
+#include "pvrr/gl/context.h"
+#include "pvrr/image.h"
+#include "pvrr/scene_json.h"
+#include "pvrr/spectrum.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace pvrr::app {
+
+LoadedScene loadScene(const std::string& path, const std::vector<std::string>& overrides, int width, int height) {
+  LoadedScene ls;
+  ls.desc = pvrr::loadScene(path, overrides);
+  if (width > 0) {
+    ls.desc.observer.image_width = width;
+    ls.desc.observer.image_height = height;
+  }
+  ls.scene = buildScene(ls.desc, readMeshFile);
+  return ls;
+}
+
+void writeFileAtomic(const std::string& path, const std::string& content) {
+  const fs::path target(path);
+  std::error_code ec;
+  if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
+  if (ec) throw Error(path + ": cannot create the folder " + target.parent_path().string() + ": " + ec.message());
+  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    if (!out) throw Error(path + ": cannot write (could not open " + tmp + ")");
+    out << content;
+    out.flush();
+    if (!out) {
+      out.close();
+      fs::remove(tmp, ec);
+      throw Error(path + ": write failed");
+    }
+  }
+  fs::rename(tmp, target, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    throw Error(path + ": cannot rename the temporary file into place");
+  }
+}
+
+size_t writeLinearPng(const std::string& path, int width, int height, const std::vector<Vec3>& linear) {
+  ImageRGB8 img(width, height);
+  size_t bad = 0;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      Vec3 c = linear[size_t(y) * size_t(width) + size_t(x)];
+      if (!isFinite(c)) {
+        ++bad;
+        c = Vec3(0);
+      }
+      uint8_t* p = img.at(x, y);
+      for (int k = 0; k < 3; ++k) p[k] = linearToSrgb8(std::clamp(c[k], 0.0, 1.0));
+    }
+  const fs::path target(path);
+  std::error_code ec;
+  if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
+  writePngAtomic(path, img);
+  return bad;
+}
+
+double seenAngle(const Vec3& p, const Vec3& a, const Vec3& b) { return angleBetween(a - p, b - p); }
+
+namespace {
+
+gl::GlBackend backendArg(const Args& a) {
+  auto v = a.get("gl");
+  return v ? gl::parseGlBackend(*v) : gl::glBackendFromEnvironment(gl::GlBackend::Auto);
+}
+
+json vec(const Vec3& v) { return json::array({v.x, v.y, v.z}); }
+
+json stagesJson(const FrameStages& s) {
+  json a = json::array();
+  for (const StageTiming& t : s.stages) a.push_back({{"name", t.name}, {"ms", t.ms}, {"ran", t.ran}, {"reason", t.reason}});
+  return a;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+}  // namespace
+
+json elementsJson(const Scene& scene, const std::vector<ElementFrame>& frames) {
+  json out = json::array();
+  for (const ElementFrame& f : frames) {
+    const Element& el = scene.elements[size_t(f.element)];
+    json e = {{"name", el.name},
+              {"type", el.type == ElementType::Lens ? "lens" : "mirror"},
+              {"vertices", f.world_pos.size()},
+              {"grid", {f.grid.grid_u, f.grid.grid_v}},
+              {"patches_grid", {f.patches_u, f.patches_v}},
+              {"split_note", f.split_note},
+              {"vertex_rays_ms", f.rays_ms},
+              {"viewpoint_fit_ms", f.fit_ms}};
+    int escapes = 0, tirs = 0;
+    for (const auto& ch : f.rays)
+      for (const VertexRay& r : ch) {
+        escapes += r.status == VertexStatus::Escape;
+        tirs += r.status == VertexStatus::Tir;
+      }
+    e["escaping_rays"] = escapes;
+    e["tir_rays"] = tirs;
+    json patches = json::array();
+    for (const PatchView& pv : f.views) {
+      const auto& gp = f.grid_patches[size_t(pv.patch)];
+      patches.push_back({{"patch", pv.patch},
+                         {"vertices", gp.vertices.size()},
+                         {"viewpoint", vec(pv.fit.eye)},
+                         {"fit_condition_number", std::isfinite(pv.fit.condition_number) ? json(pv.fit.condition_number) : json("inf")},
+                         {"fit_cost", pv.fit.cost_final},
+                         {"fit_rms_angle_arcmin", arcminutes(pv.fit.rms_angle_rad)},
+                         {"fit_max_angle_arcmin", arcminutes(pv.fit.max_angle_rad)},
+                         {"fit_accepted", pv.fit.accepted},
+                         {"fit_solver", pv.fit.solver_report},
+                         {"fallback", pv.fit.fallback},
+                         {"frustum_fov_deg", {degrees(pv.volume.fov_x_rad), degrees(pv.volume.fov_y_rad)}},
+                         {"view_volume_note", pv.volume.note},
+                         {"zooming_hits", pv.volume.zooming.size()}});
+    }
+    e["patches"] = patches;
+    out.push_back(e);
+  }
+  return out;
+}
+
+int cmdGlInfo(const std::vector<std::string>& argv) {
+  Args a("gl-info", argv, {"gl"});
+  if (!a.positional().empty()) usageError("gl-info", "unexpected argument \"" + a.positional()[0] + "\"");
+  auto ctx = gl::GlContext::create(backendArg(a));
+  std::printf("backend: %s\nGL_VERSION: %s\nGL_RENDERER: %s\nGL_VENDOR: %s\nGLSL: %s\nhardware: %s\n",
+              ctx->backendName().c_str(), ctx->glVersion().c_str(), ctx->glRenderer().c_str(), ctx->glVendor().c_str(),
+              ctx->glslVersion().c_str(), ctx->isHardware() ? "yes" : "no");
+  return 0;
+}
+
+// Renders one frame of a loaded scene in `mode` (raytrace or a raster mode). Used by render and compare.
+RenderedFrame renderFrame(LoadedScene& ls, const std::string& mode, const std::string& gl_backend_name,
+                          RenderSession* session) {
+  RenderedFrame out;
+  Scene& scene = ls.scene;
+  const DispersionMode disp = parseDispersionMode(scene.render.dispersion);
+  if (mode == "raytrace") {
+    RayScene rays(scene);
+    TraceOptions to;
+    to.max_depth = scene.render.max_depth;
+    to.dispersion = disp;
+    to.spectral_samples = scene.render.spectral_samples;
+    Tracer tracer(rays, to);
+    const auto t0 = std::chrono::steady_clock::now();
+    bool shown = false;
+    TracedFrame f = tracer.render([&](double frac) {
+      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      if (s > 1.0 && isatty(2)) {
+        std::fprintf(stderr, "\rray tracing: %3d%%", int(100 * frac));
+        shown = true;
+      }
+    });
+    if (shown) std::fprintf(stderr, "\rray tracing: done \n");
+    out.width = f.width;
+    out.height = f.height;
+    out.color = std::move(f.color);
+    out.seen = std::move(f.seen);
+    out.element = std::move(f.element);
+    out.element_point = std::move(f.element_point);
+    out.frame_ms = f.frame_ms;
+    out.stages.ran("ray-trace", f.frame_ms);
+    out.gl_backend = "none (CPU, Embree)";
+    return out;
+  }
+  const gl::RasterMode rm = gl::parseRasterMode(mode);
+  if (!session->context) session->context = gl::GlContext::create(gl::parseGlBackend(gl_backend_name));
+  session->context->makeCurrent();
+  if (!session->rays) session->rays = std::make_unique<RayScene>(scene);
+  if (!session->renderer) {
+    gl::RendererOptions ro;
+    ro.map_size = scene.render.map_size;
+    ro.vertex.channels.clear();
+    const bool any_dispersive_lens = std::any_of(scene.elements.begin(), scene.elements.end(), [](const Element& e) {
+      return e.type == ElementType::Lens && e.dispersion_on;
+    });
+    if (disp != DispersionMode::Off && any_dispersive_lens) {
+      for (double wl : kRgbWavelengths_nm) ro.vertex.channels.push_back(ChannelSpec{wl});
+    } else {
+      ro.vertex.channels.push_back(ChannelSpec{});
+    }
+    session->renderer = std::make_unique<gl::Renderer>(scene, *session->rays, ro);
+  }
+  gl::RasterFrame f = session->renderer->render(rm, &session->cache);
+  out.width = f.width;
+  out.height = f.height;
+  out.color = std::move(f.color);
+  out.seen = std::move(f.seen);
+  out.element = std::move(f.element);
+  out.element_point = std::move(f.element_point);
+  out.frame_ms = f.frame_ms;
+  out.stages = std::move(f.stages);
+  out.elements = elementsJson(scene, f.elements);
+  out.gl_backend = session->context->backendName() + " (" + session->context->glRenderer() + ")";
+  return out;
+}
+
+int cmdRender(const std::vector<std::string>& argv) {
+  Args a("render", argv, {"mode", "size", "out", "gl", "set", "stats", "frames", "orbit"}, {}, {"set"});
+  if (a.positional().size() > 1) usageError("render", "expected at most one scene file");
+  const std::string scene_path = a.positional().empty() ? kDefaultScene : a.positional()[0];
+  const auto size = a.getSize("size");
+  const int frames = a.getInt("frames", 1, 1);
+  const double orbit_deg = a.getDouble("orbit", 0.0);
+  LoadedScene ls = loadScene(scene_path, a.all("set"), size ? size->first : 0, size ? size->second : 0);
+  const std::string mode = a.get("mode", ls.scene.render.mode);
+  if (mode != "raytrace") gl::parseRasterMode(mode);  // validate before any work
+  const std::string out_path = a.get("out", ls.scene.render.output);
+  const std::string gl_name = gl::glBackendName(backendArg(a));
+
+  RenderSession session;
+  RenderedFrame last;
+  std::vector<double> frame_times;
+  std::map<std::string, std::pair<int, int>> stage_counts;  // name -> (ran, skipped)
+  std::map<std::string, std::vector<double>> stage_ms;
+  std::map<std::string, std::string> skip_reason;
+  const Vec3 eye0 = ls.scene.observer.eye, target0 = ls.scene.observer.target;
+  for (int i = 0; i < frames; ++i) {
+    if (frames > 1 && orbit_deg != 0) {
+      // Turn the head about the vertical axis through the eye.
+      const double angle = radians(orbit_deg) * (frames > 1 ? double(i) / double(frames - 1) : 0.0);
+      const Mat4 rot = glm::rotate(Mat4(1.0), angle, ls.scene.observer.up);
+      ls.scene.observer.eye = eye0;
+      ls.scene.observer.target = eye0 + Vec3(rot * Vec4(target0 - eye0, 0.0));
+      updateAttachedElements(ls.scene, ls.desc);
+      session.cache.environment_changed = false;
+    }
+    if (i > 0 && orbit_deg == 0) session.cache.environment_changed = false;
+    last = renderFrame(ls, mode, gl_name, &session);
+    frame_times.push_back(last.frame_ms);
+    for (const StageTiming& s : last.stages.stages) {
+      auto& c = stage_counts[s.name];
+      (s.ran ? c.first : c.second)++;
+      if (s.ran) stage_ms[s.name].push_back(s.ms);
+      else skip_reason[s.name] = s.reason;
+    }
+    if (mode == "raytrace" && frames > 1) {
+      // The reference does not cache; more frames only repeat the same work.
+    }
+  }
+  const size_t bad = writeLinearPng(out_path, last.width, last.height, last.color);
+  if (bad) std::fprintf(stderr, "pvrr render: warning: %zu non-finite pixels written as black\n", bad);
+  const double frame_ms = median(frame_times);
+  std::printf("%s\n", out_path.c_str());
+  std::printf("frame time: %.3f ms (%s, %dx%d, mode %s%s)\n", frame_ms, last.gl_backend.c_str(), last.width, last.height,
+              mode.c_str(), frames > 1 ? (", median of " + std::to_string(frames) + " frames").c_str() : "");
+  if (auto stats = a.get("stats")) {
+    json j = {{"scene", scene_path}, {"mode", mode}, {"size", {last.width, last.height}}, {"gl", last.gl_backend},
+              {"frame_ms", frame_ms}, {"frames", frames}, {"stages", stagesJson(last.stages)},
+              {"elements", last.elements}, {"peak_rss_mb", peakRssMb()}};
+    if (frames > 1) {
+      json per = json::array();
+      for (const auto& [name, c] : stage_counts) {
+        const auto& v = stage_ms[name];
+        double mean = 0;
+        for (double x : v) mean += x;
+        per.push_back({{"name", name}, {"frames_ran", c.first}, {"frames_skipped", c.second},
+                       {"mean_ms", v.empty() ? 0.0 : mean / double(v.size())},
+                       {"reason", c.second ? skip_reason[name] : ""}});
+      }
+      j["stage_frames"] = per;
+      j["orbit_deg"] = orbit_deg;
+    }
+    writeFileAtomic(*stats, j.dump(2) + "\n");
+  }
+  return 0;
+}
+
+int cmdTrace(const std::vector<std::string>& argv) {
+  Args a("trace", argv, {"ray", "pixel", "size", "wavelength", "set"}, {}, {"set"});
+  if (a.positional().size() != 1) usageError("trace", "expected one scene file");
+  if (a.has("ray") == a.has("pixel")) usageError("trace", "give exactly one of --ray and --pixel");
+  const auto size = a.getSize("size");
+  LoadedScene ls = loadScene(a.positional()[0], a.all("set"), size ? size->first : 0, size ? size->second : 0);
+  const double wl = a.getDouble("wavelength", 0.0);
+  if (a.has("wavelength") && (wl < 300 || wl > 1100)) usageError("trace", "--wavelength: expected 300..1100 nm");
+  Vec3 o, d;
+  if (a.has("ray")) {
+    std::vector<double> r = a.getNumbers("ray", 6);
+    o = Vec3(r[0], r[1], r[2]);
+    d = Vec3(r[3], r[4], r[5]);
+    if (glm::length(d) == 0) usageError("trace", "--ray: the direction must not be zero");
+  } else {
+    std::vector<double> p = a.getNumbers("pixel", 2);
+    const Observer& ob = ls.scene.observer;
+    if (p[0] < 0 || p[1] < 0 || p[0] > ob.width || p[1] > ob.height)
+      usageError("trace", "--pixel: outside the " + std::to_string(ob.width) + "x" + std::to_string(ob.height) + " image");
+    o = ob.eye;
+    d = ob.pixelDirection(p[0], p[1]);
+  }
+  RayScene rays(ls.scene);
+  TraceOptions to;
+  to.max_depth = ls.scene.render.max_depth;
+  Tracer tracer(rays, to);
+  std::vector<PathSegment> path;
+  tracer.trace(o, glm::normalize(d), wl, &path);
+  json segs = json::array();
+  for (const PathSegment& s : path) {
+    json j = {{"origin", vec(s.origin)}, {"direction", vec(s.direction)}, {"event", s.event},
+              {"element", s.element >= 0 ? json(ls.scene.elements[size_t(s.element)].name) : json(nullptr)},
+              {"point", s.has_point ? vec(s.point) : json(nullptr)},
+              {"normal", s.has_point ? vec(s.normal) : json(nullptr)}, {"n1", s.n1}, {"n2", s.n2}};
+    segs.push_back(j);
+  }
+  json out = {{"segments", segs}};
+  // Full double precision: 17 significant digits round-trip every double.
+  std::printf("%s\n", out.dump(2).c_str());
+  return 0;
+}
+
+}  // namespace pvrr::app

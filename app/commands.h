@@ -1,0 +1,43 @@
+// The pvrr subcommands and what they share: loading and building a scene, writing outputs atomically,
+// metrics against the reference.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "pvrr/gl/renderer.h"
+#include "pvrr/scene_build.h"
+#include "pvrr/scene_desc.h"
+#include "pvrr/tracer.h"
+
+namespace pvrr::app {
+
+int cmdRender(const std::vector<std::string>& args);
+int cmdGlInfo(const std::vector<std::string>& args);
+int cmdTrace(const std::vector<std::string>& args);
+int cmdVertices(const std::vector<std::string>& args);
+int cmdCompare(const std::vector<std::string>& args);
+int cmdMesh(const std::vector<std::string>& args);
+
+// The default scene of `pvrr render` with no scene argument.
+constexpr const char* kDefaultScene = "models/car-mirror.json";
+
+struct LoadedScene {
+  SceneDesc desc;
+  Scene scene;
+};
+// Loads, validates (with --set overrides) and builds. `size` overrides the observer's image size.
+LoadedScene loadScene(const std::string& path, const std::vector<std::string>& overrides, int width = 0,
+                      int height = 0);
+// Reads OBJ and PLY meshes with VTK (the scene builder's mesh loader).
+MeshData readMeshFile(const std::string& path);
+
+// Writes `content` to `path` through a temporary file in the same folder and a rename; creates the
+// folder. On failure removes the temporary and throws pvrr::Error naming the path.
+void writeFileAtomic(const std::string& path, const std::string& content);
+// Linear RGB -> sRGB8 PNG, atomically. Non-finite values are written as black and counted (returned).
+size_t writeLinearPng(const std::string& path, int width, int height, const std::vector<Vec3>& linear);
+
+// Angular error (radians) at `surface_point` between the directions to two seen points.
+double seenAngle(const Vec3& surface_point, const Vec3& seen_a, const Vec3& seen_b);
+
+}  // namespace pvrr::app

@@ -1,0 +1,314 @@
+// pvrr compare and pvrr vertices: accuracy against the reference, per-vertex data.
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "app/args.h"
+#include "app/report.h"
+#include "cad/error.h"
+#include "pvrr/image.h"
+#include "pvrr/spectrum.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace pvrr::app {
+
+double peakRssMb() {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
+  return 0;
+}
+
+namespace {
+
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const double pos = q * double(v.size() - 1);
+  const size_t i = size_t(pos);
+  const double f = pos - double(i);
+  return i + 1 < v.size() ? v[i] * (1 - f) + v[i + 1] * f : v[i];
+}
+
+// A perceptually ordered colour map (black-body-like: black, red, yellow, white) for heat maps.
+Vec3 heat(double x) {
+  x = std::clamp(x, 0.0, 1.0);
+  return Vec3(std::clamp(3 * x, 0.0, 1.0), std::clamp(3 * x - 1, 0.0, 1.0), std::clamp(3 * x - 2, 0.0, 1.0));
+}
+
+// 3x5 bitmap digits for the colour bar's labels ('.', '0'-'9').
+const char* glyph(char c) {
+  switch (c) {
+    case '0': return "111101101101111";
+    case '1': return "010110010010111";
+    case '2': return "111001111100111";
+    case '3': return "111001111001111";
+    case '4': return "101101111001001";
+    case '5': return "111100111001111";
+    case '6': return "111100111101111";
+    case '7': return "111001001001001";
+    case '8': return "111101111101111";
+    case '9': return "111101111001111";
+    case '.': return "000000000000010";
+    default: return "000000000000000";
+  }
+}
+
+void drawText(ImageRGB8& img, int x0, int y0, const std::string& s, int scale) {
+  for (size_t k = 0; k < s.size(); ++k) {
+    const char* g = glyph(s[k]);
+    for (int gy = 0; gy < 5; ++gy)
+      for (int gx = 0; gx < 3; ++gx)
+        if (g[gy * 3 + gx] == '1')
+          for (int sy = 0; sy < scale; ++sy)
+            for (int sx = 0; sx < scale; ++sx) {
+              const int x = x0 + int(k) * 4 * scale + gx * scale + sx, y = y0 + gy * scale + sy;
+              if (x >= 0 && y >= 0 && x < img.width && y < img.height) {
+                uint8_t* p = img.at(x, y);
+                p[0] = p[1] = p[2] = 255;
+              }
+            }
+  }
+}
+
+// The error heat map: per-pixel angular error over element pixels (others dark grey), with a colour bar
+// on the right labelled 0 and the scale maximum in arcminutes.
+void writeHeatMap(const std::string& path, int w, int h, const std::vector<double>& err, double scale_arcmin) {
+  const int bar = 60;
+  ImageRGB8 img(w + bar, h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const double e = err[size_t(y) * size_t(w) + size_t(x)];
+      uint8_t* p = img.at(x, y);
+      if (std::isnan(e)) {
+        p[0] = p[1] = p[2] = 40;
+        continue;
+      }
+      const Vec3 c = heat(e / scale_arcmin);
+      for (int k = 0; k < 3; ++k) p[k] = uint8_t(std::lround(255 * c[k]));
+    }
+  const int top = 20, bottom = h - 20;
+  for (int y = 0; y < h; ++y)
+    for (int x = w; x < w + bar; ++x) {
+      uint8_t* p = img.at(x, y);
+      p[0] = p[1] = p[2] = 0;
+      if (y >= top && y <= bottom && x >= w + 8 && x < w + 20) {
+        const Vec3 c = heat(double(bottom - y) / double(std::max(1, bottom - top)));
+        for (int k = 0; k < 3; ++k) p[k] = uint8_t(std::lround(255 * c[k]));
+      }
+    }
+  char label[32];
+  std::snprintf(label, sizeof label, "%.3g", scale_arcmin);
+  drawText(img, w + 4, 4, label, 2);
+  drawText(img, w + 4, h - 14, "0", 2);
+  writePngAtomic(path, img);
+}
+
+}  // namespace
+
+ErrorStats compareToReference(const RenderedFrame& ref, const RenderedFrame& mode, std::vector<double>* errors,
+                              int only_element) {
+  ErrorStats s;
+  const size_t n = ref.color.size();
+  if (errors) errors->assign(n, std::nan(""));
+  std::vector<double> e;
+  double se = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (ref.element[i] < 0 || (only_element >= 0 && ref.element[i] != only_element)) continue;
+    const double a = arcminutes(seenAngle(ref.element_point[i], ref.seen[i], mode.seen[i]));
+    if (!std::isfinite(a)) continue;
+    e.push_back(a);
+    if (errors) (*errors)[i] = a;
+    for (int k = 0; k < 3; ++k) {
+      const double d = linearToSrgb(std::clamp(ref.color[i][k], 0.0, 1.0)) - linearToSrgb(std::clamp(mode.color[i][k], 0.0, 1.0));
+      se += d * d;
+    }
+  }
+  s.pixels = e.size();
+  if (e.empty()) return s;
+  s.median_arcmin = quantile(e, 0.5);
+  s.p95_arcmin = quantile(e, 0.95);
+  s.max_arcmin = *std::max_element(e.begin(), e.end());
+  s.rmse = std::sqrt(se / (3.0 * double(e.size())));
+  s.psnr_db = s.rmse > 0 ? 20.0 * std::log10(1.0 / s.rmse) : 99.0;
+  return s;
+}
+
+int cmdCompare(const std::vector<std::string>& argv) {
+  Args a("compare", argv, {"modes", "size", "frames", "out", "gl", "set"}, {}, {"set"});
+  if (a.positional().size() != 1) usageError("compare", "expected one scene file");
+  auto out_dir = a.get("out");
+  if (!out_dir) usageError("compare", "--out DIR is required");
+  const auto size = a.getSize("size");
+  const int frames = a.getInt("frames", 5, 1);
+  std::vector<std::string> modes;
+  {
+    std::stringstream ss(a.get("modes", "pvrr,envmap"));
+    std::string m;
+    while (std::getline(ss, m, ','))
+      if (!m.empty()) {
+        if (m == "raytrace" || m == "reference") usageError("compare", "the reference is always rendered; list only raster modes");
+        gl::parseRasterMode(m);
+        modes.push_back(m);
+      }
+  }
+  const std::string scene_path = a.positional()[0];
+  LoadedScene ls = loadScene(scene_path, a.all("set"), size ? size->first : 0, size ? size->second : 0);
+  const auto backend = a.get("gl");
+  const std::string gl_name = backend ? *backend : gl::glBackendName(gl::glBackendFromEnvironment(gl::GlBackend::Auto));
+  gl::parseGlBackend(gl_name);
+
+  RenderSession none;
+  RenderedFrame ref = renderFrame(ls, "raytrace", gl_name, &none);
+  const int w = ref.width, h = ref.height;
+  json metrics = {{"scene", scene_path}, {"size", {w, h}}, {"reference", {{"frame_ms", ref.frame_ms}}}};
+  writeLinearPng(*out_dir + "/reference.png", w, h, ref.color);
+  json jm = json::object();
+  std::string gl_used;
+  for (const std::string& m : modes) {
+    RenderSession session;
+    std::vector<double> times;
+    RenderedFrame f;
+    // One warm-up frame (shader compilation, first uploads), then the median of N with the cache cleared,
+    // so every measured frame does all of its stages.
+    for (int i = 0; i <= frames; ++i) {
+      session.cache = gl::FrameCache{};
+      f = renderFrame(ls, m, gl_name, &session);
+      if (i > 0) times.push_back(f.frame_ms);
+    }
+    std::sort(times.begin(), times.end());
+    const double frame_ms = times[times.size() / 2];
+    gl_used = f.gl_backend;
+    std::vector<double> err;
+    const ErrorStats st = compareToReference(ref, f, &err);
+    writeLinearPng(*out_dir + "/" + m + ".png", w, h, f.color);
+    const double scale = std::max(1.0, st.p95_arcmin * 1.5);
+    writeHeatMap(*out_dir + "/" + m + "-error.png", w, h, err, scale);
+    json stages = json::array();
+    for (const StageTiming& t : f.stages.stages)
+      stages.push_back({{"name", t.name}, {"ms", t.ms}, {"ran", t.ran}, {"reason", t.reason}});
+    json per_element = json::array();
+    for (size_t e = 0; e < ls.scene.elements.size(); ++e) {
+      const ErrorStats es = compareToReference(ref, f, nullptr, int(e));
+      per_element.push_back({{"name", ls.scene.elements[e].name}, {"pixels", es.pixels},
+                             {"angular_error_arcmin", {{"median", es.median_arcmin}, {"p95", es.p95_arcmin}, {"max", es.max_arcmin}}}});
+    }
+    jm[m] = {{"frame_ms", frame_ms},
+             {"stages", stages},
+             {"speedup_vs_reference", frame_ms > 0 ? ref.frame_ms / frame_ms : 0.0},
+             {"pixels", st.pixels},
+             {"angular_error_arcmin", {{"median", st.median_arcmin}, {"p95", st.p95_arcmin}, {"max", st.max_arcmin}}},
+             {"heat_map_scale_arcmin", scale},
+             {"psnr_db", st.psnr_db},
+             {"rmse", st.rmse},
+             {"elements", per_element},
+             {"element_stats", f.elements}};
+    std::printf("%-8s %8.2f ms  median %.4f' p95 %.4f' max %.3f'  PSNR %.2f dB  (%zu px)\n", m.c_str(), frame_ms,
+                st.median_arcmin, st.p95_arcmin, st.max_arcmin, st.psnr_db, st.pixels);
+  }
+  metrics["gl"] = gl_used;
+  metrics["modes"] = jm;
+  metrics["peak_rss_mb"] = peakRssMb();
+  writeFileAtomic(*out_dir + "/metrics.json", metrics.dump(2) + "\n");
+  std::printf("reference %.1f ms; wrote %s/metrics.json\n", ref.frame_ms, out_dir->c_str());
+  return 0;
+}
+
+int cmdVertices(const std::vector<std::string>& argv) {
+  Args a("vertices", argv, {"element", "out", "set"}, {}, {"set"});
+  if (a.positional().size() != 1) usageError("vertices", "expected one scene file");
+  auto out = a.get("out");
+  if (!out) usageError("vertices", "--out FILE.csv is required");
+  const std::string ext = fs::path(*out).extension().string();
+  if (ext != ".csv" && ext != ".vtp") usageError("vertices", "--out: expected a .csv or .vtp file, got \"" + *out + "\"");
+  LoadedScene ls = loadScene(a.positional()[0], a.all("set"));
+  const Scene& scene = ls.scene;
+  std::vector<int> which;
+  for (size_t e = 0; e < scene.elements.size(); ++e)
+    if (!a.has("element") || scene.elements[e].name == *a.get("element")) which.push_back(int(e));
+  if (which.empty()) {
+    if (a.has("element")) {
+      std::vector<std::string> names;
+      for (const Element& e : scene.elements) names.push_back(e.name);
+      std::string hint = nearest(*a.get("element"), names);
+      throw Error(ls.desc.source + ": no element named \"" + *a.get("element") + "\"" +
+                  (hint.empty() ? "" : "; did you mean \"" + hint + "\"?"));
+    }
+    throw Error(ls.desc.source + ": the scene has no mirror or lens");
+  }
+  RayScene rays(scene);
+  VertexStageOptions opt;
+  const bool disp = scene.render.dispersion != "off";
+  std::vector<ElementFrame> frames;
+  for (int e : which) {
+    VertexStageOptions o = opt;
+    o.channels.clear();
+    if (disp && scene.elements[size_t(e)].type == ElementType::Lens && scene.elements[size_t(e)].dispersion_on)
+      for (double wl : kRgbWavelengths_nm) o.channels.push_back(ChannelSpec{wl});
+    else
+      o.channels.push_back(ChannelSpec{});
+    ElementFrame f = prepareElement(scene, e);
+    traceVertexRays(rays, f, scene.observer.eye, o);
+    fitPatchViews(scene, f, o);
+    frames.push_back(std::move(f));
+  }
+  if (ext == ".vtp") {
+    writeVerticesVtp(*out, scene, frames);
+    std::printf("%s\n", out->c_str());
+    return 0;
+  }
+  const bool any_lens = std::any_of(which.begin(), which.end(), [&](int e) { return scene.elements[size_t(e)].type == ElementType::Lens; });
+  std::ostringstream csv;
+  csv.precision(17);
+  csv << "element,patch,vertex,channel,px,py,pz,nx,ny,nz,dx,dy,dz,status,hx,hy,hz,s,t";
+  if (any_lens) csv << ",ix,iy,iz,bx,by,bz,bnx,bny,bnz";
+  csv << "\n";
+  json cams = json::array();
+  for (const ElementFrame& f : frames) {
+    const Element& el = scene.elements[size_t(f.element)];
+    json patches = json::array();
+    for (const PatchView& pv : f.views) {
+      const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
+      for (size_t c = 0; c < pv.st.size(); ++c) {
+        const double wl = f.rays.size() > 1 ? kRgbWavelengths_nm[c] : kLineD_nm;
+        auto rm = [](const Mat4& m) { auto r = rowMajor16(m); return json(std::vector<double>(r.begin(), r.end())); };
+        patches.push_back({{"patch", pv.patch}, {"channel", c}, {"eye", {pv.volume.eye.x, pv.volume.eye.y, pv.volume.eye.z}},
+                           {"view_matrix", rm(pv.volume.view)}, {"projection_matrix", rm(pv.volume.projection)},
+                           {"map_size", {scene.render.map_size, scene.render.map_size}},
+                           {"wavelength_nm", wl},
+                           {"n", el.type == ElementType::Lens ? el.dispersion.index(wl) : 1.0}});
+        for (size_t k = 0; k < gp.vertices.size(); ++k) {
+          const uint32_t vi = gp.vertices[k];
+          const VertexRay& r = f.rays[c][vi];
+          const Vec3 p = f.world_pos[vi], n = f.world_normal[vi];
+          csv << el.name << ',' << pv.patch << ',' << vi << ',' << c << ',' << p.x << ',' << p.y << ',' << p.z << ','
+              << n.x << ',' << n.y << ',' << n.z << ',' << r.dir.x << ',' << r.dir.y << ',' << r.dir.z << ','
+              << toString(r.status) << ',' << r.hit.x << ',' << r.hit.y << ',' << r.hit.z << ',' << pv.st[c][k].x << ','
+              << pv.st[c][k].y;
+          if (any_lens)
+            csv << ',' << r.internal_dir.x << ',' << r.internal_dir.y << ',' << r.internal_dir.z << ',' << r.back_point.x
+                << ',' << r.back_point.y << ',' << r.back_point.z << ',' << r.back_normal.x << ',' << r.back_normal.y << ','
+                << r.back_normal.z;
+          csv << "\n";
+        }
+      }
+    }
+    cams.push_back({{"name", el.name}, {"patches", patches}});
+  }
+  json j = {{"observer", {scene.observer.eye.x, scene.observer.eye.y, scene.observer.eye.z}}, {"n_outside", 1.0}, {"elements", cams}};
+  const std::string json_path = (fs::path(*out).replace_extension(".json")).string();
+  writeFileAtomic(*out, csv.str());
+  writeFileAtomic(json_path, j.dump(2) + "\n");
+  std::printf("%s\n%s\n", out->c_str(), json_path.c_str());
+  return 0;
+}
+
+}  // namespace pvrr::app

@@ -1,0 +1,77 @@
+// Headless OpenGL contexts: EGL (a GPU device, Mesa's software device, or surfaceless Mesa) and OSMesa, chosen at
+// run time. There is no default framebuffer to draw into: all rendering goes to a pvrr::gl::Framebuffer.
+//
+// Threading: GL entry points are process-wide (glad), so use GL from one thread at a time; makeCurrent() reloads
+// them whenever a different context becomes current.
+#pragma once
+#include <memory>
+#include <string>
+
+namespace pvrr::gl {
+
+namespace detail {
+class ContextBackend;
+}
+
+// Auto: EGL device (hardware, then Mesa software) > EGL surfaceless > OSMesa. Egl: only the EGL paths.
+// OsMesa: only OSMesa.
+enum class GlBackend { Auto, Egl, OsMesa };
+
+// "auto" | "egl" | "osmesa" (exactly, lower case). Throws pvrr::Error listing the choices otherwise.
+GlBackend parseGlBackend(const std::string& name);
+// The inverse of parseGlBackend.
+std::string glBackendName(GlBackend backend);
+
+// The backend named by the environment variable PVRR_GL, or `fallback` when it is unset or empty. Throws
+// pvrr::Error naming PVRR_GL and the choices when it is set to something else. The CLI combines
+// --gl flag > PVRR_GL > auto.
+GlBackend glBackendFromEnvironment(GlBackend fallback = GlBackend::Auto);
+
+// The lowest GL version pvrr runs on (core profile). create() tries the requested version first, then this one.
+inline constexpr int kGlFloorMajor = 3;
+inline constexpr int kGlFloorMinor = 3;
+
+class GlContext {
+ public:
+  // Creates a core-profile context of version major.minor (falling back to 3.3 core where that fails), makes it
+  // current on this thread and loads the GL entry points. Throws pvrr::Error listing every path tried and why
+  // each failed (the step and the EGL error name, e.g. "eglCreateContext: EGL_BAD_MATCH").
+  static std::unique_ptr<GlContext> create(GlBackend requested, int major = 4, int minor = 5);
+
+  ~GlContext();
+  GlContext(const GlContext&) = delete;
+  GlContext& operator=(const GlContext&) = delete;
+
+  // Makes this context current on this thread (releasing any other pvrr context first) and, when the last
+  // current context was a different one, reloads the GL entry points for it.
+  void makeCurrent();
+  // The context current on this thread through makeCurrent()/create(), or nullptr.
+  static GlContext* current();
+
+  // "egl-device" (a non-software EGL device), "egl-device-software" (Mesa's software device),
+  // "egl-surfaceless" or "osmesa".
+  const std::string& backendName() const { return backend_name_; }
+  const std::string& glVersion() const { return gl_version_; }    // GL_VERSION
+  const std::string& glRenderer() const { return gl_renderer_; }  // GL_RENDERER
+  const std::string& glVendor() const { return gl_vendor_; }      // GL_VENDOR
+  const std::string& glslVersion() const { return glsl_version_; }  // GL_SHADING_LANGUAGE_VERSION
+  int glMajor() const { return gl_major_; }  // GL_MAJOR_VERSION of the context actually created
+  int glMinor() const { return gl_minor_; }
+  // True on a GPU: an EGL device without EGL_MESA_device_software whose renderer is not a Mesa software
+  // rasteriser (llvmpipe, softpipe, swrast).
+  bool isHardware() const { return is_hardware_; }
+  // Why the paths tried before this one failed, one "\n  <path>, <version>: <reason>" line each ("" when the first
+  // path worked), e.g. for a verbose report of why Auto fell back to software.
+  const std::string& creationNotes() const { return creation_notes_; }
+
+ private:
+  explicit GlContext(std::unique_ptr<detail::ContextBackend> backend);
+  void loadEntryPoints();
+
+  std::unique_ptr<detail::ContextBackend> backend_;
+  std::string backend_name_, gl_version_, gl_renderer_, gl_vendor_, glsl_version_, creation_notes_;
+  int gl_major_ = 0, gl_minor_ = 0;
+  bool is_hardware_ = false;
+};
+
+}  // namespace pvrr::gl

@@ -1,0 +1,574 @@
+#include "pvrr/gl/renderer.h"
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+#include <algorithm>
+#include <chrono>
+
+#include "cad/error.h"
+#include "pvrr/gl/gl.h"
+#include "pvrr/gl/program.h"
+
+namespace pvrr::gl {
+
+RasterMode parseRasterMode(const std::string& mode) {
+  if (mode == "raster") return RasterMode::Raster;
+  if (mode == "pvrr") return RasterMode::Pvrr;
+  if (mode == "envmap") return RasterMode::Envmap;
+  throw Error("mode: expected one of pvrr, raster, envmap, raytrace; got \"" + mode + "\"");
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+glm::mat4 toFloat(const Mat4& m) { return glm::mat4(m); }
+
+// The projection * view of a camera whose origin is `origin`, acting on points relative to that origin.
+// The view's translation is folded in double precision, so nothing large reaches float.
+Mat4 relativeViewProj(const Mat4& proj, const Mat4& view, const Vec3& origin) {
+  return proj * view * glm::translate(Mat4(1.0), origin);
+}
+
+// A render target: N colour attachments (2D or one face of cube maps) and a depth buffer.
+struct Target {
+  GLuint fbo = 0, depth = 0;
+  std::vector<GLuint> colors;
+  int width = 0, height = 0;
+  bool cube = false;
+  Target() = default;
+  Target(const Target&) = delete;
+  Target& operator=(const Target&) = delete;
+  ~Target() { release(); }
+  void release() {
+    if (fbo) glDeleteFramebuffers(1, &fbo);
+    if (depth) glDeleteRenderbuffers(1, &depth);
+    if (!colors.empty()) glDeleteTextures(GLsizei(colors.size()), colors.data());
+    fbo = depth = 0;
+    colors.clear();
+  }
+  // formats: internal formats of the colour attachments; filters: GL_LINEAR or GL_NEAREST each.
+  void create(int w, int h, const std::vector<GLenum>& formats, const std::vector<GLenum>& filters, bool as_cube) {
+    release();
+    width = w;
+    height = h;
+    cube = as_cube;
+    glGenFramebuffers(1, &fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    colors.resize(formats.size());
+    glGenTextures(GLsizei(colors.size()), colors.data());
+    for (size_t i = 0; i < formats.size(); ++i) {
+      const GLenum target = cube ? GL_TEXTURE_CUBE_MAP : GL_TEXTURE_2D;
+      glBindTexture(target, colors[i]);
+      if (cube) {
+        for (int f = 0; f < 6; ++f)
+          glTexImage2D(GLenum(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f), 0, GLint(formats[i]), w, h, 0, GL_RGBA, GL_FLOAT, nullptr);
+        glTexParameteri(target, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+      } else {
+        glTexImage2D(GL_TEXTURE_2D, 0, GLint(formats[i]), w, h, 0, GL_RGBA, GL_FLOAT, nullptr);
+      }
+      glTexParameteri(target, GL_TEXTURE_MIN_FILTER, GLint(filters[i]));
+      glTexParameteri(target, GL_TEXTURE_MAG_FILTER, GLint(filters[i]));
+      glTexParameteri(target, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      glTexParameteri(target, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+      if (!cube) glFramebufferTexture2D(GL_FRAMEBUFFER, GLenum(GL_COLOR_ATTACHMENT0 + i), GL_TEXTURE_2D, colors[i], 0);
+    }
+    glGenRenderbuffers(1, &depth);
+    glBindRenderbuffer(GL_RENDERBUFFER, depth);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, w, h);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
+    if (cube) selectFace(0);
+    std::vector<GLenum> bufs(formats.size());
+    for (size_t i = 0; i < bufs.size(); ++i) bufs[i] = GLenum(GL_COLOR_ATTACHMENT0 + i);
+    glDrawBuffers(GLsizei(bufs.size()), bufs.data());
+    GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    if (status != GL_FRAMEBUFFER_COMPLETE)
+      throw Error("GL: framebuffer " + std::to_string(w) + "x" + std::to_string(h) + " incomplete (status 0x" +
+                  std::to_string(status) + ")");
+    checkGlError("creating a render target");
+  }
+  void selectFace(int face) {
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    for (size_t i = 0; i < colors.size(); ++i)
+      glFramebufferTexture2D(GL_FRAMEBUFFER, GLenum(GL_COLOR_ATTACHMENT0 + i), GLenum(GL_TEXTURE_CUBE_MAP_POSITIVE_X + face),
+                             colors[i], 0);
+  }
+  std::vector<float> read(int attachment) const {
+    std::vector<float> px(size_t(width) * size_t(height) * 4);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glReadBuffer(GLenum(GL_COLOR_ATTACHMENT0 + attachment));
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, px.data());
+    return px;
+  }
+};
+
+struct MeshBuffers {
+  GLuint vao = 0, vbo = 0, ebo = 0;
+  GLsizei count = 0;
+  void release() {
+    if (ebo) glDeleteBuffers(1, &ebo);
+    if (vbo) glDeleteBuffers(1, &vbo);
+    if (vao) glDeleteVertexArrays(1, &vao);
+    vao = vbo = ebo = 0;
+  }
+};
+
+// Interleaved float attributes: `layout` lists each attribute's component count, in location order.
+void uploadMesh(MeshBuffers& mb, const std::vector<float>& data, const std::vector<int>& layout,
+                const std::vector<uint32_t>& indices) {
+  if (!mb.vao) {
+    glGenVertexArrays(1, &mb.vao);
+    glGenBuffers(1, &mb.vbo);
+    glGenBuffers(1, &mb.ebo);
+  }
+  glBindVertexArray(mb.vao);
+  glBindBuffer(GL_ARRAY_BUFFER, mb.vbo);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(data.size() * sizeof(float)), data.data(), GL_DYNAMIC_DRAW);
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, mb.ebo);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * sizeof(uint32_t)), indices.data(), GL_DYNAMIC_DRAW);
+  int stride = 0;
+  for (int c : layout) stride += c;
+  size_t offset = 0;
+  for (size_t i = 0; i < layout.size(); ++i) {
+    glEnableVertexAttribArray(GLuint(i));
+    glVertexAttribPointer(GLuint(i), layout[i], GL_FLOAT, GL_FALSE, GLsizei(stride * sizeof(float)),
+                          reinterpret_cast<const void*>(offset * sizeof(float)));
+    offset += size_t(layout[i]);
+  }
+  mb.count = GLsizei(indices.size());
+  glBindVertexArray(0);
+}
+
+void draw(const MeshBuffers& mb) {
+  glBindVertexArray(mb.vao);
+  glDrawElements(GL_TRIANGLES, mb.count, GL_UNSIGNED_INT, nullptr);
+}
+
+// GLSL has no #include: splice `#include "file"` lines with the embedded file (one level, as used).
+std::string resolveIncludes(const std::string& src) {
+  std::string out;
+  size_t pos = 0;
+  while (pos < src.size()) {
+    size_t eol = src.find('\n', pos);
+    if (eol == std::string::npos) eol = src.size();
+    const std::string line = src.substr(pos, eol - pos);
+    const size_t q1 = line.find('"');
+    if (line.rfind("#include", 0) == 0 && q1 != std::string::npos) {
+      const size_t q2 = line.find('"', q1 + 1);
+      out += shaderSource(line.substr(q1 + 1, q2 - q1 - 1)) + "\n";
+    } else {
+      out += line + "\n";
+    }
+    pos = eol + 1;
+  }
+  return out;
+}
+
+Program makeProgram(const std::string& vert, const std::string& frag, const std::vector<std::string>& defines = {}) {
+  return Program::fromSources({vert, resolveIncludes(shaderSource(vert))}, {frag, resolveIncludes(shaderSource(frag))},
+                              defines);
+}
+
+// Cube-map faces in GL order (+X, -X, +Y, -Y, +Z, -Z): view direction and up vector.
+const Vec3 kCubeDir[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+const Vec3 kCubeUp[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
+
+}  // namespace
+
+struct Renderer::Impl {
+  const Scene& scene;
+  const RayScene& rays;
+  RendererOptions options;
+  Program env_program = makeProgram("env.vert", "env.frag");
+  Program sky_program = makeProgram("sky.vert", "sky.frag");
+  Program plain_program = makeProgram("element.vert", "element.frag", {"#define MODE_PLAIN"});
+  Program envmap_program = makeProgram("element.vert", "element.frag", {"#define MODE_ENVMAP"});
+  Program lens_envmap_program = makeProgram("element.vert", "element.frag", {"#define MODE_ENVMAP", "#define LENS"});
+  Program pvrr_program = makeProgram("element.vert", "element.frag", {"#define MODE_PVRR", "#define CHANNELS 1"});
+  Program pvrr3_program = makeProgram("element.vert", "element.frag", {"#define MODE_PVRR", "#define CHANNELS 3"});
+  Program lens_program = makeProgram("element.vert", "element.frag", {"#define MODE_PVRR", "#define CHANNELS 1", "#define LENS"});
+  Program lens3_program = makeProgram("element.vert", "element.frag", {"#define MODE_PVRR", "#define CHANNELS 3", "#define LENS"});
+  GLuint empty_vao = 0;
+  std::vector<MeshBuffers> env_meshes;
+  std::vector<GLuint> textures;
+  Target frame_target;
+  std::vector<std::unique_ptr<Target>> maps;   // first-pass maps, one per patch view (reused)
+  std::vector<std::unique_ptr<Target>> cubes;  // envmap cubes, one per element
+  std::vector<MeshBuffers> element_meshes;     // per (element, patch) in pvrr mode; per element otherwise
+
+  Impl(const Scene& s, const RayScene& r, RendererOptions o) : scene(s), rays(r), options(std::move(o)) {
+    glGenVertexArrays(1, &empty_vao);
+    for (const Texture& t : scene.textures) {
+      GLuint id = 0;
+      glGenTextures(1, &id);
+      glBindTexture(GL_TEXTURE_2D, id);
+      // Rows bottom-up for GL, so that v = 0 is the image's bottom row (pvrr/shading.cpp samples the same).
+      std::vector<uint8_t> flipped(t.rgb.size());
+      const size_t row = size_t(t.width) * 3;
+      for (int y = 0; y < t.height; ++y)
+        std::copy_n(&t.rgb[size_t(t.height - 1 - y) * row], row, &flipped[size_t(y) * row]);
+      glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_SRGB8, t.width, t.height, 0, GL_RGB, GL_UNSIGNED_BYTE, flipped.data());
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+      textures.push_back(id);
+    }
+    env_meshes.resize(scene.meshes.size());
+    for (size_t m = 0; m < scene.meshes.size(); ++m) {
+      const EnvMesh& mesh = scene.meshes[m];
+      std::vector<float> data;
+      data.reserve(mesh.positions.size() * 8);
+      for (size_t i = 0; i < mesh.positions.size(); ++i) {
+        const glm::vec3 p = mesh.positions[i], n = mesh.normals[i];
+        const glm::vec2 uv = mesh.uvs[i];
+        data.insert(data.end(), {p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y});
+      }
+      std::vector<uint32_t> idx;
+      idx.reserve(mesh.triangles.size() * 3);
+      for (const auto& t : mesh.triangles) idx.insert(idx.end(), {t.x, t.y, t.z});
+      uploadMesh(env_meshes[m], data, {3, 3, 2}, idx);
+    }
+    checkGlError("uploading the environment");
+  }
+
+  ~Impl() {
+    for (auto& m : env_meshes) m.release();
+    for (auto& m : element_meshes) m.release();
+    if (!textures.empty()) glDeleteTextures(GLsizei(textures.size()), textures.data());
+    if (empty_vao) glDeleteVertexArrays(1, &empty_vao);
+  }
+
+  void setLights(const Program& p, const Vec3& origin) const {
+    int types[8] = {};
+    float vecs[24] = {}, rad[24] = {};
+    int n = 0;
+    for (const Light& l : scene.lights) {
+      if (n == 8) break;
+      types[n] = l.type == Light::Type::Ambient ? 0 : l.type == Light::Type::Directional ? 1 : 2;
+      Vec3 v = l.type == Light::Type::Point ? l.position - origin : l.direction;
+      for (int c = 0; c < 3; ++c) {
+        vecs[3 * n + c] = float(v[c]);
+        rad[3 * n + c] = float(l.radiance[c]);
+      }
+      ++n;
+    }
+    p.set("u_num_lights", n);
+    glUniform1iv(p.uniformLocation("u_light_type"), 8, types);
+    p.setVec3("u_light_vec", vecs, 8);
+    p.setVec3("u_light_radiance", rad, 8);
+  }
+
+  // Sky and environment from a camera at `origin`; `view_origin` is where the viewing rays start (for the
+  // two-sided normal), relative to `origin`.
+  void drawEnvironment(const Mat4& view, const Mat4& proj, const Vec3& origin) const {
+    const Mat4 vp = relativeViewProj(proj, view, origin);
+    glDisable(GL_DEPTH_TEST);
+    glDepthMask(GL_FALSE);
+    sky_program.use();
+    sky_program.set("u_inv_view_proj", toFloat(glm::inverse(vp)));
+    sky_program.set("u_background", glm::vec3(scene.render.background));
+    sky_program.set("u_far", float(scene.render.far_distance_m));
+    glBindVertexArray(empty_vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glEnable(GL_DEPTH_TEST);
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_LESS);
+    env_program.use();
+    env_program.set("u_view_proj", toFloat(vp));
+    env_program.set("u_view_origin", glm::vec3(0.0f));
+    env_program.set("u_texture", 0);
+    setLights(env_program, origin);
+    glActiveTexture(GL_TEXTURE0);
+    for (size_t m = 0; m < scene.meshes.size(); ++m) {
+      const EnvMesh& mesh = scene.meshes[m];
+      const DiffuseMaterial& mat = scene.materials[size_t(mesh.material)];
+      env_program.set("u_offset", glm::vec3(mesh.anchor - origin));
+      env_program.set("u_albedo", glm::vec3(mat.color));
+      env_program.set("u_has_texture", mat.texture >= 0 ? 1 : 0);
+      if (mat.texture >= 0) glBindTexture(GL_TEXTURE_2D, textures[size_t(mat.texture)]);
+      draw(env_meshes[m]);
+    }
+  }
+
+  void clearTarget(const Target& t) const {
+    glBindFramebuffer(GL_FRAMEBUFFER, t.fbo);
+    glViewport(0, 0, t.width, t.height);
+    const float zero[4] = {0, 0, 0, 0};
+    for (size_t i = 0; i < t.colors.size(); ++i) glClearBufferfv(GL_COLOR, GLint(i), zero);
+    glClear(GL_DEPTH_BUFFER_BIT);
+  }
+
+  void setElementMaterial(const Program& p, const Element& el, int index) const {
+    p.set("u_element_id", float(index + 1));
+    p.set("u_metal", el.mirror.metal ? 1 : 0);
+    p.set("u_reflectance", glm::vec3(el.mirror.reflectance));
+    p.set("u_metal_n", glm::vec3(el.mirror.n));
+    p.set("u_metal_k", glm::vec3(el.mirror.k));
+  }
+
+  // Whole-element mesh (plain and envmap modes): position relative to the element's origin, normal.
+  void uploadElementGrid(MeshBuffers& mb, const ElementFrame& f, const Vec3& anchor) {
+    std::vector<float> data;
+    for (size_t i = 0; i < f.world_pos.size(); ++i) {
+      glm::vec3 p(f.world_pos[i] - anchor), n(f.world_normal[i]);
+      data.insert(data.end(), {p.x, p.y, p.z, n.x, n.y, n.z, 0, 0, 0, 0, 0, 0, 1, 1, 1});
+    }
+    std::vector<uint32_t> idx;
+    for (const auto& t : f.grid.triangles) idx.insert(idx.end(), {t.x, t.y, t.z});
+    uploadMesh(mb, data, {3, 3, 2, 2, 2, 3}, idx);
+  }
+
+  void uploadPatch(MeshBuffers& mb, const ElementFrame& f, const PatchView& pv, const Vec3& anchor) {
+    const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
+    const size_t channels = pv.st.size();
+    std::vector<float> data;
+    data.reserve(gp.vertices.size() * 15);
+    for (size_t k = 0; k < gp.vertices.size(); ++k) {
+      const uint32_t vi = gp.vertices[k];
+      glm::vec3 p(f.world_pos[vi] - anchor), n(f.world_normal[vi]);
+      data.insert(data.end(), {p.x, p.y, p.z, n.x, n.y, n.z});
+      for (size_t c = 0; c < 3; ++c) {
+        const Vec2 st = pv.st[std::min(c, channels - 1)][k];
+        data.insert(data.end(), {float(st.x), float(st.y)});
+      }
+      Vec3 tr(1.0);
+      for (size_t c = 0; c < 3; ++c) tr[int(c)] = f.rays[std::min(c, channels - 1)][vi].transmittance[int(c)];
+      data.insert(data.end(), {float(tr.x), float(tr.y), float(tr.z)});
+    }
+    std::vector<uint32_t> idx;
+    for (const auto& t : gp.triangles) idx.insert(idx.end(), {t.x, t.y, t.z});
+    uploadMesh(mb, data, {3, 3, 2, 2, 2, 3}, idx);
+  }
+
+  Target& mapTarget(size_t i) {
+    while (maps.size() <= i) maps.push_back(std::make_unique<Target>());
+    Target& t = *maps[i];
+    if (t.width != options.map_size)
+      t.create(options.map_size, options.map_size, {GL_RGBA16F, GL_RGBA32F, GL_RGBA32F}, {GL_LINEAR, GL_NEAREST, GL_NEAREST},
+               false);
+    return t;
+  }
+
+  RasterFrame render(RasterMode mode, FrameCache* cache);
+};
+
+Renderer::Renderer(const Scene& scene, const RayScene& rays, RendererOptions options)
+    : impl_(std::make_unique<Impl>(scene, rays, std::move(options))) {}
+Renderer::~Renderer() = default;
+
+RasterFrame Renderer::render(RasterMode mode, FrameCache* cache) { return impl_->render(mode, cache); }
+
+RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
+  const auto frame_start = Clock::now();
+  const Observer& ob = scene.observer;
+  RasterFrame out;
+  out.width = ob.width;
+  out.height = ob.height;
+  const bool has_lens = std::any_of(scene.elements.begin(), scene.elements.end(),
+                                    [](const Element& e) { return e.type == ElementType::Lens; });
+  const size_t channels = options.vertex.channels.size();
+  const size_t n_el = scene.elements.size();
+
+  // --- CPU stages (pvrr mode) ---
+  std::vector<ElementFrame> frames;
+  if (mode == RasterMode::Pvrr && n_el > 0) {
+    frames.resize(n_el);
+    // Eye-fixed caching: an element whose pose relative to the eye is unchanged keeps its rays and views.
+    const Mat4 view = ob.view();
+    std::vector<bool> reuse(n_el, false);
+    for (size_t e = 0; e < n_el; ++e) {
+      const Mat4 rel = view * scene.elements[e].local_to_world;
+      if (cache && cache->valid && cache->elements.size() == n_el && cache->element_to_eye[e] == rel &&
+          !cache->environment_changed)
+        reuse[e] = true;
+    }
+    bool all_reused = std::all_of(reuse.begin(), reuse.end(), [](bool b) { return b; });
+    auto t0 = Clock::now();
+    double refraction_ms = 0;
+    for (size_t e = 0; e < n_el; ++e) {
+      if (reuse[e]) {
+        frames[e] = cache->elements[e];
+        continue;
+      }
+      frames[e] = prepareElement(scene, int(e));
+      traceVertexRays(rays, frames[e], ob.eye, options.vertex);
+      if (scene.elements[e].type == ElementType::Lens) refraction_ms += frames[e].rays_ms;
+    }
+    if (all_reused)
+      out.stages.skipped("vertex-rays", "eye-fixed cache: no element moved relative to the eye");
+    else
+      out.stages.ran("vertex-rays", msSince(t0));
+    if (!has_lens)
+      out.stages.skipped("refraction", "no lens in the scene");
+    else if (all_reused)
+      out.stages.skipped("refraction", "eye-fixed cache: no element moved relative to the eye");
+    else
+      out.stages.ran("refraction", refraction_ms);
+    t0 = Clock::now();
+    for (size_t e = 0; e < n_el; ++e)
+      if (!reuse[e]) fitPatchViews(scene, frames[e], options.vertex);
+    if (all_reused)
+      out.stages.skipped("viewpoint-fit", "eye-fixed cache: no element moved relative to the eye");
+    else
+      out.stages.ran("viewpoint-fit", msSince(t0));
+    if (channels > 1)
+      out.stages.ran("colour-channels", 0);
+    else
+      out.stages.skipped("colour-channels", has_lens ? "dispersion off: one colour pass" : "no lens: one colour pass");
+    if (cache) {
+      cache->element_to_eye.resize(n_el);
+      for (size_t e = 0; e < n_el; ++e) cache->element_to_eye[e] = view * scene.elements[e].local_to_world;
+      cache->elements = frames;
+      cache->valid = true;
+    }
+  } else {
+    const std::string why = n_el == 0 ? "no mirror or lens in the scene"
+                                      : std::string("mode ") + (mode == RasterMode::Raster ? "raster" : "envmap");
+    out.stages.skipped("vertex-rays", why);
+    out.stages.skipped("refraction", has_lens ? why : "no lens in the scene");
+    out.stages.skipped("viewpoint-fit", why);
+    out.stages.skipped("colour-channels", why);
+  }
+
+  // --- first pass ---
+  auto t0 = Clock::now();
+  std::vector<size_t> map_index_of_view;
+  if (mode == RasterMode::Pvrr && !frames.empty()) {
+    size_t next = 0;
+    for (ElementFrame& f : frames) {
+      for (PatchView& pv : f.views) {
+        Target& t = mapTarget(next++);
+        clearTarget(t);
+        drawEnvironment(pv.volume.view, pv.volume.projection, pv.volume.eye);
+      }
+    }
+    glFinish();
+    out.stages.ran("first-pass", msSince(t0));
+  } else if (mode == RasterMode::Envmap && n_el > 0) {
+    while (cubes.size() < n_el) cubes.push_back(std::make_unique<Target>());
+    for (size_t e = 0; e < n_el; ++e) {
+      Target& c = *cubes[e];
+      if (c.width != options.map_size)
+        c.create(options.map_size, options.map_size, {GL_RGBA16F, GL_RGBA32F}, {GL_LINEAR, GL_NEAREST}, true);
+      const Vec3 centre = Vec3(scene.elements[e].local_to_world[3]);
+      const double near_m = 1e-3, far_m = 2.0 * (scene.boundsRadius() + glm::length(centre - scene.bounds_min)) + 1.0;
+      const Mat4 proj = glm::perspective(kPi / 2, 1.0, near_m, far_m);
+      for (int face = 0; face < 6; ++face) {
+        c.selectFace(face);
+        clearTarget(c);
+        drawEnvironment(glm::lookAt(centre, centre + kCubeDir[face], kCubeUp[face]), proj, centre);
+      }
+    }
+    glFinish();
+    out.stages.ran("first-pass", msSince(t0));
+  } else {
+    out.stages.skipped("first-pass", n_el == 0 ? "no mirror or lens in the scene" : "mode raster");
+  }
+
+  // --- second pass ---
+  t0 = Clock::now();
+  if (frame_target.width != ob.width || frame_target.height != ob.height)
+    frame_target.create(ob.width, ob.height, {GL_RGBA32F, GL_RGBA32F, GL_RGBA32F}, {GL_NEAREST, GL_NEAREST, GL_NEAREST},
+                        false);
+  clearTarget(frame_target);
+  const double near_m = 1e-3;
+  const double far_m = 4.0 * (scene.boundsRadius() + glm::length(ob.eye - 0.5 * (scene.bounds_min + scene.bounds_max))) + 1.0;
+  const Mat4 view = ob.view(), proj = ob.projection(near_m, far_m);
+  drawEnvironment(view, proj, ob.eye);
+  const Mat4 vp = relativeViewProj(proj, view, ob.eye);
+  size_t next_map = 0;
+  element_meshes.resize(std::max(element_meshes.size(), size_t(1)));
+  size_t next_mesh = 0;
+  auto meshSlot = [&]() -> MeshBuffers& {
+    if (element_meshes.size() <= next_mesh) element_meshes.resize(next_mesh + 1);
+    return element_meshes[next_mesh++];
+  };
+  for (size_t e = 0; e < n_el; ++e) {
+    const Element& el = scene.elements[e];
+    const Vec3 anchor = Vec3(el.local_to_world[3]);
+    const bool lens = el.type == ElementType::Lens;
+    if (mode == RasterMode::Pvrr) {
+      const ElementFrame& f = frames[e];
+      const Program& p = lens ? (channels == 3 ? lens3_program : lens_program) : (channels == 3 ? pvrr3_program : pvrr_program);
+      p.use();
+      p.set("u_view_proj", toFloat(vp));
+      p.set("u_offset", glm::vec3(anchor - ob.eye));
+      p.set("u_view_origin", glm::vec3(0.0f));
+      p.set("u_map", 0);
+      p.set("u_seen_map", 1);
+      setLights(p, ob.eye);
+      setElementMaterial(p, el, int(e));
+      for (const PatchView& pv : f.views) {
+        const Target& map = *maps[next_map++];
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D, map.colors[0]);
+        glActiveTexture(GL_TEXTURE1);
+        glBindTexture(GL_TEXTURE_2D, map.colors[1]);
+        p.set("u_seen_offset", glm::vec3(pv.volume.eye - ob.eye));
+        MeshBuffers& mb = meshSlot();
+        uploadPatch(mb, f, pv, anchor);
+        glBindFramebuffer(GL_FRAMEBUFFER, frame_target.fbo);
+        glViewport(0, 0, ob.width, ob.height);
+        draw(mb);
+      }
+      glActiveTexture(GL_TEXTURE0);
+    } else {
+      ElementFrame f = prepareElement(scene, int(e));
+      const Program& p = mode == RasterMode::Raster ? plain_program : (lens ? lens_envmap_program : envmap_program);
+      p.use();
+      p.set("u_view_proj", toFloat(vp));
+      p.set("u_offset", glm::vec3(anchor - ob.eye));
+      p.set("u_view_origin", glm::vec3(0.0f));
+      setLights(p, ob.eye);
+      setElementMaterial(p, el, int(e));
+      if (mode == RasterMode::Envmap) {
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_CUBE_MAP, cubes[e]->colors[0]);
+        glActiveTexture(GL_TEXTURE1);
+        glBindTexture(GL_TEXTURE_CUBE_MAP, cubes[e]->colors[1]);
+        glActiveTexture(GL_TEXTURE0);
+        p.set("u_cube", 0);
+        p.set("u_seen_cube", 1);
+        p.set("u_seen_offset", glm::vec3(anchor - ob.eye));
+      }
+      MeshBuffers& mb = meshSlot();
+      uploadElementGrid(mb, f, anchor);
+      glBindFramebuffer(GL_FRAMEBUFFER, frame_target.fbo);
+      glViewport(0, 0, ob.width, ob.height);
+      draw(mb);
+    }
+  }
+  glFinish();
+  checkGlError("rendering a frame");
+  out.stages.ran("second-pass", msSince(t0));
+  out.elements = std::move(frames);
+
+  if (options.read_back) {
+    const std::vector<float> color = frame_target.read(0), seen = frame_target.read(1), surf = frame_target.read(2);
+    const size_t n = size_t(ob.width) * size_t(ob.height);
+    out.color.resize(n);
+    out.seen.resize(n);
+    out.element.resize(n);
+    out.element_point.resize(n);
+    for (int y = 0; y < ob.height; ++y) {
+      for (int x = 0; x < ob.width; ++x) {
+        const size_t src = (size_t(ob.height - 1 - y) * size_t(ob.width) + size_t(x)) * 4;  // GL rows are bottom-up
+        const size_t dst = size_t(y) * size_t(ob.width) + size_t(x);
+        out.color[dst] = Vec3(color[src], color[src + 1], color[src + 2]);
+        out.seen[dst] = ob.eye + Vec3(seen[src], seen[src + 1], seen[src + 2]);
+        const int id = int(std::lround(surf[src + 3])) - 1;
+        out.element[dst] = id;
+        out.element_point[dst] = ob.eye + Vec3(surf[src], surf[src + 1], surf[src + 2]);
+      }
+    }
+  }
+  out.frame_ms = msSince(frame_start);
+  return out;
+}
+
+}  // namespace pvrr::gl

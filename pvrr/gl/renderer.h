@@ -1,0 +1,63 @@
+// The raster paths on the GPU: "raster" (elements drawn as plain surfaces), "pvrr" (the paper's two passes,
+// with the CPU stages of pvrr/vertex_stage.h), and "envmap" (a dynamic cube map from each element's centre,
+// the classic baseline). A current GL context (pvrr/gl/context.h) is required.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pvrr/ray_scene.h"
+#include "pvrr/stats.h"
+#include "pvrr/vertex_stage.h"
+
+namespace pvrr::gl {
+
+enum class RasterMode { Raster, Pvrr, Envmap };
+RasterMode parseRasterMode(const std::string& mode);  // throws pvrr::Error
+
+// What one frame produced, read back from the GPU. Rows top-down. `seen` and `surface` are world points
+// (double, reconstructed from camera-relative floats).
+struct RasterFrame {
+  int width = 0, height = 0;
+  std::vector<Vec3> color;          // linear RGB
+  std::vector<Vec3> seen;           // the pixel's seen point
+  std::vector<int> element;         // element index under the pixel, -1 for none
+  std::vector<Vec3> element_point;  // the element surface point under the pixel
+  FrameStages stages;
+  double frame_ms = 0;              // CPU + GPU (finished) time of the frame
+  std::vector<ElementFrame> elements;  // PVRR per-element state of this frame (pvrr mode)
+};
+
+struct RendererOptions {
+  int map_size = 1024;              // first-pass map (pvrr) or cube face (envmap) size
+  VertexStageOptions vertex;        // channels, viewpoint options
+  bool read_back = true;            // false: leave the frame on the GPU (benchmarks of the draw alone)
+};
+
+// Reuse across frames (paper section 5, eye-fixed caching): when an element has not moved relative to the
+// eye, its vertex rays and viewpoints are kept; when the environment has not changed either, its first
+// pass is kept too.
+struct FrameCache {
+  bool valid = false;
+  std::vector<Mat4> element_to_eye;  // per element, the element pose relative to the eye of the last frame
+  std::vector<ElementFrame> elements;
+  bool environment_changed = true;
+};
+
+class Renderer {
+ public:
+  Renderer(const Scene& scene, const RayScene& rays, RendererOptions options);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Renders one frame of `scene` (which may have moved since construction only in its observer and in the
+  // poses of elements attached to the observer) as seen by the scene's observer.
+  RasterFrame render(RasterMode mode, FrameCache* cache = nullptr);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace pvrr::gl

@@ -1,0 +1,274 @@
+#include "pvrr/ray_scene.h"
+
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <string>
+
+#include "cad/error.h"
+
+namespace pvrr {
+
+namespace {
+
+void embreeError(void*, RTCError code, const char* message) {
+  // Errors reach us through rtcGetDeviceError checks below; keep a trace on stderr for diagnosis.
+  std::fprintf(stderr, "pvrr: Embree error %d: %s\n", int(code), message ? message : "");
+}
+
+// What an Embree geometry ID stands for.
+struct GeomInfo {
+  HitKind kind = HitKind::None;
+  int index = -1;    // mesh or element
+  int surface = 0;   // element surface
+  std::vector<Vec2> params;  // element tessellation: (u, v) per vertex
+};
+
+// Double-precision ray/triangle intersection (Moller-Trumbore); returns t or -1, and barycentrics.
+double intersectTriangle(const Vec3& o, const Vec3& d, const Vec3& a, const Vec3& b, const Vec3& c,
+                         double& bu, double& bv) {
+  Vec3 e1 = b - a, e2 = c - a;
+  Vec3 pv = glm::cross(d, e2);
+  double det = glm::dot(e1, pv);
+  if (det == 0.0) return -1;
+  double inv = 1.0 / det;
+  Vec3 tv = o - a;
+  bu = glm::dot(tv, pv) * inv;
+  Vec3 qv = glm::cross(tv, e1);
+  bv = glm::dot(d, qv) * inv;
+  return glm::dot(e2, qv) * inv;
+}
+
+}  // namespace
+
+bool refineRaySurface(const cad::Surface& s, const Vec3& o, const Vec3& d, Vec2& uv, double& t) {
+  const cad::ParamDomain dom = s.domain();
+  const double scale = std::max({1.0, glm::length(o), std::abs(t)});
+  // Convergence at a few ulps of the coordinates' magnitude: the best double precision can give.
+  const double tol = 8.0 * std::numeric_limits<double>::epsilon() * scale;
+  for (int it = 0; it < 30; ++it) {
+    cad::SurfaceDerivs sd = s.evaluate(uv.x, uv.y);
+    Vec3 f = sd.p - (o + t * d);
+    if (glm::length(f) <= tol) return std::isfinite(t);
+    // Solve [du dv -d] (du, dv, dt)^T = -f.
+    Mat3 j(sd.du, sd.dv, -d);
+    double det = glm::determinant(j);
+    if (!std::isfinite(det) || det == 0.0) return false;
+    Vec3 step = glm::inverse(j) * (-f);
+    uv += Vec2(step.x, step.y);
+    t += step.z;
+    // A root outside the domain is no intersection; clamping lets a boundary hit still converge.
+    uv.x = std::clamp(uv.x, dom.u0, dom.u1);
+    uv.y = std::clamp(uv.y, dom.v0, dom.v1);
+  }
+  // Stalled within a few hundred ulps (a grazing hit): accept; anything worse is no intersection.
+  cad::SurfaceDerivs sd = s.evaluate(uv.x, uv.y);
+  return std::isfinite(t) && glm::length(sd.p - (o + t * d)) < 64.0 * tol;
+}
+
+struct RayScene::Impl {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  Vec3 anchor{0};  // world position subtracted before converting to float
+  std::vector<GeomInfo> geoms;
+  // Element surface -> geometry ID, for single-surface queries.
+  std::vector<std::array<int, 2>> element_geoms;
+  ~Impl() {
+    if (scene) rtcReleaseScene(scene);
+    if (device) rtcReleaseDevice(device);
+  }
+};
+
+namespace {
+
+unsigned addTriangles(RTCDevice dev, RTCScene scn, const std::vector<glm::vec3>& verts,
+                      const std::vector<glm::u32vec3>& tris) {
+  RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+  auto* v = static_cast<float*>(
+      rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), verts.size()));
+  for (size_t i = 0; i < verts.size(); ++i) {
+    v[3 * i] = verts[i].x;
+    v[3 * i + 1] = verts[i].y;
+    v[3 * i + 2] = verts[i].z;
+  }
+  auto* idx = static_cast<unsigned*>(
+      rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), tris.size()));
+  for (size_t i = 0; i < tris.size(); ++i) {
+    idx[3 * i] = tris[i].x;
+    idx[3 * i + 1] = tris[i].y;
+    idx[3 * i + 2] = tris[i].z;
+  }
+  rtcCommitGeometry(g);
+  unsigned id = rtcAttachGeometry(scn, g);
+  rtcReleaseGeometry(g);
+  return id;
+}
+
+}  // namespace
+
+RayScene::RayScene(const Scene& scene, RaySceneOptions options) : scene_(scene), impl_(std::make_unique<Impl>()) {
+  Impl& im = *impl_;
+  im.device = rtcNewDevice(nullptr);
+  if (!im.device) throw Error("Embree: could not create a device (error " + std::to_string(rtcGetDeviceError(nullptr)) + ")");
+  rtcSetDeviceErrorFunction(im.device, embreeError, nullptr);
+  im.scene = rtcNewScene(im.device);
+  rtcSetSceneBuildQuality(im.scene, RTC_BUILD_QUALITY_HIGH);
+  im.anchor = scene.observer.eye;
+  epsilon_ = 1e-9 * std::max(1.0, scene.boundsRadius()) + 1e-12 * glm::length(im.anchor);
+
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    const EnvMesh& mesh = scene.meshes[m];
+    if (mesh.triangles.empty()) continue;
+    std::vector<glm::vec3> verts(mesh.positions.size());
+    const Vec3 shift = mesh.anchor - im.anchor;
+    for (size_t i = 0; i < verts.size(); ++i) verts[i] = glm::vec3(Vec3(mesh.positions[i]) + shift);
+    unsigned id = addTriangles(im.device, im.scene, verts, mesh.triangles);
+    if (im.geoms.size() <= id) im.geoms.resize(id + 1);
+    im.geoms[id] = GeomInfo{HitKind::Environment, int(m), 0, {}};
+  }
+  im.element_geoms.assign(scene.elements.size(), {-1, -1});
+  for (size_t e = 0; e < scene.elements.size(); ++e) {
+    const Element& el = scene.elements[e];
+    const int nsurf = el.type == ElementType::Lens ? 2 : 1;
+    for (int s = 0; s < nsurf; ++s) {
+      const cad::Surface& surf = s == 0 ? el.frontSurface() : *el.lens.back;
+      const cad::Outline* outline = el.has_outline ? &el.outline : nullptr;
+      cad::Tessellation tess = cad::tessellateGrid(surf, options.element_tessellation,
+                                                   options.element_tessellation, outline);
+      std::vector<glm::vec3> verts(tess.positions.size());
+      for (size_t i = 0; i < verts.size(); ++i) verts[i] = glm::vec3(el.toWorldPoint(tess.positions[i]) - im.anchor);
+      unsigned id = addTriangles(im.device, im.scene, verts, tess.triangles);
+      if (im.geoms.size() <= id) im.geoms.resize(id + 1);
+      im.geoms[id] = GeomInfo{HitKind::Element, int(e), s, std::move(tess.params)};
+      im.element_geoms[e][size_t(s)] = int(id);
+    }
+  }
+  rtcCommitScene(im.scene);
+  RTCError err = rtcGetDeviceError(im.device);
+  if (err != RTC_ERROR_NONE) throw Error("Embree: scene build failed (error " + std::to_string(int(err)) + ")");
+}
+
+RayScene::~RayScene() = default;
+
+RayHit RayScene::intersect(const Vec3& o, const Vec3& d, double t_min, double t_max) const {
+  const Impl& im = *impl_;
+  double tnear = t_min;
+  // A candidate on an element's tessellation whose exact hit falls outside the element is skipped and the
+  // ray continues; a handful of retries covers every case seen in practice.
+  for (int attempt = 0; attempt < 8; ++attempt) {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh{};
+    Vec3 ol = o - im.anchor;
+    rh.ray.org_x = float(ol.x);
+    rh.ray.org_y = float(ol.y);
+    rh.ray.org_z = float(ol.z);
+    rh.ray.dir_x = float(d.x);
+    rh.ray.dir_y = float(d.y);
+    rh.ray.dir_z = float(d.z);
+    // The float origin can be off by half an ulp of |o - anchor|; widen the interval by that much and
+    // let the double-precision refinement decide.
+    const double slack = 4.0 * std::numeric_limits<float>::epsilon() * (glm::length(ol) + 1e-3);
+    rh.ray.tnear = float(std::max(0.0, tnear - slack));
+    rh.ray.tfar = std::isfinite(t_max) ? float(t_max + slack) : std::numeric_limits<float>::infinity();
+    rh.ray.mask = ~0u;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(im.scene, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return RayHit{};
+
+    const GeomInfo& g = im.geoms[rh.hit.geomID];
+    RayHit hit;
+    if (g.kind == HitKind::Environment) {
+      const EnvMesh& mesh = scene_.meshes[size_t(g.index)];
+      const glm::u32vec3 tri = mesh.triangles[rh.hit.primID];
+      Vec3 a = mesh.anchor + Vec3(mesh.positions[tri.x]);
+      Vec3 b = mesh.anchor + Vec3(mesh.positions[tri.y]);
+      Vec3 c = mesh.anchor + Vec3(mesh.positions[tri.z]);
+      double bu = rh.hit.u, bv = rh.hit.v;
+      double t = intersectTriangle(o, d, a, b, c, bu, bv);
+      if (!(t > tnear) || t >= t_max) {
+        // Float and double disagree at the interval's edge: step past this triangle.
+        tnear = std::max(tnear, double(rh.ray.tfar)) + epsilon_;
+        continue;
+      }
+      hit.kind = HitKind::Environment;
+      hit.t = t;
+      hit.point = o + t * d;
+      hit.normal = glm::normalize(glm::cross(b - a, c - a));
+      double bw = 1.0 - bu - bv;
+      hit.uv = bw * Vec2(mesh.uvs[tri.x]) + bu * Vec2(mesh.uvs[tri.y]) + bv * Vec2(mesh.uvs[tri.z]);
+      hit.mesh = g.index;
+      return hit;
+    }
+    // Element candidate: interpolate the tessellation's parameters and refine on the exact surface.
+    RayHit exact = intersectElementSurface(g.index, g.surface, o, d, tnear, t_max);
+    if (exact.hit()) return exact;
+    tnear = double(rh.ray.tfar) + epsilon_;
+  }
+  return RayHit{};
+}
+
+RayHit RayScene::intersectElementSurface(int element, int surface, const Vec3& o, const Vec3& d, double t_min,
+                                         double t_max) const {
+  const Impl& im = *impl_;
+  const Element& el = scene_.elements[size_t(element)];
+  const int gid = im.element_geoms[size_t(element)][size_t(surface)];
+  if (gid < 0) return RayHit{};
+  const cad::Surface& surf = surface == 0 ? el.frontSurface() : *el.lens.back;
+  // Candidate from the tessellation of this surface alone.
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  Vec3 ol = o - im.anchor;
+  const double slack = 4.0 * std::numeric_limits<float>::epsilon() * (glm::length(ol) + 1e-3);
+  // Query the whole scene but accept only this geometry: iterate over hits along the ray.
+  double tnear = std::max(0.0, t_min - slack);
+  Vec2 uv{0};
+  double t = -1;
+  for (int attempt = 0; attempt < 16; ++attempt) {
+    RTCRayHit rh{};
+    rh.ray.org_x = float(ol.x);
+    rh.ray.org_y = float(ol.y);
+    rh.ray.org_z = float(ol.z);
+    rh.ray.dir_x = float(d.x);
+    rh.ray.dir_y = float(d.y);
+    rh.ray.dir_z = float(d.z);
+    rh.ray.tnear = float(tnear);
+    rh.ray.tfar = std::isfinite(t_max) ? float(t_max + slack) : std::numeric_limits<float>::infinity();
+    rh.ray.mask = ~0u;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(im.scene, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return RayHit{};
+    if (int(rh.hit.geomID) == gid) {
+      const GeomInfo& g = im.geoms[size_t(gid)];
+      t = rh.ray.tfar;
+      // Embree's (u, v) are the barycentrics of the triangle's vertices 1 and 2.
+      RTCGeometry geom = rtcGetGeometry(im.scene, rh.hit.geomID);
+      const auto* idx = static_cast<const unsigned*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_INDEX, 0));
+      const unsigned* tri = idx + 3 * size_t(rh.hit.primID);
+      double bu = rh.hit.u, bv = rh.hit.v;
+      uv = (1.0 - bu - bv) * g.params[tri[0]] + bu * g.params[tri[1]] + bv * g.params[tri[2]];
+      break;
+    }
+    tnear = double(rh.ray.tfar) + slack;
+  }
+  if (t < 0) return RayHit{};
+  const Vec3 ol_local = el.toLocalPoint(o);
+  const Vec3 dl = el.toLocalDir(d);
+  if (!refineRaySurface(surf, ol_local, dl, uv, t)) return RayHit{};
+  if (!(t > t_min) || t >= t_max) return RayHit{};
+  if (el.has_outline && !el.outline.contains(uv, 1e-12)) return RayHit{};
+  RayHit hit;
+  hit.kind = HitKind::Element;
+  hit.t = t;
+  hit.point = o + t * d;
+  hit.normal = glm::normalize(el.toWorldDir(surf.normal(uv.x, uv.y)));
+  hit.element = element;
+  hit.surface = surface;
+  hit.param = uv;
+  return hit;
+}
+
+}  // namespace pvrr

@@ -1,0 +1,62 @@
+// Ray queries against a Scene with Embree, exact to double precision:
+// - environment triangles are found by Embree (float, relative to one scene anchor near the observer) and
+//   the hit is recomputed in double on the hit triangle;
+// - optical elements are found on a fine tessellation and the hit is then refined by Newton iterations on
+//   the element's exact surface, so results do not depend on that tessellation.
+// No Embree type appears here.
+#pragma once
+#include <memory>
+
+#include "pvrr/scene.h"
+
+namespace pvrr {
+
+enum class HitKind { None, Environment, Element };
+
+struct RayHit {
+  HitKind kind = HitKind::None;
+  double t = kInf;
+  Vec3 point{0};
+  Vec3 normal{0};       // unit geometric normal (environment: the triangle's; element: the exact surface's,
+                        // oriented as the surface: +z side of the element's local frame)
+  Vec2 uv{0};           // environment texture coordinates
+  int mesh = -1;        // environment mesh index
+  int element = -1;     // element index
+  int surface = 0;      // element surface: 0 = front (mirror surface, lens eye side), 1 = lens back
+  Vec2 param{0};        // element surface parameters (u, v) of the exact hit
+  bool hit() const { return kind != HitKind::None; }
+};
+
+struct RaySceneOptions {
+  int element_tessellation = 96;  // grid used only to find candidate element hits
+};
+
+class RayScene {
+ public:
+  explicit RayScene(const Scene& scene, RaySceneOptions options = {});
+  ~RayScene();
+  RayScene(const RayScene&) = delete;
+  RayScene& operator=(const RayScene&) = delete;
+
+  // Nearest hit on o + t d (d unit) for t in (t_min, t_max).
+  RayHit intersect(const Vec3& o, const Vec3& d, double t_min = 0, double t_max = kInf) const;
+  // Exact intersection with one surface of one element only (e.g. a lens's back surface from inside).
+  RayHit intersectElementSurface(int element, int surface, const Vec3& o, const Vec3& d, double t_min = 0,
+                                 double t_max = kInf) const;
+
+  const Scene& scene() const { return scene_; }
+  // Offset that moves a secondary ray's origin off a surface, relative to the scene scale.
+  double epsilon() const { return epsilon_; }
+
+ private:
+  struct Impl;
+  const Scene& scene_;
+  double epsilon_ = 1e-9;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Newton refinement of a ray/surface intersection from a starting guess (u, v, t). Returns false when it
+// does not converge to a point inside the domain. Exposed for tests.
+bool refineRaySurface(const cad::Surface& s, const Vec3& o, const Vec3& d, Vec2& uv, double& t);
+
+}  // namespace pvrr

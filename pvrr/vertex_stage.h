@@ -1,0 +1,71 @@
+// The CPU stages of PVRR for one optical element (paper section 3): per-vertex rays traced exactly into the
+// scene ("vertex-rays"), one least-squares virtual viewpoint and view volume per patch and colour channel
+// ("viewpoint-fit"), and each vertex's texture coordinates: the projection of its exact hit point through
+// that patch's virtual camera.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "cad/tessellate.h"
+#include "pvrr/ray_scene.h"
+#include "pvrr/view_volume.h"
+#include "pvrr/viewpoint.h"
+
+namespace pvrr {
+
+enum class VertexStatus { Hit, Escape, Tir };
+const char* toString(VertexStatus s);
+
+// One vertex of the element's front surface, for one colour channel.
+struct VertexRay {
+  Vec3 dir{0};     // outgoing direction into the scene (unit)
+  Vec3 origin{0};  // where the outgoing ray starts: the vertex (mirror) or the back-surface point (lens)
+  VertexStatus status = VertexStatus::Escape;
+  Vec3 hit{0};     // the exact hit point, or the far point of an escaping ray
+  // Lenses: the direction inside the glass, the back-surface point and its unit normal.
+  Vec3 internal_dir{0}, back_point{0}, back_normal{0};
+  Vec3 transmittance{1.0};  // lens: Fresnel transmittance of both interfaces (per RGB channel)
+};
+
+// One patch's virtual camera. With dispersion the channels share the viewpoint and the first pass (fitted
+// to the middle channel's rays, as in the paper) and differ only in their texture coordinates.
+struct PatchView {
+  int patch = 0;       // index into ElementFrame::grid_patches
+  ViewpointFit fit;
+  ViewVolume volume;
+  std::vector<std::vector<Vec2>> st;  // [channel][vertex of the patch, in GridPatch::vertices order]
+};
+
+struct ChannelSpec {
+  double wavelength_nm = 0;  // <= 0: the d line
+};
+
+struct VertexStageOptions {
+  std::vector<ChannelSpec> channels{ChannelSpec{}};  // 1 (no dispersion) or 3 (R, G, B)
+  ViewpointOptions viewpoint;
+  double max_patch_fov_rad = 0;  // overrides the element's when > 0
+  int max_patch_splits = 4;      // doublings per direction for the automatic split
+};
+
+struct ElementFrame {
+  int element = -1;
+  Vec3 eye{0};
+  cad::Tessellation grid;                   // local coordinates (from cad)
+  std::vector<Vec3> world_pos, world_normal;
+  std::vector<std::vector<VertexRay>> rays;  // [channel][vertex]
+  std::vector<cad::GridPatch> grid_patches;
+  std::vector<PatchView> views;              // one per patch
+  double rays_ms = 0, fit_ms = 0;
+  int patches_u = 1, patches_v = 1;
+  std::string split_note;                    // why patches were split, if they were
+};
+
+// Tessellates the element (its tess_u x tess_v grid) in local and world coordinates.
+ElementFrame prepareElement(const Scene& scene, int element);
+// Stage "vertex-rays": traces every vertex's ray for every channel from `eye`.
+void traceVertexRays(const RayScene& rays, ElementFrame& f, const Vec3& eye, const VertexStageOptions& opt);
+// Stage "viewpoint-fit": patches (split automatically if the element asks), viewpoints, view volumes and
+// texture coordinates. Throws nothing for degenerate input: each fit reports its condition and fallback.
+void fitPatchViews(const Scene& scene, ElementFrame& f, const VertexStageOptions& opt);
+
+}  // namespace pvrr

@@ -1,0 +1,117 @@
+// The view volume of the 1st-pass reflection map (paper 3.3, 4.2, 4.3) and the texture coordinates of the
+// per-vertex hit points in it (paper 3.4).
+//
+// Conventions: world space, metres, radians; OpenGL camera and clip conventions (camera looks down -z_eye,
+// x right, y up; NDC in [-1, 1]^3 with glDepthRange(0, 1)); matrices glm::dmat4, column-major (m[col][row]).
+// Texture coordinates (s, t) = (NDC.xy + 1) / 2: (0, 0) is the bottom-left corner of the map, as GL samples a
+// texture rendered into an FBO and read back with glReadPixels (row 0 = bottom row).
+//
+// Forward volume (buildViewVolume). For each ray i of the patch: origin o_i on the mirror, hit point h_i.
+// Depths are measured along `forward` from the eye: z(p) = (p - e) . forward.
+//  - forward = the normalised mean of the ray directions (paper 3.3).
+//  - Zooming region: hits with z(h_i) <= 0 lie behind the eye (a concave mirror or convex lens whose fitted
+//    viewpoint lies between the surface and the scene: objects inside the focal length, paper Fig. 8b/d).
+//    No frustum looking along `forward` can contain them; they are listed in `zooming`, left out of this
+//    volume, and `reversed` is set: render them with buildReversedViewVolume.
+//  - near: beyond every mirror vertex (so the mirror itself, and everything behind it, is clipped) and before
+//    every hit point: near = max_i z(o_i) + min(near_gap_m, half the gap to the nearest hit), and at least
+//    min_near_fraction of the nearest hit's depth (a concave mirror's vertices all lie behind its eye, where
+//    they are clipped anyway; the floor keeps the depth buffer usable). If some hit is nearer than the
+//    farthest mirror vertex, the hits win: near = (1 - 1e-3) * (nearest hit depth), the mirror vertices then
+//    beyond near are counted in `mirror_vertices_unclipped` and the note tells the renderer to leave the
+//    element out of its own map pass.
+//  - far: beyond every hit point and the scene bounding sphere if given, times (1 + far_margin).
+//  - sides: the frustum contains every reflection segment [o_i, h_i] between near and far: each segment is
+//    clipped to near <= z <= far, its end points are projected onto the near plane (a segment projects to a
+//    segment, so the box of the end points contains it), the bounding box is widened by `margin` of its size
+//    on each side, and each side is limited to max_fov_rad / 2 from `forward`. The frustum is asymmetric
+//    whenever the rays are. Hits that then project outside [0, 1]^2 are counted in `hits_outside`.
+//  - up: the up hint projected perpendicular to forward (paper 4.3: a principal curvature direction of a
+//    saddle or cylindrical mirror aligns the map's aspect ratio with the spread of the rays; pass the mean
+//    surface normal for a mirror-aligned frame), else world_up projected, else the world axis least aligned
+//    with forward. right = forward x up.
+//
+// Reversed volume (buildReversedViewVolume), for the zooming region. Those hits lie between the eye and the
+// mirror: each ray runs from o_i (the mirror, far from the eye) through h_i towards the eye. Looking from the
+// eye back towards the mirror (forward' = -mean direction of the zooming rays, depth' = (p - e) . forward'),
+// the point a reflection ray meets FIRST is the one nearest the mirror, i.e. the FARTHEST from the eye along
+// the view line. So the renderer must:
+//   1. clear the depth buffer to 0 (glClearDepth(0)) and use glDepthFunc(GL_GREATER) (paper 7: "reverse the
+//      evaluation function of the depth buffer"): the fragment farthest from the eye survives;
+//   2. rely on the FAR plane to remove the mirror and everything behind it: far' = min over ALL mirror
+//      vertices of the patch of depth'(o_i) - gap (otherwise the mirror, being the farthest surface, would
+//      win everywhere). Do not draw the element itself or its housing in this pass; anything that lies
+//      between the hits and the mirror but off the rays (a housing rim) would otherwise also win;
+//   3. near' = reversed_near_fraction * (nearest zooming hit depth'): objects nearer than that are clipped,
+//      which costs nothing, since with GL_GREATER they would lose to anything farther on the same view line,
+//      and it buys depth precision where it matters (a perspective depth buffer resolves ~z^2/near, and the
+//      surfaces to discriminate lie near far');
+//   4. use the same projectToTexture() with this volume for the zooming vertices. The map is not mirrored
+//      for the renderer: every vertex gets its own texture coordinate. Triangles that mix zooming and
+//      ordinary vertices need both maps (or a split) and are the renderer's choice.
+#pragma once
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cad/math.h"
+#include "pvrr/viewpoint.h"
+
+namespace pvrr {
+
+struct ViewVolume {
+  Vec3 eye{0}, forward{0, 0, -1}, up{0, 1, 0}, right{1, 0, 0};  // orthonormal, right = forward x up
+  double near_m = 0, far_m = 0;  // depths along forward, 0 < near_m < far_m
+  // Frustum extents AT the near plane (m, in the camera's right/up coordinates), asymmetric in general:
+  // left < right_, bottom < top, glFrustum(left, right_, bottom, top, near_m, far_m).
+  double left = 0, right_ = 0, bottom = 0, top = 0;
+  Mat4 view{1.0};           // world -> camera
+  Mat4 view_relative{1.0};  // (p - eye) -> camera: the rotation only, for camera-relative rendering
+  Mat4 projection{1.0};     // camera -> clip (OpenGL, NDC z in [-1, 1])
+  double fov_x_rad = 0, fov_y_rad = 0;  // full angles between opposite sides
+  bool reversed = false;  // forward volume: some hits lie behind the eye (zooming): render them with
+                          // buildReversedViewVolume
+  bool backward = false;  // this IS the reversed volume: depth test GL_GREATER, clear depth 0
+  std::vector<int> zooming;  // indices of the rays whose hit lies behind the eye along the patch's forward
+  int hits_covered = 0;      // hits this volume projects (forward: the others; reversed: the zooming ones)
+  int hits_outside = 0;      // of those, hits that project outside [0, 1]^2 (max_fov_rad limit)
+  int mirror_vertices_unclipped = 0;  // mirror vertices the near (forward) / far (reversed) plane fails to clip
+  std::string note;  // "" or what was unusual and what the renderer must do about it
+};
+
+struct ViewVolumeOptions {
+  std::optional<Vec3> up_hint;  // e.g. a principal curvature direction (paper 4.3)
+  Vec3 world_up{0, 1, 0};       // the scene's up (pvrr::Observer's default)
+  double margin = 0.02;         // fraction of the frustum's width/height added on each side
+  double max_fov_rad = radians(150.0);  // each side at most half of this from forward
+  double near_gap_m = 1e-3;     // near plane this far beyond the farthest mirror vertex (or half the gap)
+  double min_near_fraction = 1e-2;       // near >= this * nearest hit depth
+  double far_margin = 0.01;     // far = (1 + far_margin) * the farthest depth to contain
+  Vec3 scene_center{0};         // scene bounding sphere; scene_radius_m = 0: none
+  double scene_radius_m = 0;
+  double reversed_near_fraction = 0.5;  // reversed volume: near' = this * nearest zooming hit depth'
+};
+
+// Throws pvrr::Error when rays is empty, the eye or a ray is not finite, or the ray directions cancel out
+// (spread over more than a hemisphere: split the patch, paper 4.1). When every hit lies behind the eye the
+// volume is a nominal one (note says so, hits_covered = 0).
+ViewVolume buildViewVolume(const Vec3& eye, const std::vector<ViewpointRay>& rays,
+                           const ViewVolumeOptions& options = {});
+
+// The backward-looking volume for the zooming rays of the SAME rays (all of the patch's rays are needed: every
+// mirror vertex must lie beyond its far plane). Throws pvrr::Error when no hit lies behind the eye.
+ViewVolume buildReversedViewVolume(const Vec3& eye, const std::vector<ViewpointRay>& rays,
+                                   const ViewVolumeOptions& options = {});
+
+// (s, t) = (NDC.xy + 1) / 2 of a world point; equal to the projection * view route. NaN for points with
+// depth <= 0 (at or behind the eye plane).
+Vec2 projectToTexture(const ViewVolume& vv, const Vec3& world_point);
+// Texel space of a width x height map: (s * width, t * height); texel (i, j) covers [i, i+1) x [j, j+1) and
+// its centre is (i + 0.5, j + 0.5); row j = 0 is the bottom row.
+Vec2 projectToTexel(const ViewVolume& vv, const Vec3& world_point, int width, int height);
+
+// m as 16 doubles, row-major (out[4 * row + col]), e.g. for printing or row-major APIs; glm is column-major.
+std::array<double, 16> rowMajor16(const Mat4& m);
+
+}  // namespace pvrr

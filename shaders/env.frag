@@ -1,0 +1,23 @@
+#version 330 core
+// Output 0: linear colour. Output 1: the shaded point relative to the camera origin (w = 1), which the
+// accuracy reports read as the pixel's "seen point". Output 2: no element (w = 0).
+in vec3 v_pos;
+in vec3 v_normal;
+in vec2 v_uv;
+uniform vec3 u_albedo;
+uniform bool u_has_texture;
+uniform sampler2D u_texture;   // GL_SRGB8: decoded to linear before filtering
+uniform vec3 u_view_origin;    // the point rays come from (the camera, or the virtual viewpoint), relative
+layout(location = 0) out vec4 o_color;
+layout(location = 1) out vec4 o_seen;
+layout(location = 2) out vec4 o_surface;
+#include "shading.glsl"
+void main() {
+  vec3 n = normalize(v_normal);
+  if (dot(n, v_pos - u_view_origin) > 0.0) n = -n;  // two-sided: face the viewer, as the tracer does
+  vec3 albedo = u_albedo;
+  if (u_has_texture) albedo *= texture(u_texture, v_uv).rgb;
+  o_color = vec4(shadeDiffuse(albedo, v_pos, n), 1.0);
+  o_seen = vec4(v_pos, 1.0);
+  o_surface = vec4(0.0);
+}

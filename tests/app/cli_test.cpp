@@ -1,0 +1,172 @@
+// The pvrr command as a user runs it: exit codes, messages that name the file and the JSON path, no partial
+// output files, and outputs that parse.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Run {
+  int code = -1;
+  std::string out, err;
+};
+
+// Runs build/pvrr with the arguments (a shell fragment) from the source tree, capturing both streams.
+Run pvrr(const std::string& args) {
+  static int counter = 0;
+  const fs::path tmp = fs::temp_directory_path() / ("pvrr-cli-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+  const std::string cmd = "cd '" PVRR_SOURCE_DIR "' && '" PVRR_BINARY "' " + args + " >'" + tmp.string() + ".out' 2>'" +
+                          tmp.string() + ".err'";
+  Run r;
+  const int status = std::system(cmd.c_str());
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  auto slurp = [](const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  };
+  r.out = slurp(tmp.string() + ".out");
+  r.err = slurp(tmp.string() + ".err");
+  fs::remove(tmp.string() + ".out");
+  fs::remove(tmp.string() + ".err");
+  return r;
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("pvrr-cli-" + std::to_string(::getpid()) + "-" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  fs::path dir_;
+};
+
+TEST_F(Cli, NoArgumentsIsAUsageError) {
+  Run r = pvrr("");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.out.find("usage"), std::string::npos);
+}
+
+TEST_F(Cli, UnknownCommandSuggestsTheNearest) {
+  Run r = pvrr("rendr");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("did you mean \"render\""), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, UnknownOptionSuggestsTheNearest) {
+  Run r = pvrr("render --sise 10x10");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("--size"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, MissingSceneFileIsNamed) {
+  const std::string out = path("x.png");
+  Run r = pvrr("render models/no-such-scene.json --out '" + out + "'");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("no-such-scene.json"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(Cli, BadOverrideNamesFileAndJsonPath) {
+  const std::string out = path("x.png");
+  Run r = pvrr("render models/spectacle-lens.json --set 'elements[0].material.n_d=\"abc\"' --out '" + out + "'");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("spectacle-lens.json"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("elements[0].material"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_TRUE(fs::is_empty(dir_));  // no temporary left either
+}
+
+TEST_F(Cli, BrokenJsonGivesLineAndColumn) {
+  const std::string scene = path("broken.json");
+  std::ofstream(scene) << "{\n  \"version\": 1,\n  \"observer\": {\n";
+  Run r = pvrr("render '" + scene + "' --out '" + path("x.png") + "'");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("broken.json"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("x.png")));
+}
+
+TEST_F(Cli, RenderWritesThePngAndStats) {
+  const std::string out = path("car.png"), stats = path("stats.json");
+  Run r = pvrr("render --size 64x48 --gl osmesa --out '" + out + "' --stats '" + stats + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(out));
+  EXPECT_NE(r.out.find("frame time"), std::string::npos);
+  std::ifstream in(stats);
+  nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_GT(j["frame_ms"].get<double>(), 0);
+  bool has_second_pass = false;
+  for (const auto& s : j["stages"]) {
+    EXPECT_TRUE(s.contains("name") && s.contains("ms") && s.contains("ran") && s.contains("reason"));
+    if (s["name"] == "second-pass") has_second_pass = s["ran"].get<bool>();
+    if (s["name"] == "refraction") {
+      EXPECT_FALSE(s["ran"].get<bool>());  // the car mirror scene has no lens
+      EXPECT_NE(s["reason"].get<std::string>().find("no lens"), std::string::npos);
+    }
+  }
+  EXPECT_TRUE(has_second_pass);
+}
+
+TEST_F(Cli, GlInfoOnBothBackends) {
+  for (const char* b : {"osmesa", "egl"}) {
+    Run r = pvrr(std::string("gl-info --gl ") + b);
+    ASSERT_EQ(r.code, 0) << b << ": " << r.err;
+    EXPECT_NE(r.out.find("GL_VERSION"), std::string::npos);
+    EXPECT_NE(r.out.find("GL_RENDERER"), std::string::npos);
+    EXPECT_NE(r.out.find(b == std::string("egl") ? "egl" : "osmesa"), std::string::npos) << r.out;
+  }
+  EXPECT_EQ(pvrr("gl-info --gl vulkan").code, 1);
+}
+
+TEST_F(Cli, TracePrintsThePathAsJson) {
+  Run r = pvrr("trace models/plane-mirror.json --pixel 400,300");
+  ASSERT_EQ(r.code, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(j["segments"].is_array());
+  ASSERT_FALSE(j["segments"].empty());
+  for (const auto& s : j["segments"]) {
+    EXPECT_EQ(s["origin"].size(), 3u);
+    EXPECT_TRUE(s.contains("event") && s.contains("n1") && s.contains("n2"));
+  }
+  const std::string last = j["segments"].back()["event"];
+  EXPECT_TRUE(last == "diffuse" || last == "escape") << last;
+  EXPECT_EQ(pvrr("trace models/plane-mirror.json --pixel 1,2 --ray 0,0,0,1,0,0").code, 1);
+}
+
+TEST_F(Cli, VerticesCsvHasTheDocumentedColumns) {
+  const std::string out = path("v.csv");
+  Run r = pvrr("vertices models/car-mirror.json --out '" + out + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream in(out);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header, "element,patch,vertex,channel,px,py,pz,nx,ny,nz,dx,dy,dz,status,hx,hy,hz,s,t");
+  int rows = 0;
+  for (std::string line; std::getline(in, line);) ++rows;
+  EXPECT_GE(rows, 49);
+  std::ifstream js(path("v.json"));
+  nlohmann::json j = nlohmann::json::parse(js);
+  EXPECT_EQ(j["elements"][0]["patches"][0]["view_matrix"].size(), 16u);
+}
+
+TEST_F(Cli, RaytraceModeRenders) {
+  const std::string out = path("rt.png");
+  Run r = pvrr("render models/plane-mirror.json --mode raytrace --size 48x36 --out '" + out + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(out));
+}
+
+}  // namespace

@@ -1,0 +1,224 @@
+// The reference tracer against closed forms: it is the ground truth of every accuracy figure.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "cad/lens.h"
+#include "pvrr/optics.h"
+#include "pvrr/scene_build.h"
+#include "pvrr/scene_json.h"
+#include "pvrr/tracer.h"
+#include "support/test_scenes.h"
+
+namespace pvrr {
+namespace {
+
+// Exact-surface hits are Newton-refined in double: a few ulps of the coordinates (metres, |x| ~ 1).
+constexpr double kExactHitTol = 1e-12;
+// The bound for the laws of reflection and refraction along traced paths.
+constexpr double kLawTol = 1e-9;
+
+TEST(Tracer, PlaneMirrorMapsAPointToItsMirrorImage) {
+  Scene s = test::roomScene(Vec3(0.3, 0.2, 2.0), Vec3(0, 0, 0));
+  test::addMirror(s, cad::makePlane(cad::Outline::circle(1.0)), cad::Outline::circle(1.0), test::pose(Vec3(0), Vec3(0, 0, 1)));
+  s.updateBounds();
+  RayScene rays(s);
+  Tracer tracer(rays, TraceOptions{});
+  // Aim at the mirror image of a wall point seen in the z = 0 mirror: the path must end exactly on it.
+  const Vec3 wall_point(1.2, -0.7, 3.0);  // on the z = +3 wall (behind the observer)
+  const Vec3 image(wall_point.x, wall_point.y, -wall_point.z);
+  const Vec3 eye = s.observer.eye;
+  std::vector<PathSegment> path;
+  TraceResult r = tracer.trace(eye, glm::normalize(image - eye), 0, &path);
+  ASSERT_EQ(path.size(), 2u);
+  EXPECT_EQ(path[0].event, "reflect");
+  EXPECT_EQ(path[1].event, "diffuse");
+  EXPECT_LT(glm::length(r.seen - wall_point), kExactHitTol * 10);
+  EXPECT_EQ(r.first_element, 0);
+  EXPECT_EQ(r.bounces, 1);
+}
+
+TEST(Tracer, SphericalMirrorMatchesAnalyticReflection) {
+  const double R = 1.2;  // convex, centre behind the mirror at z = -R
+  Scene s = test::roomScene(Vec3(0.1, 0.05, 1.5), Vec3(0, 0, 0));
+  const cad::Outline outline = cad::Outline::rectangle(0.4, 0.3, 0.05);
+  test::addMirror(s, cad::makeSphere(R, outline), outline, test::pose(Vec3(0), Vec3(0, 0, 1)));
+  s.updateBounds();
+  RayScene rays(s);
+  Tracer tracer(rays, TraceOptions{});
+  const Vec3 centre(0, 0, -R);
+  for (double x : {-0.15, 0.0, 0.12}) {
+    for (double y : {-0.1, 0.03, 0.11}) {
+      const Vec3 o = s.observer.eye;
+      const Vec3 d = glm::normalize(Vec3(x, y, 0.0) - o);
+      // Independent solution: nearest root of |o + t d - c|^2 = R^2; normal radial; mirror formula.
+      const Vec3 oc = o - centre;
+      const double b = glm::dot(oc, d), c = glm::dot(oc, oc) - R * R;
+      const double t = -b - std::sqrt(b * b - c);
+      const Vec3 p = o + t * d;
+      const Vec3 n = (p - centre) / R;
+      const Vec3 refl = d - 2.0 * glm::dot(d, n) * n;
+      std::vector<PathSegment> path;
+      tracer.trace(o, d, 0, &path);
+      ASSERT_GE(path.size(), 2u);
+      ASSERT_EQ(path[0].event, "reflect");
+      EXPECT_LT(glm::length(path[0].point - p), kExactHitTol) << x << "," << y;
+      EXPECT_LT(glm::length(path[0].normal - n), 1e-12);
+      EXPECT_LT(glm::length(path[1].direction - refl), 1e-12);
+    }
+  }
+}
+
+TEST(Tracer, ExactHitIsIndependentOfTheCandidateTessellation) {
+  const double R = -0.6;  // concave
+  Scene s = test::roomScene(Vec3(0.0, 0.0, 0.45), Vec3(0, 0, 0));
+  const cad::Outline outline = cad::Outline::circle(0.2);
+  test::addMirror(s, cad::makeSphere(R, outline), outline, test::pose(Vec3(0), Vec3(0, 0, 1)));
+  s.updateBounds();
+  RayScene coarse(s, RaySceneOptions{6}), fine(s, RaySceneOptions{128});
+  const double scene_size = 2 * s.boundsRadius();
+  for (int i = 0; i < 25; ++i) {
+    const Vec3 aim(0.08 * std::cos(i * 0.7) * (i % 5) / 4.0, 0.08 * std::sin(i * 0.7) * (i % 5) / 4.0, 0);
+    const Vec3 o = s.observer.eye, d = glm::normalize(aim - o);
+    RayHit a = coarse.intersect(o, d), b = fine.intersect(o, d);
+    ASSERT_EQ(a.kind, HitKind::Element);
+    ASSERT_EQ(b.kind, HitKind::Element);
+    EXPECT_LT(glm::length(a.point - b.point), 1e-9 * scene_size);
+    // And against the analytic sphere: |p - c| = |R|.
+    EXPECT_NEAR(glm::length(a.point - Vec3(0, 0, -R)), std::abs(R), kExactHitTol);
+  }
+}
+
+// A lens built in code: front (eye side) and back sag surfaces, index n without dispersion.
+void addLens(Scene& s, cad::SagSurfacePtr front, cad::SagSurfacePtr back, const cad::Outline& outline, double t,
+             double n, const Mat4& pose) {
+  Element e;
+  e.name = "lens";
+  e.type = ElementType::Lens;
+  e.lens = cad::makeLens(front, back, outline, t, 0, "test lens");
+  e.outline = outline;
+  e.local_to_world = pose;
+  e.world_to_local = glm::inverse(pose);
+  e.dispersion = Dispersion::constant(n);
+  s.elements.push_back(e);
+  s.updateBounds();
+}
+
+TEST(Tracer, SlabShiftsARayByTheTextbookAmount) {
+  const double t = 0.01, n = 1.5;
+  Scene s = test::roomScene(Vec3(0, 0, 1), Vec3(0, 0, 0));
+  const cad::Outline outline = cad::Outline::circle(0.3);
+  addLens(s, cad::makePlane(outline), cad::makePlane(outline), outline, t, n, test::pose(Vec3(0), Vec3(0, 0, 1)));
+  RayScene rays(s);
+  Tracer tracer(rays, TraceOptions{});
+  for (double theta_deg : {10.0, 30.0, 55.0}) {
+    const double th = radians(theta_deg);
+    const Vec3 d(std::sin(th), 0, -std::cos(th));
+    const Vec3 o = Vec3(0, 0, 0) - 0.5 * d;  // through the front vertex
+    std::vector<PathSegment> path;
+    tracer.trace(o, d, 0, &path);
+    ASSERT_GE(path.size(), 3u);
+    EXPECT_EQ(path[0].event, "refract");
+    EXPECT_EQ(path[1].event, "refract");
+    const Vec3 out_o = path[2].origin, out_d = path[2].direction;
+    EXPECT_LT(glm::length(out_d - d), 1e-12);  // parallel to the incident ray
+    // Lateral shift: distance between the incident line and the emerging line.
+    const double shift = glm::length(glm::cross(out_o - o, d));
+    const double expected = t * std::sin(th) * (1 - std::cos(th) / std::sqrt(n * n - std::sin(th) * std::sin(th)));
+    EXPECT_NEAR(shift, expected, 1e-12) << theta_deg;
+  }
+}
+
+TEST(Tracer, GlassBallFocusesNearTheParaxialFocus) {
+  // A ball lens of radius a from two hemispheres (front R = a, back R = -a, thickness 2a).
+  const double a = 0.01, n = 1.5;
+  Scene s = test::roomScene(Vec3(0, 0, 1), Vec3(0, 0, 0));
+  const cad::Outline outline = cad::Outline::circle(2 * a * 0.999);
+  addLens(s, cad::makeSphere(a, outline), cad::makeSphere(-a, outline), outline, 2 * a, n,
+          test::pose(Vec3(0), Vec3(0, 0, 1)));
+  RayScene rays(s);
+  Tracer tracer(rays, TraceOptions{});
+  // Rays travel along +z from the far side (z < -2a) towards the eye side. Ball centre at z = -a.
+  // Paraxial focus from the centre: f = n a / (2 (n - 1)). Third-order longitudinal spherical
+  // aberration grows as h^2: the crossing lies before f by less than C h^2 / a with C < 1 here.
+  const double f = n * a / (2 * (n - 1));
+  double prev_gap = 0;
+  for (double h_rel : {0.05, 0.1, 0.2}) {
+    const double h = h_rel * a;
+    std::vector<PathSegment> path;
+    tracer.trace(Vec3(h, 0, -1.0), Vec3(0, 0, 1), 0, &path);
+    ASSERT_GE(path.size(), 3u);
+    const Vec3 o = path[2].origin, d = path[2].direction;
+    ASSERT_LT(d.x, 0);
+    const double z_cross = o.z + (-o.x / d.x) * d.z;  // where x = 0
+    const double gap = (-a + f) - z_cross;            // paraxial focus minus crossing
+    EXPECT_GT(gap, 0) << h_rel;
+    EXPECT_LT(gap, h * h / a) << h_rel;
+    EXPECT_GT(gap, prev_gap);  // aberration grows with height
+    prev_gap = gap;
+  }
+}
+
+TEST(Tracer, TotalInternalReflectionBeyondTheCriticalAngle) {
+  const double n = 1.5;
+  Scene s = test::roomScene(Vec3(0, 0, 1), Vec3(0, 0, 0));
+  // Back surface concave towards the glass (R = -0.1 m, centre at z = 0): normal-incidence rays entering the
+  // flat front meet it at sin(i) = x / 0.1, beyond the critical angle for x > 0.1 / n.
+  const cad::Outline outline = cad::Outline::circle(0.18);
+  addLens(s, cad::makePlane(outline), cad::makeSphere(-0.1, outline), outline, 0.1, n, test::pose(Vec3(0), Vec3(0, 0, 1)));
+  RayScene rays(s);
+  Tracer tracer(rays, TraceOptions{});
+  int tir = 0;
+  for (double x = 0.05; x < 0.089; x += 0.005) {
+    std::vector<PathSegment> path;
+    tracer.trace(Vec3(x, 0, 1.0), Vec3(0, 0, -1), 0, &path);
+    for (const PathSegment& p : path)
+      if (p.event == "tir") {
+        ++tir;
+        const double cos_i = std::abs(glm::dot(p.direction, p.normal));
+        EXPECT_LT(cos_i, std::cos(criticalAngle(n, 1.0)) + 1e-12);
+      }
+  }
+  EXPECT_GT(tir, 0);
+}
+
+// Checks one traced path segment by segment.
+void checkLaws(const std::vector<PathSegment>& path, const std::string& where) {
+  for (size_t i = 0; i + 1 < path.size(); ++i) {
+    const PathSegment& s = path[i];
+    const Vec3 d = s.direction, dn = path[i + 1].direction, n = s.normal;
+    if (s.event == "reflect" || s.event == "tir") {
+      EXPECT_LT(glm::length(dn - (d - 2 * glm::dot(d, n) * n)), kLawTol) << where;
+    } else if (s.event == "refract") {
+      const double sin_i = glm::length(glm::cross(d, n)), sin_t = glm::length(glm::cross(dn, n));
+      EXPECT_NEAR(s.n1 * sin_i, s.n2 * sin_t, kLawTol) << where;
+      EXPECT_NEAR(glm::dot(glm::cross(d, n), dn), 0.0, kLawTol) << where;  // coplanar
+    }
+    EXPECT_LT(glm::length(path[i + 1].origin - s.point), kLawTol) << where;
+  }
+}
+
+TEST(Tracer, PathsInEveryDefaultSceneObeyTheLaws) {
+  const std::filesystem::path models = std::filesystem::path(PVRR_SOURCE_DIR) / "models";
+  int scenes = 0, specular = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(models)) {
+    if (entry.path().extension() != ".json") continue;
+    SceneDesc desc = loadScene(entry.path().string(), {"observer.image_size=[40,30]"});
+    Scene scene = buildScene(desc);
+    RayScene rays(scene);
+    Tracer tracer(rays, TraceOptions{});
+    ++scenes;
+    for (int y = 0; y < 30; y += 3)
+      for (int x = 0; x < 40; x += 3) {
+        std::vector<PathSegment> path;
+        tracer.trace(scene.observer.eye, scene.observer.pixelDirection(x + 0.5, y + 0.5), 0, &path);
+        for (const PathSegment& p : path) specular += p.event == "reflect" || p.event == "refract";
+        checkLaws(path, entry.path().filename().string());
+      }
+  }
+  EXPECT_GE(scenes, 5);
+  EXPECT_GT(specular, 0);
+}
+
+}  // namespace
+}  // namespace pvrr

@@ -1,0 +1,100 @@
+// The CPU stages of PVRR: per-vertex rays, viewpoint, view volume and texture coordinates.
+#include <gtest/gtest.h>
+
+#include "pvrr/optics.h"
+#include "pvrr/vertex_stage.h"
+#include "support/test_scenes.h"
+
+namespace pvrr {
+namespace {
+
+// The plane-mirror viewpoint is exact: 1e-9 relative is the bound (the fit itself reaches ~1e-15).
+constexpr double kViewpointRelTol = 1e-9;
+// Per-vertex laws of reflection and refraction hold to double precision.
+constexpr double kVertexLawTol = 1e-12;
+
+TEST(VertexStage, PlaneMirrorViewpointIsTheMirrorImageOfTheEye) {
+  Scene s = test::roomScene(Vec3(0.4, 0.3, 1.8), Vec3(0, 0, 0));
+  const cad::Outline outline = cad::Outline::rectangle(0.6, 0.4, 0.05);
+  // A mirror tilted about y, so the image is not trivially (x, y, -z).
+  const Vec3 normal = glm::normalize(Vec3(0.2, 0.0, 1.0)), centre(0.1, -0.05, 0.0);
+  test::addMirror(s, cad::makePlane(outline), outline, test::pose(centre, normal), 9);
+  s.updateBounds();
+  RayScene rays(s);
+  ElementFrame f = prepareElement(s, 0);
+  VertexStageOptions opt;
+  traceVertexRays(rays, f, s.observer.eye, opt);
+  fitPatchViews(s, f, opt);
+  ASSERT_EQ(f.views.size(), 1u);
+  const Vec3 e = s.observer.eye;
+  const Vec3 image = e - 2.0 * glm::dot(e - centre, normal) * normal;
+  EXPECT_LT(glm::length(f.views[0].fit.eye - image), kViewpointRelTol * glm::length(image));
+  EXPECT_TRUE(f.views[0].fit.fallback.empty()) << f.views[0].fit.fallback;
+  EXPECT_TRUE(std::isfinite(f.views[0].fit.condition_number));
+  for (const Vec2& st : f.views[0].st[0]) {
+    EXPECT_GE(st.x, 0.0);
+    EXPECT_LE(st.x, 1.0);
+    EXPECT_GE(st.y, 0.0);
+    EXPECT_LE(st.y, 1.0);
+  }
+}
+
+TEST(VertexStage, MirrorRaysObeyTheLawOfReflection) {
+  Scene s = test::roomScene(Vec3(0.2, 0.1, 1.5), Vec3(0, 0, 0));
+  const cad::Outline outline = cad::Outline::rectangle(0.3, 0.2, 0.03);
+  test::addMirror(s, cad::makeSphere(1.2, outline), outline, test::pose(Vec3(0), Vec3(0, 0, 1)), 7);
+  s.updateBounds();
+  RayScene rays(s);
+  ElementFrame f = prepareElement(s, 0);
+  traceVertexRays(rays, f, s.observer.eye, VertexStageOptions{});
+  ASSERT_EQ(f.world_pos.size(), 49u);
+  for (size_t i = 0; i < f.world_pos.size(); ++i) {
+    const Vec3 d = glm::normalize(f.world_pos[i] - s.observer.eye), n = f.world_normal[i];
+    const VertexRay& r = f.rays[0][i];
+    EXPECT_NEAR(-glm::dot(d, n), glm::dot(r.dir, n), kVertexLawTol);             // equal angles
+    EXPECT_NEAR(glm::dot(glm::cross(d, n), r.dir), 0.0, kVertexLawTol);            // coplanar
+    EXPECT_EQ(r.status, VertexStatus::Hit);                                         // a closed room
+    EXPECT_NEAR(glm::length(glm::cross(r.hit - r.origin, r.dir)), 0.0, 1e-9);       // hit on the ray
+  }
+}
+
+TEST(VertexStage, LensRaysObeySnellAtBothSurfaces) {
+  Scene s = test::roomScene(Vec3(0.0, 0.0, 0.3), Vec3(0, 0, -1));
+  const cad::Outline outline = cad::Outline::circle(0.05);
+  Element e;
+  e.name = "lens";
+  e.type = ElementType::Lens;
+  e.lens = cad::makeLens(cad::makeSphere(-0.12, outline), cad::makeSphere(0.09, outline), outline, 0.002, 0.0, "t");
+  e.outline = outline;
+  e.local_to_world = test::pose(Vec3(0, 0, 0.288), Vec3(0, 0, 1));
+  e.world_to_local = glm::inverse(e.local_to_world);
+  e.dispersion = Dispersion::fromAbbe(1.498, 58);
+  e.tess_u = e.tess_v = 9;
+  s.elements.push_back(e);
+  s.updateBounds();
+  RayScene rays(s);
+  ElementFrame f = prepareElement(s, 0);
+  VertexStageOptions opt;
+  opt.channels = {ChannelSpec{656.2725}, ChannelSpec{587.5618}, ChannelSpec{486.1327}};
+  traceVertexRays(rays, f, s.observer.eye, opt);
+  for (size_t c = 0; c < 3; ++c) {
+    const double n = e.dispersion.index(opt.channels[c].wavelength_nm);
+    for (size_t i = 0; i < f.world_pos.size(); ++i) {
+      const VertexRay& r = f.rays[c][i];
+      ASSERT_NE(r.status, VertexStatus::Tir);
+      const Vec3 d = glm::normalize(f.world_pos[i] - s.observer.eye), n1 = f.world_normal[i];
+      EXPECT_NEAR(glm::length(glm::cross(d, n1)), n * glm::length(glm::cross(r.internal_dir, n1)), kVertexLawTol);
+      EXPECT_NEAR(n * glm::length(glm::cross(r.internal_dir, r.back_normal)), glm::length(glm::cross(r.dir, r.back_normal)),
+                  kVertexLawTol);
+      EXPECT_NEAR(glm::dot(glm::cross(d, n1), r.internal_dir), 0.0, kVertexLawTol);
+    }
+  }
+  // Blue bends more than red: at an off-axis vertex the channels' exit directions differ, blue most deviated.
+  const size_t corner = 0;
+  const Vec3 d0 = glm::normalize(f.world_pos[corner] - s.observer.eye);
+  const double dev_r = angleBetween(f.rays[0][corner].dir, d0), dev_b = angleBetween(f.rays[2][corner].dir, d0);
+  EXPECT_GT(dev_b, dev_r);
+}
+
+}  // namespace
+}  // namespace pvrr
