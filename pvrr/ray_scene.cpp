@@ -155,6 +155,9 @@ RayScene::~RayScene() = default;
 RayHit RayScene::intersect(const Vec3& o, const Vec3& d, double t_min, double t_max) const {
   const Impl& im = *impl_;
   double tnear = t_min;
+  // After a rejected candidate the next query starts strictly beyond it (the float slack below must not
+  // bring the same triangle back).
+  float past = 0.0f;
   // A candidate on an element's tessellation whose exact hit falls outside the element is skipped and the
   // ray continues; a handful of retries covers every case seen in practice.
   for (int attempt = 0; attempt < 8; ++attempt) {
@@ -171,7 +174,7 @@ RayHit RayScene::intersect(const Vec3& o, const Vec3& d, double t_min, double t_
     // The float origin can be off by half an ulp of |o - anchor|; widen the interval by that much and
     // let the double-precision refinement decide.
     const double slack = 4.0 * std::numeric_limits<float>::epsilon() * (glm::length(ol) + 1e-3);
-    rh.ray.tnear = float(std::max(0.0, tnear - slack));
+    rh.ray.tnear = std::max(float(std::max(0.0, tnear - slack)), past);
     rh.ray.tfar = std::isfinite(t_max) ? float(t_max + slack) : std::numeric_limits<float>::infinity();
     rh.ray.mask = ~0u;
     rh.ray.flags = 0;
@@ -191,7 +194,7 @@ RayHit RayScene::intersect(const Vec3& o, const Vec3& d, double t_min, double t_
       double t = intersectTriangle(o, d, a, b, c, bu, bv);
       if (!(t > tnear) || t >= t_max) {
         // Float and double disagree at the interval's edge: step past this triangle.
-        tnear = std::max(tnear, double(rh.ray.tfar)) + epsilon_;
+        past = std::nextafter(rh.ray.tfar, std::numeric_limits<float>::infinity());
         continue;
       }
       hit.kind = HitKind::Environment;
@@ -204,15 +207,15 @@ RayHit RayScene::intersect(const Vec3& o, const Vec3& d, double t_min, double t_
       return hit;
     }
     // Element candidate: interpolate the tessellation's parameters and refine on the exact surface.
-    RayHit exact = intersectElementSurface(g.index, g.surface, o, d, tnear, t_max);
+    RayHit exact = intersectElementSurface(g.index, g.surface, o, d, tnear, t_max, rh.ray.tnear);
     if (exact.hit()) return exact;
-    tnear = double(rh.ray.tfar) + epsilon_;
+    past = std::nextafter(rh.ray.tfar, std::numeric_limits<float>::infinity());
   }
   return RayHit{};
 }
 
 RayHit RayScene::intersectElementSurface(int element, int surface, const Vec3& o, const Vec3& d, double t_min,
-                                         double t_max) const {
+                                         double t_max, double search_from) const {
   const Impl& im = *impl_;
   const Element& el = scene_.elements[size_t(element)];
   const int gid = im.element_geoms[size_t(element)][size_t(surface)];
@@ -224,7 +227,7 @@ RayHit RayScene::intersectElementSurface(int element, int surface, const Vec3& o
   Vec3 ol = o - im.anchor;
   const double slack = 4.0 * std::numeric_limits<float>::epsilon() * (glm::length(ol) + 1e-3);
   // Query the whole scene but accept only this geometry: iterate over hits along the ray.
-  double tnear = std::max(0.0, t_min - slack);
+  double tnear = search_from >= 0 ? search_from : std::max(0.0, t_min - slack);
   Vec2 uv{0};
   double t = -1;
   for (int attempt = 0; attempt < 16; ++attempt) {

@@ -41,8 +41,9 @@ class RayScene {
   // Nearest hit on o + t d (d unit) for t in (t_min, t_max).
   RayHit intersect(const Vec3& o, const Vec3& d, double t_min = 0, double t_max = kInf) const;
   // Exact intersection with one surface of one element only (e.g. a lens's back surface from inside).
+  // `search_from` (>= 0) starts the candidate search on the tessellation there instead of at t_min.
   RayHit intersectElementSurface(int element, int surface, const Vec3& o, const Vec3& d, double t_min = 0,
-                                 double t_max = kInf) const;
+                                 double t_max = kInf, double search_from = -1) const;
 
   const Scene& scene() const { return scene_; }
   // Offset that moves a secondary ray's origin off a surface, relative to the scene scale.

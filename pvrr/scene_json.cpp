@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cad/error.h"
+#include "pvrr/material.h"
 #include "pvrr/texture_gen.h"
 
 namespace pvrr {
@@ -33,10 +34,6 @@ constexpr double kParallelAngle_rad = 1e-6;
 constexpr int kMaxImageSize = 16384;
 // Largest procedural texture side (textures stay small; docs/scene-format.md).
 constexpr int kMaxTextureSize = 1024;
-// Fraunhofer lines in micrometres (d: helium 587.56 nm; F: hydrogen 486.13 nm; C: hydrogen 656.27 nm).
-constexpr double kLambdaD_um = 0.58756, kLambdaF_um = 0.48613, kLambdaC_um = 0.65627;
-// Visible range where a Sellmeier pole is not allowed (micrometres).
-constexpr double kVisibleMin_um = 0.38, kVisibleMax_um = 0.78;
 
 // ---------------------------------------------------------------------------------------------------------
 // Messages
@@ -745,20 +742,13 @@ MirrorMaterialDesc readMirrorMaterial(const Ctx& c, const json* j, const std::st
     m.reflectance = o.number("reflectance", leftOpen(0, 1));
   } else if (o.has("metal")) {
     m.kind = MirrorMaterialDesc::Kind::Metal;
-    m.metal = o.choice("metal", {"chromium", "silver", "aluminium"});
+    m.metal = o.choice("metal", metalNames());  // pvrr/material.h
   } else {
     m.kind = MirrorMaterialDesc::Kind::Conductor;
     m.n = o.vec3("n", VecKind::Positive);
     m.k = o.vec3("k", VecKind::ColourNonNegative);
   }
   return m;
-}
-
-double sellmeierN(const std::array<double, 3>& b, const std::array<double, 3>& c_um2, double lambda_um) {
-  const double l2 = lambda_um * lambda_um;
-  double n2 = 1;
-  for (int i = 0; i < 3; ++i) n2 += b[i] * l2 / (l2 - c_um2[i]);
-  return n2 > 0 ? std::sqrt(n2) : std::nan("");
 }
 
 LensMaterialDesc readLensMaterial(const Ctx& c, const json* j, const std::string& path) {
@@ -770,15 +760,12 @@ LensMaterialDesc readLensMaterial(const Ctx& c, const json* j, const std::string
   if (forms != 1)
     c.expected(path, "exactly one of {\"name\"}, {\"n_d\", \"V_d\"} or {\"sellmeier\"} (plus \"dispersion\")", j);
   if (o.has("name")) {
-    std::vector<std::string> names;
-    for (const NamedLensMaterial& n : namedLensMaterials()) names.push_back(n.name);
+    // The material library (pvrr/material.h) is the catalogue: its names, its n_d and V_d.
     m.kind = LensMaterialDesc::Kind::Named;
-    m.name = o.choice("name", names);
-    for (const NamedLensMaterial& n : namedLensMaterials())
-      if (m.name == n.name) {
-        m.n_d = n.n_d;
-        m.V_d = n.V_d;
-      }
+    m.name = o.choice("name", lensMaterialNames());
+    const Dispersion d = lookupLensMaterial(m.name).dispersion;
+    m.n_d = d.n_d();
+    m.V_d = d.abbe();
   } else if (o.has("sellmeier")) {
     m.kind = LensMaterialDesc::Kind::Sellmeier;
     Obj s(c, o.get("sellmeier"), o.at("sellmeier"), "an object {\"B\": [B1, B2, B3], \"C\": [C1, C2, C3] (um^2)}",
@@ -787,19 +774,17 @@ LensMaterialDesc readLensMaterial(const Ctx& c, const json* j, const std::string
     for (int i = 0; i < 3; ++i) {
       m.sellmeier_b[i] = b[i];
       m.sellmeier_c_um2[i] = cc[i];
-      const double pole_um = std::sqrt(cc[i]);
-      if (pole_um >= kVisibleMin_um && pole_um <= kVisibleMax_um)
-        s.expected("C", "C_i outside the visible band [" + fmt(kVisibleMin_um * kVisibleMin_um) + ", " +
-                            fmt(kVisibleMax_um * kVisibleMax_um) + "] um^2 (a pole of n there)");
     }
-    const double nd = sellmeierN(m.sellmeier_b, m.sellmeier_c_um2, kLambdaD_um);
-    const double nf = sellmeierN(m.sellmeier_b, m.sellmeier_c_um2, kLambdaF_um);
-    const double nc = sellmeierN(m.sellmeier_b, m.sellmeier_c_um2, kLambdaC_um);
-    if (!(nd > 1) || !(nf > 1) || !(nc > 1) || !(nf > nc))
-      s.ctx().expected(s.path(), "coefficients giving n > 1 and normal dispersion (n_F > n_C) in the visible",
-                       o.get("sellmeier"));
-    m.n_d = nd;
-    m.V_d = (nd - 1) / (nf - nc);
+    const std::string what = "coefficients giving a finite index > 1 with normal dispersion over " +
+                             fmt(kDispersionCheckMin_nm) + ".." + fmt(kDispersionCheckMax_nm) + " nm";
+    try {
+      const Dispersion d = Dispersion::sellmeier(m.sellmeier_b, m.sellmeier_c_um2);
+      m.n_d = d.n_d();
+      m.V_d = d.abbe();
+    } catch (const Error&) {
+      c.expected(s.path(), what, o.get("sellmeier"));
+    }
+    if (!(m.n_d > 1) || !(m.V_d > 0) || !std::isfinite(m.V_d)) c.expected(s.path(), what, o.get("sellmeier"));
   } else {
     m.kind = LensMaterialDesc::Kind::Abbe;
     m.n_d = o.number("n_d", leftOpen(1, 3));
@@ -957,7 +942,8 @@ SceneDesc readScene(Ctx& c, const json& doc) {
       const std::string path = indexPath("elements", i);
       s.elements.push_back(readElement(c, &(*els)[i], path, i));
       if (!names.insert(s.elements.back().name).second)
-        c.expected(childPath(path, "name"), "a name no other element has", &(*els)[i].at("name"));
+        c.expected(childPath(path, "name"), "a name no other element has (names default to \"element<index>\")",
+                   (*els)[i].contains("name") ? &(*els)[i]["name"] : nullptr);
     }
   }
   s.render = readRender(c, top.get("render"), c.file);
@@ -1140,17 +1126,6 @@ Override applyOverride(json& doc, const std::string& text, const std::string& fi
 }  // namespace
 
 // -----------------------------------------------------------------------------------------------------------
-
-const std::vector<NamedLensMaterial>& namedLensMaterials() {
-  // Nominal catalogue values (/work/shared/notes/optics-facts.md: lens-shapers.com, igateoptics.com, Jalie;
-  // N-BK7 from the Schott data sheet).
-  static const std::vector<NamedLensMaterial> materials = {
-      {"cr-39", 1.498, 58},           {"trivex", 1.532, 44},          {"mid-index-1.56", 1.56, 37},
-      {"polycarbonate", 1.586, 30},   {"high-index-1.60", 1.60, 41},  {"high-index-1.67", 1.67, 32},
-      {"high-index-1.74", 1.74, 33},  {"n-bk7", 1.5168, 64.17},
-  };
-  return materials;
-}
 
 int editDistance(const std::string& a, const std::string& b) {
   const size_t n = a.size(), m = b.size();

@@ -26,14 +26,6 @@ SceneDesc loadScene(const std::string& path, const std::vector<std::string>& set
 SceneDesc parseScene(const std::string& json_text, const std::string& name_for_messages,
                      const std::string& base_dir, const std::vector<std::string>& set_overrides = {});
 
-// The lens materials a scene may name ("material": {"name": ...}) with their catalogue n_d and V_d
-// (docs/scene-format.md lists the sources).
-struct NamedLensMaterial {
-  const char* name;
-  double n_d, V_d;
-};
-const std::vector<NamedLensMaterial>& namedLensMaterials();
-
 // Edit distance (optimal string alignment: insertions, deletions, substitutions, adjacent
 // transpositions), used for "did you mean" suggestions.
 int editDistance(const std::string& a, const std::string& b);

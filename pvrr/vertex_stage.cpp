@@ -114,13 +114,18 @@ void fitOnePatch(const Scene& scene, const ElementFrame& f, size_t patch_index, 
   const size_t channels = f.rays.size();
   const size_t fit_channel = channels / 2;  // the middle (green) channel, or the only one
   pv.patch = int(patch_index);
-  std::vector<ViewpointRay> vrays;
+  std::vector<ViewpointRay> vrays, fit_rays;
   vrays.reserve(gp.vertices.size());
   for (uint32_t vi : gp.vertices) {
     const VertexRay& r = f.rays[fit_channel][vi];
     vrays.push_back(ViewpointRay{r.origin, r.dir, r.hit});
+    // A ray that never left the lens properly (TIR, or out through the edge band) says nothing about where
+    // the scene is seen from: keep it out of the fit.
+    if (r.status != VertexStatus::Tir) fit_rays.push_back(vrays.back());
   }
-  pv.fit = fitViewpoint(vrays, vopt);
+  pv.rays_excluded = int(vrays.size() - fit_rays.size());
+  if (fit_rays.size() < 3) fit_rays = vrays;
+  pv.fit = fitViewpoint(fit_rays, vopt);
   ViewVolumeOptions vo;
   vo.scene_radius_m = scene.boundsRadius();
   vo.scene_center = 0.5 * (scene.bounds_min + scene.bounds_max);
@@ -132,7 +137,15 @@ void fitOnePatch(const Scene& scene, const ElementFrame& f, size_t patch_index, 
       vo.up_hint = glm::normalize(el.toWorldDir(k.dir2));
     }
   }
-  pv.volume = buildViewVolume(pv.fit.eye, vrays, vo);
+  pv.volume = buildViewVolume(pv.fit.eye, fit_rays, vo);
+  pv.q.assign(gp.vertices.size(), 1.0);
+  bool all_in_front = true;
+  for (size_t k = 0; k < gp.vertices.size(); ++k) {
+    const Vec4 clip = pv.volume.projection * pv.volume.view * Vec4(f.world_pos[gp.vertices[k]], 1.0);
+    pv.q[k] = clip.w;
+    all_in_front = all_in_front && clip.w > 0;
+  }
+  if (!all_in_front) pv.q.assign(gp.vertices.size(), 1.0);
   pv.st.assign(channels, std::vector<Vec2>(gp.vertices.size()));
   for (size_t c = 0; c < channels; ++c)
     for (size_t k = 0; k < gp.vertices.size(); ++k)

@@ -34,6 +34,12 @@ struct PatchView {
   ViewpointFit fit;
   ViewVolume volume;
   std::vector<std::vector<Vec2>> st;  // [channel][vertex of the patch, in GridPatch::vertices order]
+  // Projective weight per vertex: the clip w of the vertex itself in the patch's camera. The second pass
+  // interpolates (s q, t q, q) and divides per fragment, which is exact for a plane mirror (the vertex, the
+  // viewpoint and the hit are collinear) and follows the surface's own projection for curved ones. All 1
+  // (plain affine interpolation, as in the paper) when some vertex lies behind the viewpoint.
+  std::vector<double> q;
+  int rays_excluded = 0;  // flagged (tir / edge) rays left out of the fit
 };
 
 struct ChannelSpec {

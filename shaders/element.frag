@@ -6,9 +6,9 @@
 //   LENS         the element is a lens (transmission) rather than a mirror (reflection)
 in vec3 v_pos;
 in vec3 v_normal;
-in vec2 v_st0;
-in vec2 v_st1;
-in vec2 v_st2;
+in vec3 v_st0;
+in vec3 v_st1;
+in vec3 v_st2;
 in vec3 v_trans;
 uniform vec3 u_view_origin;
 uniform float u_element_id;      // index + 1
@@ -19,7 +19,7 @@ uniform vec3 u_metal_k;
 uniform vec3 u_seen_offset;      // (the map's camera origin) - (this pass's camera origin)
 #if defined(MODE_PVRR)
 uniform sampler2D u_map;         // first pass colour (linear)
-uniform sampler2D u_seen_map;    // first pass seen points, relative to the map's camera origin (NEAREST)
+uniform sampler2D u_seen_map;    // first pass seen points, relative to the map's camera origin (LINEAR)
 #elif defined(MODE_ENVMAP)
 uniform samplerCube u_cube;
 uniform samplerCube u_seen_cube;
@@ -67,11 +67,12 @@ void main() {
 #endif
 #if defined(MODE_PVRR)
 #if CHANNELS == 3
-  vec3 c = vec3(texture(u_map, v_st0).r, texture(u_map, v_st1).g, texture(u_map, v_st2).b);
-  vec4 seen = texture(u_seen_map, v_st1);
+  vec3 c = vec3(texture(u_map, v_st0.xy / v_st0.z).r, texture(u_map, v_st1.xy / v_st1.z).g,
+                texture(u_map, v_st2.xy / v_st2.z).b);
+  vec4 seen = texture(u_seen_map, v_st1.xy / v_st1.z);
 #else
-  vec3 c = texture(u_map, v_st0).rgb;
-  vec4 seen = texture(u_seen_map, v_st0);
+  vec3 c = texture(u_map, v_st0.xy / v_st0.z).rgb;
+  vec4 seen = texture(u_seen_map, v_st0.xy / v_st0.z);
 #endif
 #else
   vec3 dir = reflect(view, n);

@@ -316,25 +316,26 @@ struct Renderer::Impl {
     std::vector<float> data;
     for (size_t i = 0; i < f.world_pos.size(); ++i) {
       glm::vec3 p(f.world_pos[i] - anchor), n(f.world_normal[i]);
-      data.insert(data.end(), {p.x, p.y, p.z, n.x, n.y, n.z, 0, 0, 0, 0, 0, 0, 1, 1, 1});
+      data.insert(data.end(), {p.x, p.y, p.z, n.x, n.y, n.z, 0, 0, 1, 0, 0, 1, 0, 0, 1, 1, 1, 1});
     }
     std::vector<uint32_t> idx;
     for (const auto& t : f.grid.triangles) idx.insert(idx.end(), {t.x, t.y, t.z});
-    uploadMesh(mb, data, {3, 3, 2, 2, 2, 3}, idx);
+    uploadMesh(mb, data, {3, 3, 3, 3, 3, 3}, idx);
   }
 
   void uploadPatch(MeshBuffers& mb, const ElementFrame& f, const PatchView& pv, const Vec3& anchor) {
     const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
     const size_t channels = pv.st.size();
     std::vector<float> data;
-    data.reserve(gp.vertices.size() * 15);
+    data.reserve(gp.vertices.size() * 18);
     for (size_t k = 0; k < gp.vertices.size(); ++k) {
       const uint32_t vi = gp.vertices[k];
       glm::vec3 p(f.world_pos[vi] - anchor), n(f.world_normal[vi]);
       data.insert(data.end(), {p.x, p.y, p.z, n.x, n.y, n.z});
+      const double q = pv.q[k];
       for (size_t c = 0; c < 3; ++c) {
         const Vec2 st = pv.st[std::min(c, channels - 1)][k];
-        data.insert(data.end(), {float(st.x), float(st.y)});
+        data.insert(data.end(), {float(st.x * q), float(st.y * q), float(q)});
       }
       Vec3 tr(1.0);
       for (size_t c = 0; c < 3; ++c) tr[int(c)] = f.rays[std::min(c, channels - 1)][vi].transmittance[int(c)];
@@ -342,14 +343,16 @@ struct Renderer::Impl {
     }
     std::vector<uint32_t> idx;
     for (const auto& t : gp.triangles) idx.insert(idx.end(), {t.x, t.y, t.z});
-    uploadMesh(mb, data, {3, 3, 2, 2, 2, 3}, idx);
+    uploadMesh(mb, data, {3, 3, 3, 3, 3, 3}, idx);
   }
 
   Target& mapTarget(size_t i) {
     while (maps.size() <= i) maps.push_back(std::make_unique<Target>());
     Target& t = *maps[i];
     if (t.width != options.map_size)
-      t.create(options.map_size, options.map_size, {GL_RGBA16F, GL_RGBA32F, GL_RGBA32F}, {GL_LINEAR, GL_NEAREST, GL_NEAREST},
+      // Seen points are filtered linearly too: exact within a surface, a blend only across depth edges
+      // (nearest filtering would quantise every seen point by up to half a texel).
+      t.create(options.map_size, options.map_size, {GL_RGBA16F, GL_RGBA32F, GL_RGBA32F}, {GL_LINEAR, GL_LINEAR, GL_NEAREST},
                false);
     return t;
   }
@@ -454,7 +457,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     for (size_t e = 0; e < n_el; ++e) {
       Target& c = *cubes[e];
       if (c.width != options.map_size)
-        c.create(options.map_size, options.map_size, {GL_RGBA16F, GL_RGBA32F}, {GL_LINEAR, GL_NEAREST}, true);
+        c.create(options.map_size, options.map_size, {GL_RGBA16F, GL_RGBA32F}, {GL_LINEAR, GL_LINEAR}, true);
       const Vec3 centre = Vec3(scene.elements[e].local_to_world[3]);
       const double near_m = 1e-3, far_m = 2.0 * (scene.boundsRadius() + glm::length(centre - scene.bounds_min)) + 1.0;
       const Mat4 proj = glm::perspective(kPi / 2, 1.0, near_m, far_m);

@@ -14,18 +14,18 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Run {
+struct Result {
   int code = -1;
   std::string out, err;
 };
 
 // Runs build/pvrr with the arguments (a shell fragment) from the source tree, capturing both streams.
-Run pvrr(const std::string& args) {
+Result pvrr(const std::string& args) {
   static int counter = 0;
   const fs::path tmp = fs::temp_directory_path() / ("pvrr-cli-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
   const std::string cmd = "cd '" PVRR_SOURCE_DIR "' && '" PVRR_BINARY "' " + args + " >'" + tmp.string() + ".out' 2>'" +
                           tmp.string() + ".err'";
-  Run r;
+  Result r;
   const int status = std::system(cmd.c_str());
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   auto slurp = [](const fs::path& p) {
@@ -55,26 +55,26 @@ class Cli : public ::testing::Test {
 };
 
 TEST_F(Cli, NoArgumentsIsAUsageError) {
-  Run r = pvrr("");
+  Result r = pvrr("");
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.out.find("usage"), std::string::npos);
 }
 
 TEST_F(Cli, UnknownCommandSuggestsTheNearest) {
-  Run r = pvrr("rendr");
+  Result r = pvrr("rendr");
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("did you mean \"render\""), std::string::npos) << r.err;
 }
 
 TEST_F(Cli, UnknownOptionSuggestsTheNearest) {
-  Run r = pvrr("render --sise 10x10");
+  Result r = pvrr("render --sise 10x10");
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("--size"), std::string::npos) << r.err;
 }
 
 TEST_F(Cli, MissingSceneFileIsNamed) {
   const std::string out = path("x.png");
-  Run r = pvrr("render models/no-such-scene.json --out '" + out + "'");
+  Result r = pvrr("render models/no-such-scene.json --out '" + out + "'");
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("no-such-scene.json"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out));
@@ -82,7 +82,7 @@ TEST_F(Cli, MissingSceneFileIsNamed) {
 
 TEST_F(Cli, BadOverrideNamesFileAndJsonPath) {
   const std::string out = path("x.png");
-  Run r = pvrr("render models/spectacle-lens.json --set 'elements[0].material.n_d=\"abc\"' --out '" + out + "'");
+  Result r = pvrr("render models/spectacle-lens.json --set 'elements[0].material.n_d=\"abc\"' --out '" + out + "'");
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("spectacle-lens.json"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("elements[0].material"), std::string::npos) << r.err;
@@ -93,7 +93,7 @@ TEST_F(Cli, BadOverrideNamesFileAndJsonPath) {
 TEST_F(Cli, BrokenJsonGivesLineAndColumn) {
   const std::string scene = path("broken.json");
   std::ofstream(scene) << "{\n  \"version\": 1,\n  \"observer\": {\n";
-  Run r = pvrr("render '" + scene + "' --out '" + path("x.png") + "'");
+  Result r = pvrr("render '" + scene + "' --out '" + path("x.png") + "'");
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("broken.json"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(path("x.png")));
@@ -101,7 +101,7 @@ TEST_F(Cli, BrokenJsonGivesLineAndColumn) {
 
 TEST_F(Cli, RenderWritesThePngAndStats) {
   const std::string out = path("car.png"), stats = path("stats.json");
-  Run r = pvrr("render --size 64x48 --gl osmesa --out '" + out + "' --stats '" + stats + "'");
+  Result r = pvrr("render --size 64x48 --gl osmesa --out '" + out + "' --stats '" + stats + "'");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(fs::exists(out));
   EXPECT_NE(r.out.find("frame time"), std::string::npos);
@@ -122,7 +122,7 @@ TEST_F(Cli, RenderWritesThePngAndStats) {
 
 TEST_F(Cli, GlInfoOnBothBackends) {
   for (const char* b : {"osmesa", "egl"}) {
-    Run r = pvrr(std::string("gl-info --gl ") + b);
+    Result r = pvrr(std::string("gl-info --gl ") + b);
     ASSERT_EQ(r.code, 0) << b << ": " << r.err;
     EXPECT_NE(r.out.find("GL_VERSION"), std::string::npos);
     EXPECT_NE(r.out.find("GL_RENDERER"), std::string::npos);
@@ -132,7 +132,7 @@ TEST_F(Cli, GlInfoOnBothBackends) {
 }
 
 TEST_F(Cli, TracePrintsThePathAsJson) {
-  Run r = pvrr("trace models/plane-mirror.json --pixel 400,300");
+  Result r = pvrr("trace models/plane-mirror.json --pixel 400,300");
   ASSERT_EQ(r.code, 0) << r.err;
   nlohmann::json j = nlohmann::json::parse(r.out);
   ASSERT_TRUE(j["segments"].is_array());
@@ -148,7 +148,7 @@ TEST_F(Cli, TracePrintsThePathAsJson) {
 
 TEST_F(Cli, VerticesCsvHasTheDocumentedColumns) {
   const std::string out = path("v.csv");
-  Run r = pvrr("vertices models/car-mirror.json --out '" + out + "'");
+  Result r = pvrr("vertices models/car-mirror.json --out '" + out + "'");
   ASSERT_EQ(r.code, 0) << r.err;
   std::ifstream in(out);
   std::string header;
@@ -164,7 +164,7 @@ TEST_F(Cli, VerticesCsvHasTheDocumentedColumns) {
 
 TEST_F(Cli, RaytraceModeRenders) {
   const std::string out = path("rt.png");
-  Run r = pvrr("render models/plane-mirror.json --mode raytrace --size 48x36 --out '" + out + "'");
+  Result r = pvrr("render models/plane-mirror.json --mode raytrace --size 48x36 --out '" + out + "'");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(fs::exists(out));
 }

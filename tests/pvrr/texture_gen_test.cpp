@@ -84,7 +84,7 @@ TEST(TextureGen, RejectsWhatTheLoaderRejects) {
   TextureDesc chart = desc(TextureDesc::Kind::EyeChart, 64, 64, Vec3(1), Vec3(0));
   chart.rows = eyeChartMaxRows(64, 64) + 1;
   EXPECT_THROW(generateTexture(chart), Error);
-  EXPECT_EQ(eyeChartMaxRows(8, 8), 0);
+  EXPECT_GE(eyeChartMaxRows(512, 512), 8);  // the loader's default rows fit its default resolution
 }
 
 TEST(TextureGen, CheckerAlternates) {
@@ -266,8 +266,9 @@ TEST(TextureGen, SkyIsAVerticalGradientFromZenithToHorizon) {
   EXPECT_EQ(pixel(img, 0, img.height - 1), code(d.color_a));
   for (int y = 0; y < img.height; ++y) {
     for (int x = 1; x < img.width; ++x) ASSERT_EQ(pixel(img, x, y), pixel(img, 0, y));
-    if (y > 0)
+    if (y > 0) {
       for (int k = 0; k < 3; ++k) ASSERT_GE(pixel(img, 0, y)[k], pixel(img, 0, y - 1)[k]) << "row " << y;
+    }
   }
 }
 

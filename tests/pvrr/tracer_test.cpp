@@ -20,7 +20,7 @@ constexpr double kLawTol = 1e-9;
 
 TEST(Tracer, PlaneMirrorMapsAPointToItsMirrorImage) {
   Scene s = test::roomScene(Vec3(0.3, 0.2, 2.0), Vec3(0, 0, 0));
-  test::addMirror(s, cad::makePlane(cad::Outline::circle(1.0)), cad::Outline::circle(1.0), test::pose(Vec3(0), Vec3(0, 0, 1)));
+  test::addMirror(s, cad::makePlane(cad::Outline::circle(2.0)), cad::Outline::circle(2.0), test::pose(Vec3(0), Vec3(0, 0, 1)));
   s.updateBounds();
   RayScene rays(s);
   Tracer tracer(rays, TraceOptions{});

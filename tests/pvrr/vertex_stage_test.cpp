@@ -60,7 +60,7 @@ TEST(VertexStage, MirrorRaysObeyTheLawOfReflection) {
 
 TEST(VertexStage, LensRaysObeySnellAtBothSurfaces) {
   Scene s = test::roomScene(Vec3(0.0, 0.0, 0.3), Vec3(0, 0, -1));
-  const cad::Outline outline = cad::Outline::circle(0.05);
+  const cad::Outline outline = cad::Outline::circle(0.03);
   Element e;
   e.name = "lens";
   e.type = ElementType::Lens;
@@ -79,18 +79,28 @@ TEST(VertexStage, LensRaysObeySnellAtBothSurfaces) {
   traceVertexRays(rays, f, s.observer.eye, opt);
   for (size_t c = 0; c < 3; ++c) {
     const double n = e.dispersion.index(opt.channels[c].wavelength_nm);
+    size_t flagged = 0;
     for (size_t i = 0; i < f.world_pos.size(); ++i) {
       const VertexRay& r = f.rays[c][i];
-      ASSERT_NE(r.status, VertexStatus::Tir);
+      // Steep rays at the rim leave through the edge band: flagged, not refracted at the back. Only the
+      // outermost ring may be flagged.
+      const int gi = int(i) / f.grid.grid_v, gj = int(i) % f.grid.grid_v;
+      const bool rim = gi == 0 || gj == 0 || gi == f.grid.grid_u - 1 || gj == f.grid.grid_v - 1;
+      if (r.status == VertexStatus::Tir) {
+        EXPECT_TRUE(rim) << "vertex " << i;
+        ++flagged;
+        continue;
+      }
       const Vec3 d = glm::normalize(f.world_pos[i] - s.observer.eye), n1 = f.world_normal[i];
       EXPECT_NEAR(glm::length(glm::cross(d, n1)), n * glm::length(glm::cross(r.internal_dir, n1)), kVertexLawTol);
       EXPECT_NEAR(n * glm::length(glm::cross(r.internal_dir, r.back_normal)), glm::length(glm::cross(r.dir, r.back_normal)),
                   kVertexLawTol);
       EXPECT_NEAR(glm::dot(glm::cross(d, n1), r.internal_dir), 0.0, kVertexLawTol);
     }
+    EXPECT_LE(flagged, size_t(4 * (9 - 1)));
   }
   // Blue bends more than red: at an off-axis vertex the channels' exit directions differ, blue most deviated.
-  const size_t corner = 0;
+  const size_t corner = 4 * 9 + 1;  // off-axis, well inside the rim
   const Vec3 d0 = glm::normalize(f.world_pos[corner] - s.observer.eye);
   const double dev_r = angleBetween(f.rays[0][corner].dir, d0), dev_b = angleBetween(f.rays[2][corner].dir, d0);
   EXPECT_GT(dev_b, dev_r);
