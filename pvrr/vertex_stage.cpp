@@ -1,5 +1,7 @@
 #include "pvrr/vertex_stage.h"
 
+#include <tbb/parallel_for.h>
+
 #include <chrono>
 
 #include "cad/error.h"
@@ -49,7 +51,8 @@ void traceVertexRays(const RayScene& rays, ElementFrame& f, const Vec3& eye, con
   f.rays.assign(opt.channels.size(), std::vector<VertexRay>(f.world_pos.size()));
   for (size_t c = 0; c < opt.channels.size(); ++c) {
     const double wl = opt.channels[c].wavelength_nm > 0 ? opt.channels[c].wavelength_nm : kLineD_nm;
-    for (size_t i = 0; i < f.world_pos.size(); ++i) {
+    // Vertices are independent: one task per block of vertices.
+    tbb::parallel_for(size_t(0), f.world_pos.size(), [&](size_t i) {
       VertexRay& vr = f.rays[c][i];
       const Vec3 p = f.world_pos[i], n = f.world_normal[i];
       const Vec3 d_in = glm::normalize(p - eye);
@@ -64,7 +67,7 @@ void traceVertexRays(const RayScene& rays, ElementFrame& f, const Vec3& eye, con
           vr.origin = p;
           vr.dir = d_in;
           vr.hit = p + far * d_in;
-          continue;
+          return;
         }
         vr.internal_dir = in.direction;
         RayHit back = rays.intersectElementSurface(f.element, 1, p, in.direction, eps);
@@ -74,7 +77,7 @@ void traceVertexRays(const RayScene& rays, ElementFrame& f, const Vec3& eye, con
           vr.origin = p;
           vr.dir = in.direction;
           vr.hit = p + far * in.direction;
-          continue;
+          return;
         }
         vr.back_point = back.point;
         vr.back_normal = back.normal;
@@ -89,7 +92,7 @@ void traceVertexRays(const RayScene& rays, ElementFrame& f, const Vec3& eye, con
           vr.status = VertexStatus::Tir;
           vr.dir = reflect(in.direction, back.normal);
           vr.hit = back.point + far * vr.dir;
-          continue;
+          return;
         }
         vr.dir = out.direction;
       }
@@ -101,7 +104,7 @@ void traceVertexRays(const RayScene& rays, ElementFrame& f, const Vec3& eye, con
         vr.status = VertexStatus::Escape;
         vr.hit = vr.origin + far * vr.dir;
       }
-    }
+    });
   }
   f.rays_ms = msSince(t0);
 }
@@ -138,6 +141,17 @@ void fitOnePatch(const Scene& scene, const ElementFrame& f, size_t patch_index, 
     }
   }
   pv.volume = buildViewVolume(pv.fit.eye, fit_rays, vo);
+  // Concave mirrors and convex lenses: when most hits lie between the surface and the viewpoint (the
+  // zooming region), render the map looking back from the viewpoint with a reversed depth test (paper's
+  // future work). A patch with both kinds keeps the majority's volume and reports the rest.
+  const size_t zooming = pv.volume.zooming.size();
+  if (2 * zooming > fit_rays.size()) {
+    const std::string forward_note = pv.volume.note;
+    pv.volume = buildReversedViewVolume(pv.fit.eye, fit_rays, vo);
+    if (zooming < fit_rays.size())
+      pv.volume.note += (pv.volume.note.empty() ? "" : "; ") + std::to_string(fit_rays.size() - zooming) +
+                        " hit(s) beyond the viewpoint are not in this reversed map";
+  }
   pv.q.assign(gp.vertices.size(), 1.0);
   bool all_in_front = true;
   for (size_t k = 0; k < gp.vertices.size(); ++k) {

@@ -265,7 +265,10 @@ struct Renderer::Impl {
 
   // Sky and environment from a camera at `origin`; `view_origin` is where the viewing rays start (for the
   // two-sided normal), relative to `origin`.
-  void drawEnvironment(const Mat4& view, const Mat4& proj, const Vec3& origin) const {
+  // reversed_depth: the zooming-region pass (view_volume.h): the fragment farthest from the camera wins.
+  // rays_from: where the viewing rays start (two-sided normals face it); the camera unless given.
+  void drawEnvironment(const Mat4& view, const Mat4& proj, const Vec3& origin, bool reversed_depth = false,
+                       const Vec3* rays_from = nullptr) const {
     const Mat4 vp = relativeViewProj(proj, view, origin);
     glDisable(GL_DEPTH_TEST);
     glDepthMask(GL_FALSE);
@@ -277,10 +280,10 @@ struct Renderer::Impl {
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glEnable(GL_DEPTH_TEST);
     glDepthMask(GL_TRUE);
-    glDepthFunc(GL_LESS);
+    glDepthFunc(reversed_depth ? GL_GREATER : GL_LESS);
     env_program.use();
     env_program.set("u_view_proj", toFloat(vp));
-    env_program.set("u_view_origin", glm::vec3(0.0f));
+    env_program.set("u_view_origin", rays_from ? glm::vec3(*rays_from - origin) : glm::vec3(0.0f));
     env_program.set("u_texture", 0);
     setLights(env_program, origin);
     glActiveTexture(GL_TEXTURE0);
@@ -295,12 +298,13 @@ struct Renderer::Impl {
     }
   }
 
-  void clearTarget(const Target& t) const {
+  void clearTarget(const Target& t, bool reversed_depth = false) const {
     glBindFramebuffer(GL_FRAMEBUFFER, t.fbo);
     glViewport(0, 0, t.width, t.height);
     const float zero[4] = {0, 0, 0, 0};
     for (size_t i = 0; i < t.colors.size(); ++i) glClearBufferfv(GL_COLOR, GLint(i), zero);
-    glClear(GL_DEPTH_BUFFER_BIT);
+    const float depth = reversed_depth ? 0.0f : 1.0f;
+    glClearBufferfv(GL_DEPTH, 0, &depth);
   }
 
   void setElementMaterial(const Program& p, const Element& el, int index) const {
@@ -444,10 +448,13 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   if (mode == RasterMode::Pvrr && !frames.empty()) {
     size_t next = 0;
     for (ElementFrame& f : frames) {
+      // In a reversed (zooming) map the rays come from the mirror, not from the viewpoint.
+      const Vec3 element_centre = Vec3(scene.elements[size_t(f.element)].local_to_world[3]);
       for (PatchView& pv : f.views) {
         Target& t = mapTarget(next++);
-        clearTarget(t);
-        drawEnvironment(pv.volume.view, pv.volume.projection, pv.volume.eye);
+        clearTarget(t, pv.volume.backward);
+        drawEnvironment(pv.volume.view, pv.volume.projection, pv.volume.eye, pv.volume.backward,
+                        pv.volume.backward ? &element_centre : nullptr);
       }
     }
     glFinish();
