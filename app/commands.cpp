@@ -253,6 +253,7 @@ int cmdRender(const std::vector<std::string>& argv) {
       ls.scene.observer.eye = eye0;
       ls.scene.observer.target = eye0 + Vec3(rot * Vec4(target0 - eye0, 0.0));
       updateAttachedElements(ls.scene, ls.desc);
+      if (session.rays) session.rays->updateElementPoses();
       session.cache.environment_changed = false;
     }
     if (i > 0 && orbit_deg == 0) session.cache.environment_changed = false;

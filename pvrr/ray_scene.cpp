@@ -24,6 +24,7 @@ struct GeomInfo {
   int index = -1;    // mesh or element
   int surface = 0;   // element surface
   std::vector<Vec2> params;  // element tessellation: (u, v) per vertex
+  std::vector<Vec3> local;   // element tessellation: local positions (to move it with the element)
 };
 
 // Double-precision ray/triangle intersection (Moller-Trumbore); returns t or -1, and barycentrics.
@@ -126,7 +127,7 @@ RayScene::RayScene(const Scene& scene, RaySceneOptions options) : scene_(scene),
     for (size_t i = 0; i < verts.size(); ++i) verts[i] = glm::vec3(Vec3(mesh.positions[i]) + shift);
     unsigned id = addTriangles(im.device, im.scene, verts, mesh.triangles);
     if (im.geoms.size() <= id) im.geoms.resize(id + 1);
-    im.geoms[id] = GeomInfo{HitKind::Environment, int(m), 0, {}};
+    im.geoms[id] = GeomInfo{HitKind::Environment, int(m), 0, {}, {}};
   }
   im.element_geoms.assign(scene.elements.size(), {-1, -1});
   for (size_t e = 0; e < scene.elements.size(); ++e) {
@@ -141,7 +142,7 @@ RayScene::RayScene(const Scene& scene, RaySceneOptions options) : scene_(scene),
       for (size_t i = 0; i < verts.size(); ++i) verts[i] = glm::vec3(el.toWorldPoint(tess.positions[i]) - im.anchor);
       unsigned id = addTriangles(im.device, im.scene, verts, tess.triangles);
       if (im.geoms.size() <= id) im.geoms.resize(id + 1);
-      im.geoms[id] = GeomInfo{HitKind::Element, int(e), s, std::move(tess.params)};
+      im.geoms[id] = GeomInfo{HitKind::Element, int(e), s, std::move(tess.params), std::move(tess.positions)};
       im.element_geoms[e][size_t(s)] = int(id);
     }
   }
@@ -151,6 +152,26 @@ RayScene::RayScene(const Scene& scene, RaySceneOptions options) : scene_(scene),
 }
 
 RayScene::~RayScene() = default;
+
+void RayScene::updateElementPoses() {
+  Impl& im = *impl_;
+  for (size_t id = 0; id < im.geoms.size(); ++id) {
+    const GeomInfo& g = im.geoms[id];
+    if (g.kind != HitKind::Element) continue;
+    const Element& el = scene_.elements[size_t(g.index)];
+    RTCGeometry geom = rtcGetGeometry(im.scene, unsigned(id));
+    auto* v = static_cast<float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
+    for (size_t i = 0; i < g.local.size(); ++i) {
+      const Vec3 p = el.toWorldPoint(g.local[i]) - im.anchor;
+      v[3 * i] = float(p.x);
+      v[3 * i + 1] = float(p.y);
+      v[3 * i + 2] = float(p.z);
+    }
+    rtcUpdateGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0);
+    rtcCommitGeometry(geom);
+  }
+  rtcCommitScene(im.scene);
+}
 
 RayHit RayScene::intersect(const Vec3& o, const Vec3& d, double t_min, double t_max) const {
   const Impl& im = *impl_;

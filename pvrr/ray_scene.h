@@ -45,6 +45,10 @@ class RayScene {
   RayHit intersectElementSurface(int element, int surface, const Vec3& o, const Vec3& d, double t_min = 0,
                                  double t_max = kInf, double search_from = -1) const;
 
+  // After elements moved (Element::local_to_world changed, e.g. spectacles turning with the head): moves
+  // their candidate tessellations in Embree and recommits. The environment is untouched.
+  void updateElementPoses();
+
   const Scene& scene() const { return scene_; }
   // Offset that moves a secondary ray's origin off a surface, relative to the scene scale.
   double epsilon() const { return epsilon_; }

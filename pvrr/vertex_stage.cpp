@@ -111,24 +111,24 @@ void traceVertexRays(const RayScene& rays, ElementFrame& f, const Vec3& eye, con
 
 namespace {
 
-void fitOnePatch(const Scene& scene, const ElementFrame& f, size_t patch_index, const Element& el,
-                 PatchView& pv, const ViewpointOptions& vopt) {
-  const cad::GridPatch& gp = f.grid_patches[patch_index];
-  const size_t channels = f.rays.size();
-  const size_t fit_channel = channels / 2;  // the middle (green) channel, or the only one
-  pv.patch = int(patch_index);
-  std::vector<ViewpointRay> vrays, fit_rays;
-  vrays.reserve(gp.vertices.size());
+// The patch's rays for the fit and the view volume: flagged rays (TIR, or out through the lens's edge
+// band) say nothing about where the scene is seen from and are left out, unless too few remain.
+std::vector<ViewpointRay> patchRays(const ElementFrame& f, const cad::GridPatch& gp, int* excluded) {
+  const size_t fit_channel = f.rays.size() / 2;  // the middle (green) channel, or the only one
+  std::vector<ViewpointRay> all, kept;
   for (uint32_t vi : gp.vertices) {
     const VertexRay& r = f.rays[fit_channel][vi];
-    vrays.push_back(ViewpointRay{r.origin, r.dir, r.hit});
-    // A ray that never left the lens properly (TIR, or out through the edge band) says nothing about where
-    // the scene is seen from: keep it out of the fit.
-    if (r.status != VertexStatus::Tir) fit_rays.push_back(vrays.back());
+    all.push_back(ViewpointRay{r.origin, r.dir, r.hit});
+    if (r.status != VertexStatus::Tir) kept.push_back(all.back());
   }
-  pv.rays_excluded = int(vrays.size() - fit_rays.size());
-  if (fit_rays.size() < 3) fit_rays = vrays;
-  pv.fit = fitViewpoint(fit_rays, vopt);
+  if (excluded) *excluded = int(all.size() - kept.size());
+  return kept.size() < 3 ? all : kept;
+}
+
+// View volume, projective weights and texture coordinates of a patch whose viewpoint is fitted.
+void buildPatchMap(const Scene& scene, const ElementFrame& f, const Element& el, PatchView& pv) {
+  const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
+  const std::vector<ViewpointRay> rays = patchRays(f, gp, nullptr);
   ViewVolumeOptions vo;
   vo.scene_radius_m = scene.boundsRadius();
   vo.scene_center = 0.5 * (scene.bounds_min + scene.bounds_max);
@@ -136,20 +136,17 @@ void fitOnePatch(const Scene& scene, const ElementFrame& f, size_t patch_index, 
   const size_t centre_vertex = gp.vertices[gp.vertices.size() / 2];
   if (!f.grid.curvatures.empty()) {
     const cad::Curvature& k = f.grid.curvatures[centre_vertex];
-    if (k.k1 * k.k2 < 0 || std::abs(k.k2) < 1e-3 * std::abs(k.k1)) {
-      vo.up_hint = glm::normalize(el.toWorldDir(k.dir2));
-    }
+    if (k.k1 * k.k2 < 0 || std::abs(k.k2) < 1e-3 * std::abs(k.k1)) vo.up_hint = glm::normalize(el.toWorldDir(k.dir2));
   }
-  pv.volume = buildViewVolume(pv.fit.eye, fit_rays, vo);
+  pv.volume = buildViewVolume(pv.fit.eye, rays, vo);
   // Concave mirrors and convex lenses: when most hits lie between the surface and the viewpoint (the
   // zooming region), render the map looking back from the viewpoint with a reversed depth test (paper's
   // future work). A patch with both kinds keeps the majority's volume and reports the rest.
   const size_t zooming = pv.volume.zooming.size();
-  if (2 * zooming > fit_rays.size()) {
-    const std::string forward_note = pv.volume.note;
-    pv.volume = buildReversedViewVolume(pv.fit.eye, fit_rays, vo);
-    if (zooming < fit_rays.size())
-      pv.volume.note += (pv.volume.note.empty() ? "" : "; ") + std::to_string(fit_rays.size() - zooming) +
+  if (2 * zooming > rays.size()) {
+    pv.volume = buildReversedViewVolume(pv.fit.eye, rays, vo);
+    if (zooming < rays.size())
+      pv.volume.note += (pv.volume.note.empty() ? "" : "; ") + std::to_string(rays.size() - zooming) +
                         " hit(s) beyond the viewpoint are not in this reversed map";
   }
   pv.q.assign(gp.vertices.size(), 1.0);
@@ -160,10 +157,17 @@ void fitOnePatch(const Scene& scene, const ElementFrame& f, size_t patch_index, 
     all_in_front = all_in_front && clip.w > 0;
   }
   if (!all_in_front) pv.q.assign(gp.vertices.size(), 1.0);
+  const size_t channels = f.rays.size();
   pv.st.assign(channels, std::vector<Vec2>(gp.vertices.size()));
   for (size_t c = 0; c < channels; ++c)
-    for (size_t k = 0; k < gp.vertices.size(); ++k)
-      pv.st[c][k] = projectToTexture(pv.volume, f.rays[c][gp.vertices[k]].hit);
+    for (size_t k = 0; k < gp.vertices.size(); ++k) pv.st[c][k] = projectToTexture(pv.volume, f.rays[c][gp.vertices[k]].hit);
+}
+
+void fitOnePatch(const Scene& scene, const ElementFrame& f, size_t patch_index, const Element& el, PatchView& pv,
+                 const ViewpointOptions& vopt) {
+  pv.patch = int(patch_index);
+  pv.fit = fitViewpoint(patchRays(f, f.grid_patches[patch_index], &pv.rays_excluded), vopt);
+  buildPatchMap(scene, f, el, pv);
 }
 
 }  // namespace
@@ -200,6 +204,51 @@ void fitPatchViews(const Scene& scene, ElementFrame& f, const VertexStageOptions
   f.patches_u = pu;
   f.patches_v = pv;
   f.fit_ms = msSince(t0);
+}
+
+}  // namespace pvrr
+
+namespace pvrr {
+
+void moveRigidly(ElementFrame& f, const Mat4& motion) {
+  auto point = [&](Vec3& p) { p = Vec3(motion * Vec4(p, 1.0)); };
+  auto dir = [&](Vec3& d) { d = Vec3(motion * Vec4(d, 0.0)); };
+  point(f.eye);
+  for (Vec3& p : f.world_pos) point(p);
+  for (Vec3& n : f.world_normal) dir(n);
+  for (auto& channel : f.rays)
+    for (VertexRay& r : channel) {
+      point(r.origin);
+      dir(r.dir);
+      point(r.hit);
+      dir(r.internal_dir);
+      point(r.back_point);
+      dir(r.back_normal);
+    }
+  for (PatchView& pv : f.views) {
+    point(pv.fit.eye);
+    point(pv.fit.closed_form_eye);
+  }
+}
+
+void updateTextureCoordinates(const RayScene& rays, ElementFrame& f) {
+  auto t0 = std::chrono::steady_clock::now();
+  const Scene& scene = rays.scene();
+  const double eps = rays.epsilon(), far = scene.render.far_distance_m;
+  for (auto& channel : f.rays)
+    tbb::parallel_for(size_t(0), channel.size(), [&](size_t i) {
+      VertexRay& r = channel[i];
+      if (r.status == VertexStatus::Tir) {
+        r.hit = r.origin + far * r.dir;
+        return;
+      }
+      const RayHit h = rays.intersect(r.origin, r.dir, eps);
+      r.status = h.hit() ? VertexStatus::Hit : VertexStatus::Escape;
+      r.hit = h.hit() ? h.point : r.origin + far * r.dir;
+    });
+  const Element& el = scene.elements[size_t(f.element)];
+  for (PatchView& pv : f.views) buildPatchMap(scene, f, el, pv);
+  f.rays_ms = msSince(t0);
 }
 
 }  // namespace pvrr

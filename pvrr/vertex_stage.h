@@ -74,4 +74,12 @@ void traceVertexRays(const RayScene& rays, ElementFrame& f, const Vec3& eye, con
 // texture coordinates. Throws nothing for degenerate input: each fit reports its condition and fallback.
 void fitPatchViews(const Scene& scene, ElementFrame& f, const VertexStageOptions& opt);
 
+// Eye-fixed caching (paper section 5): when the element has not moved relative to the eye, its rays in the
+// eye's frame and its fitted viewpoints are unchanged. moveRigidly carries a cached frame along with the
+// eye (motion = new eye pose * inverse of the old one); updateTextureCoordinates then re-intersects the
+// (unchanged) rays with the scene, rebuilds each view volume around the kept viewpoint and recomputes the
+// texture coordinates: exact, without re-refracting or re-fitting.
+void moveRigidly(ElementFrame& f, const Mat4& motion);
+void updateTextureCoordinates(const RayScene& rays, ElementFrame& f);
+
 }  // namespace pvrr

@@ -1,7 +1,8 @@
 #version 330 core
 // Optical elements. Variants by prepended defines:
 //   MODE_PVRR    the warped first-pass map (paper 3.4); CHANNELS 3 reads one map coordinate per colour
-//   MODE_ENVMAP  the classic dynamic cube map from the element centre
+//   MODE_ENVMAP  the classic dynamic cube map from the element centre (lens: looked up along the
+//                interpolated exact exit directions of the vertices, the 'refraction vectors' baseline)
 //   MODE_PLAIN   a plain grey shaded surface (raster mode)
 //   LENS         the element is a lens (transmission) rather than a mirror (reflection)
 in vec3 v_pos;
@@ -75,7 +76,11 @@ void main() {
   vec4 seen = texture(u_seen_map, v_st0.xy / v_st0.z);
 #endif
 #else
+#if defined(LENS)
+  vec3 dir = normalize(v_st0);  // the exact exit direction at the vertices, interpolated
+#else
   vec3 dir = reflect(view, n);
+#endif
   vec3 c = texture(u_cube, dir).rgb;
   vec4 seen = texture(u_seen_cube, dir);
 #endif

@@ -315,12 +315,17 @@ struct Renderer::Impl {
     p.set("u_metal_k", glm::vec3(el.mirror.k));
   }
 
-  // Whole-element mesh (plain and envmap modes): position relative to the element's origin, normal.
+  // Whole-element mesh (plain and envmap modes): position relative to the element's origin, normal; for an
+  // envmap lens the exact exit direction of each vertex's ray in the first coordinate slot and its Fresnel
+  // transmittance (the "refraction vectors" baseline).
   void uploadElementGrid(MeshBuffers& mb, const ElementFrame& f, const Vec3& anchor) {
     std::vector<float> data;
+    const bool has_rays = !f.rays.empty();
     for (size_t i = 0; i < f.world_pos.size(); ++i) {
       glm::vec3 p(f.world_pos[i] - anchor), n(f.world_normal[i]);
-      data.insert(data.end(), {p.x, p.y, p.z, n.x, n.y, n.z, 0, 0, 1, 0, 0, 1, 0, 0, 1, 1, 1, 1});
+      const glm::vec3 d = has_rays ? glm::vec3(f.rays[0][i].dir) : glm::vec3(0, 0, 1);
+      const glm::vec3 tr = has_rays ? glm::vec3(f.rays[0][i].transmittance) : glm::vec3(1);
+      data.insert(data.end(), {p.x, p.y, p.z, n.x, n.y, n.z, d.x, d.y, d.z, 0, 0, 1, 0, 0, 1, tr.x, tr.y, tr.z});
     }
     std::vector<uint32_t> idx;
     for (const auto& t : f.grid.triangles) idx.insert(idx.end(), {t.x, t.y, t.z});
@@ -383,53 +388,65 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
 
   // --- CPU stages (pvrr mode) ---
   std::vector<ElementFrame> frames;
+  bool skip_first_pass = false;
   if (mode == RasterMode::Pvrr && n_el > 0) {
     frames.resize(n_el);
-    // Eye-fixed caching: an element whose pose relative to the eye is unchanged keeps its rays and views.
+    // Eye-fixed caching (paper 5): an element whose pose relative to the eye is unchanged keeps its rays
+    // (in the eye's frame) and its fitted viewpoints; only the scene intersections and texture coordinates
+    // are redone, after moving the cached frame rigidly with the eye.
     const Mat4 view = ob.view();
+    const Mat4 motion = glm::inverse(view) * (cache ? cache->view : Mat4(1.0));
+    auto same = [](const Mat4& a, const Mat4& b) {
+      double d = 0;
+      for (int c = 0; c < 4; ++c) d = std::max(d, glm::length(a[c] - b[c]));
+      return d < 1e-12;  // a rigid pose re-composed in double differs by a few ulps, never more
+    };
     std::vector<bool> reuse(n_el, false);
-    for (size_t e = 0; e < n_el; ++e) {
-      const Mat4 rel = view * scene.elements[e].local_to_world;
-      if (cache && cache->valid && cache->elements.size() == n_el && cache->element_to_eye[e] == rel &&
-          !cache->environment_changed)
-        reuse[e] = true;
-    }
-    bool all_reused = std::all_of(reuse.begin(), reuse.end(), [](bool b) { return b; });
+    for (size_t e = 0; e < n_el; ++e)
+      reuse[e] = cache && cache->valid && cache->elements.size() == n_el &&
+                 same(cache->element_to_eye[e], view * scene.elements[e].local_to_world);
+    const bool all_reused = std::all_of(reuse.begin(), reuse.end(), [](bool b) { return b; });
+    const bool nothing_moved = all_reused && same(motion, Mat4(1.0)) && !cache->environment_changed;
+    const std::string cached = "eye-fixed cache: no element moved relative to the eye";
     auto t0 = Clock::now();
-    double refraction_ms = 0;
+    double refraction_ms = 0, texcoord_ms = 0;
+    bool any_texcoords = false;
     for (size_t e = 0; e < n_el; ++e) {
       if (reuse[e]) {
         frames[e] = cache->elements[e];
+        if (!nothing_moved) {
+          moveRigidly(frames[e], motion);
+          updateTextureCoordinates(rays, frames[e]);
+          texcoord_ms += frames[e].rays_ms;
+          any_texcoords = true;
+        }
         continue;
       }
       frames[e] = prepareElement(scene, int(e));
       traceVertexRays(rays, frames[e], ob.eye, options.vertex);
       if (scene.elements[e].type == ElementType::Lens) refraction_ms += frames[e].rays_ms;
     }
-    if (all_reused)
-      out.stages.skipped("vertex-rays", "eye-fixed cache: no element moved relative to the eye");
-    else
-      out.stages.ran("vertex-rays", msSince(t0));
-    if (!has_lens)
-      out.stages.skipped("refraction", "no lens in the scene");
-    else if (all_reused)
-      out.stages.skipped("refraction", "eye-fixed cache: no element moved relative to the eye");
-    else
-      out.stages.ran("refraction", refraction_ms);
+    const double cpu_ms = msSince(t0);
+    if (all_reused) out.stages.skipped("vertex-rays", cached);
+    else out.stages.ran("vertex-rays", cpu_ms - texcoord_ms);
+    if (!has_lens) out.stages.skipped("refraction", "no lens in the scene");
+    else if (all_reused) out.stages.skipped("refraction", cached);
+    else out.stages.ran("refraction", refraction_ms);
     t0 = Clock::now();
     for (size_t e = 0; e < n_el; ++e)
       if (!reuse[e]) fitPatchViews(scene, frames[e], options.vertex);
-    if (all_reused)
-      out.stages.skipped("viewpoint-fit", "eye-fixed cache: no element moved relative to the eye");
-    else
-      out.stages.ran("viewpoint-fit", msSince(t0));
-    if (channels > 1)
-      out.stages.ran("colour-channels", 0);
-    else
-      out.stages.skipped("colour-channels", has_lens ? "dispersion off: one colour pass" : "no lens: one colour pass");
+    if (all_reused) out.stages.skipped("viewpoint-fit", cached);
+    else out.stages.ran("viewpoint-fit", msSince(t0));
+    if (any_texcoords) out.stages.ran("texture-coordinates", texcoord_ms);
+    else out.stages.skipped("texture-coordinates", nothing_moved ? "nothing moved since the last frame"
+                                                                 : "computed with the viewpoint fit");
+    if (channels > 1) out.stages.ran("colour-channels", 0);
+    else out.stages.skipped("colour-channels", has_lens ? "dispersion off: one colour pass" : "no lens: one colour pass");
+    skip_first_pass = nothing_moved;
     if (cache) {
       cache->element_to_eye.resize(n_el);
       for (size_t e = 0; e < n_el; ++e) cache->element_to_eye[e] = view * scene.elements[e].local_to_world;
+      cache->view = view;
       cache->elements = frames;
       cache->valid = true;
     }
@@ -439,13 +456,16 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     out.stages.skipped("vertex-rays", why);
     out.stages.skipped("refraction", has_lens ? why : "no lens in the scene");
     out.stages.skipped("viewpoint-fit", why);
+    out.stages.skipped("texture-coordinates", why);
     out.stages.skipped("colour-channels", why);
   }
 
   // --- first pass ---
   auto t0 = Clock::now();
   std::vector<size_t> map_index_of_view;
-  if (mode == RasterMode::Pvrr && !frames.empty()) {
+  if (mode == RasterMode::Pvrr && !frames.empty() && skip_first_pass) {
+    out.stages.skipped("first-pass", "eye-fixed cache: neither the elements nor the environment moved relative to the eye");
+  } else if (mode == RasterMode::Pvrr && !frames.empty()) {
     size_t next = 0;
     for (ElementFrame& f : frames) {
       // In a reversed (zooming) map the rays come from the mirror, not from the viewpoint.
@@ -529,6 +549,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       glActiveTexture(GL_TEXTURE0);
     } else {
       ElementFrame f = prepareElement(scene, int(e));
+      if (lens && mode == RasterMode::Envmap) traceVertexRays(rays, f, ob.eye, VertexStageOptions{});
       const Program& p = mode == RasterMode::Raster ? plain_program : (lens ? lens_envmap_program : envmap_program);
       p.use();
       p.set("u_view_proj", toFloat(vp));

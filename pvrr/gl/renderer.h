@@ -40,6 +40,7 @@ struct RendererOptions {
 struct FrameCache {
   bool valid = false;
   std::vector<Mat4> element_to_eye;  // per element, the element pose relative to the eye of the last frame
+  Mat4 view{1.0};                    // the observer's view matrix of the cached frame
   std::vector<ElementFrame> elements;
   bool environment_changed = true;
 };
