@@ -8,6 +8,7 @@
 #include <string>
 
 #include "cad/error.h"
+#include "cad/sag.h"
 
 namespace pvrr {
 
@@ -44,7 +45,7 @@ double intersectTriangle(const Vec3& o, const Vec3& d, const Vec3& a, const Vec3
 
 }  // namespace
 
-bool refineRaySurface(const cad::Surface& s, const Vec3& o, const Vec3& d, Vec2& uv, double& t) {
+bool refineRaySurface(const cad::Surface& s, const Vec3& o, const Vec3& d, Vec2& uv, double& t, bool clamp) {
   const cad::ParamDomain dom = s.domain();
   const double scale = std::max({1.0, glm::length(o), std::abs(t)});
   // Convergence at a few ulps of the coordinates' magnitude: the best double precision can give.
@@ -61,8 +62,10 @@ bool refineRaySurface(const cad::Surface& s, const Vec3& o, const Vec3& d, Vec2&
     uv += Vec2(step.x, step.y);
     t += step.z;
     // A root outside the domain is no intersection; clamping lets a boundary hit still converge.
-    uv.x = std::clamp(uv.x, dom.u0, dom.u1);
-    uv.y = std::clamp(uv.y, dom.v0, dom.v1);
+    if (clamp) {
+      uv.x = std::clamp(uv.x, dom.u0, dom.u1);
+      uv.y = std::clamp(uv.y, dom.v0, dom.v1);
+    }
   }
   // Stalled within a few hundred ulps (a grazing hit): accept; anything worse is no intersection.
   cad::SurfaceDerivs sd = s.evaluate(uv.x, uv.y);
@@ -236,7 +239,7 @@ RayHit RayScene::intersect(const Vec3& o, const Vec3& d, double t_min, double t_
 }
 
 RayHit RayScene::intersectElementSurface(int element, int surface, const Vec3& o, const Vec3& d, double t_min,
-                                         double t_max, double search_from) const {
+                                         double t_max, double search_from, bool within_outline) const {
   const Impl& im = *impl_;
   const Element& el = scene_.elements[size_t(element)];
   const int gid = im.element_geoms[size_t(element)][size_t(surface)];
@@ -264,7 +267,7 @@ RayHit RayScene::intersectElementSurface(int element, int surface, const Vec3& o
     rh.ray.mask = ~0u;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(im.scene, &ctx, &rh);
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return RayHit{};
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;  // no candidate: the direct solve below
     if (int(rh.hit.geomID) == gid) {
       const GeomInfo& g = im.geoms[size_t(gid)];
       t = rh.ray.tfar;
@@ -278,12 +281,23 @@ RayHit RayScene::intersectElementSurface(int element, int surface, const Vec3& o
     }
     tnear = double(rh.ray.tfar) + slack;
   }
-  if (t < 0) return RayHit{};
   const Vec3 ol_local = el.toLocalPoint(o);
   const Vec3 dl = el.toLocalDir(d);
-  if (!refineRaySurface(surf, ol_local, dl, uv, t)) return RayHit{};
+  if (t < 0) {
+    // No candidate: the tessellation is a polygon inscribed in the outline, so hits within a chord of the
+    // rim can miss it. A sag surface can be solved directly: start where the ray crosses its vertex plane.
+    const auto* sag = dynamic_cast<const cad::SagSurface*>(&surf);
+    if (!sag || std::abs(dl.z) < 1e-12) return RayHit{};
+    t = (sag->zVertex() - ol_local.z) / dl.z;
+    if (!(t > t_min) || t >= t_max) return RayHit{};
+    uv = Vec2(ol_local.x + t * dl.x, ol_local.y + t * dl.y);
+    if (within_outline && !el.outline.contains(uv, 0.01 * std::max(el.outline.width(), el.outline.height())))
+      return RayHit{};
+  }
+  const bool extend = !within_outline && dynamic_cast<const cad::SagSurface*>(&surf) != nullptr;
+  if (!refineRaySurface(surf, ol_local, dl, uv, t, !extend)) return RayHit{};
   if (!(t > t_min) || t >= t_max) return RayHit{};
-  if (el.has_outline && !el.outline.contains(uv, 1e-12)) return RayHit{};
+  if (within_outline && el.has_outline && !el.outline.contains(uv, 1e-12)) return RayHit{};
   RayHit hit;
   hit.kind = HitKind::Element;
   hit.t = t;

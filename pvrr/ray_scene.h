@@ -42,8 +42,10 @@ class RayScene {
   RayHit intersect(const Vec3& o, const Vec3& d, double t_min = 0, double t_max = kInf) const;
   // Exact intersection with one surface of one element only (e.g. a lens's back surface from inside).
   // `search_from` (>= 0) starts the candidate search on the tessellation there instead of at t_min.
+  // `within_outline` false: a sag surface is intersected as its analytic extension beyond the outline
+  // (used to continue a lens's rim rays smoothly; see vertex_stage.cpp).
   RayHit intersectElementSurface(int element, int surface, const Vec3& o, const Vec3& d, double t_min = 0,
-                                 double t_max = kInf, double search_from = -1) const;
+                                 double t_max = kInf, double search_from = -1, bool within_outline = true) const;
 
   // After elements moved (Element::local_to_world changed, e.g. spectacles turning with the head): moves
   // their candidate tessellations in Embree and recommits. The environment is untouched.
@@ -62,6 +64,7 @@ class RayScene {
 
 // Newton refinement of a ray/surface intersection from a starting guess (u, v, t). Returns false when it
 // does not converge to a point inside the domain. Exposed for tests.
-bool refineRaySurface(const cad::Surface& s, const Vec3& o, const Vec3& d, Vec2& uv, double& t);
+// With `clamp` false the iterate may leave the parameter domain (analytic sag surfaces only).
+bool refineRaySurface(const cad::Surface& s, const Vec3& o, const Vec3& d, Vec2& uv, double& t, bool clamp = true);
 
 }  // namespace pvrr

@@ -71,6 +71,11 @@ void traceVertexRays(const RayScene& rays, ElementFrame& f, const Vec3& eye, con
         }
         vr.internal_dir = in.direction;
         RayHit back = rays.intersectElementSurface(f.element, 1, p, in.direction, eps);
+        // A rim vertex's internal ray may leave through the edge band within a fraction of a millimetre (the
+        // vertex lies exactly on the rim). Continue it through the back surface's analytic extension, so the
+        // rim triangles interpolate smoothly; the band where light truly leaves through the edge is then
+        // thinner than the drift, usually below a pixel.
+        if (!back.hit()) back = rays.intersectElementSurface(f.element, 1, p, in.direction, eps, kInf, -1, false);
         if (!back.hit()) {
           // The internal ray leaves through the edge band: no back point. Treated like TIR: flagged.
           vr.status = VertexStatus::Tir;
