@@ -46,6 +46,14 @@ const std::map<std::string, Command>& commands() {
       {"compare",
        {cmdCompare, "render the reference and each mode; write images, error heat maps and metrics.json",
         "pvrr compare SCENE [--modes pvrr,envmap,raster] [--size WxH] [--frames N] [--gl B] [--set PATH=VALUE]... --out DIR"}},
+      {"sweep",
+       {cmdSweep, "compare over a grid of tessellations and map sizes; write sweep.csv and error-vs-time plots",
+        "pvrr sweep SCENE [--tessellation N1,N2,...] [--map-size S1,S2,...] [--vary PATH=V1,V2,...]... [--modes M1,...]\n"
+        "           [--size WxH] [--frames N] [--gl B] --out DIR\n"
+        "  Writes DIR/sweep.csv (mode,tessellation,map_size,vertices,frame_ms,median_arcmin,p95_arcmin,max_arcmin,\n"
+        "  psnr_db,reference_ms,vary), DIR/error_vs_time.png and .svg, DIR/error_vs_vertices.png."}},
+      {"plot",
+       {cmdPlot, "redraw the plots of a sweep from its CSV", "pvrr plot DIR/sweep.csv [--out DIR]"}},
       {"mesh",
        {cmdMesh, "tessellate a surface and write it as OBJ, PLY or VTP",
         "pvrr mesh (SURFACE_FILE | SCENE --element NAME) [--tessellation N | --tolerance T] --out FILE.obj|.ply|.vtp"}},

@@ -17,6 +17,8 @@ int cmdTrace(const std::vector<std::string>& args);
 int cmdVertices(const std::vector<std::string>& args);
 int cmdCompare(const std::vector<std::string>& args);
 int cmdMesh(const std::vector<std::string>& args);
+int cmdSweep(const std::vector<std::string>& args);
+int cmdPlot(const std::vector<std::string>& args);
 
 // The default scene of `pvrr render` with no scene argument.
 constexpr const char* kDefaultScene = "models/car-mirror.json";

@@ -169,4 +169,46 @@ TEST_F(Cli, RaytraceModeRenders) {
   EXPECT_TRUE(fs::exists(out));
 }
 
+TEST_F(Cli, SweepWritesCsvAndPlotsAndPlotRedraws) {
+  Result r = pvrr("sweep models/plane-mirror.json --tessellation 3,5 --map-size 128 --modes pvrr --size 64x48 --frames 1 --out '" +
+               dir_.string() + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream in(path("sweep.csv"));
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header.rfind("mode,tessellation,map_size,vertices,frame_ms,median_arcmin,p95_arcmin,max_arcmin,psnr_db", 0), 0u);
+  int rows = 0;
+  for (std::string line; std::getline(in, line);) ++rows;
+  EXPECT_EQ(rows, 2);
+  for (const char* f : {"error_vs_time.png", "error_vs_time.svg", "error_vs_vertices.png"}) EXPECT_TRUE(fs::exists(path(f))) << f;
+  fs::remove(path("error_vs_time.png"));
+  Result p = pvrr("plot '" + path("sweep.csv") + "'");
+  ASSERT_EQ(p.code, 0) << p.err;
+  EXPECT_TRUE(fs::exists(path("error_vs_time.png")));
+  std::ofstream(path("bad.csv")) << "nonsense\n";
+  Result bad = pvrr("plot '" + path("bad.csv") + "'");
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_NE(bad.err.find("bad.csv:1"), std::string::npos) << bad.err;
+}
+
+TEST_F(Cli, MeshExportsObjWithNormals) {
+  Result r = pvrr("mesh models/car-mirror.step --tessellation 9 --out '" + path("m.obj") + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream in(path("m.obj"));
+  int v = 0, vn = 0, f = 0;
+  for (std::string line; std::getline(in, line);) {
+    v += line.rfind("v ", 0) == 0;
+    vn += line.rfind("vn ", 0) == 0;
+    f += line.rfind("f ", 0) == 0 && line.find("//") != std::string::npos;
+  }
+  EXPECT_EQ(v, 81);
+  EXPECT_EQ(vn, 81);
+  EXPECT_GT(f, 100);
+  std::ofstream(path("broken.step")) << "ISO-10303-21;\nHEADER;\n";
+  Result bad = pvrr("mesh '" + path("broken.step") + "' --out '" + path("b.obj") + "'");
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_NE(bad.err.find("broken.step"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(path("b.obj")));
+}
+
 }  // namespace
