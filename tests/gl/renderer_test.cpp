@@ -9,6 +9,7 @@
 #include "pvrr/gl/renderer.h"
 #include "pvrr/scene_build.h"
 #include "pvrr/scene_json.h"
+#include "pvrr/spectrum.h"
 #include "pvrr/tracer.h"
 #include "support/test_scenes.h"
 
@@ -230,6 +231,37 @@ TEST_P(RendererTest, EyeFixedCacheMatchesAFreshFrame) {
   const double cached_err = medianArcmin(ref, a), fresh_err = medianArcmin(ref, b);
   EXPECT_LE(cached_err, 1.0);
   EXPECT_LE(cached_err, 1.1 * fresh_err + 0.02) << "cached " << cached_err << "', fresh " << fresh_err << "'";
+}
+
+// The spectacle lens (issue 6): median angular error over lens pixels <= 1 arcmin at the default
+// tessellation; the reading lens with RGB dispersion renders three channels from one shared first pass.
+TEST_P(RendererTest, LensAccuracyAndDispersion) {
+  auto ctx = makeContext(GetParam());
+  if (!ctx) return;
+  {
+    Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/spectacle-lens.json", {"observer.image_size=[200,150]"}));
+    RayScene rays(s);
+    const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
+    gl::Renderer r(s, rays, gl::RendererOptions{});
+    EXPECT_LE(medianArcmin(ref, r.render(gl::RasterMode::Pvrr)), 1.0);
+  }
+  Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/reading-lens.json", {"observer.image_size=[200,150]"}));
+  RayScene rays(s);
+  gl::RendererOptions opt;
+  opt.vertex.channels = {ChannelSpec{kRgbWavelengths_nm[0]}, ChannelSpec{kRgbWavelengths_nm[1]}, ChannelSpec{kRgbWavelengths_nm[2]}};
+  gl::Renderer r(s, rays, opt);
+  gl::RasterFrame f = r.render(gl::RasterMode::Pvrr);
+  ASSERT_EQ(f.elements.size(), 1u);
+  EXPECT_EQ(f.elements[0].views.size(), 1u);        // one shared first pass
+  EXPECT_EQ(f.elements[0].views[0].st.size(), 3u);  // three texture-coordinate sets
+  const auto it = std::find_if(f.stages.stages.begin(), f.stages.stages.end(),
+                               [](const StageTiming& t) { return t.name == "colour-channels"; });
+  ASSERT_NE(it, f.stages.stages.end());
+  EXPECT_TRUE(it->ran);
+  TraceOptions to;
+  to.dispersion = DispersionMode::Rgb;
+  const TracedFrame ref = Tracer(rays, to).render();
+  EXPECT_LE(medianArcmin(ref, f), 1.0);
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, RendererTest, ::testing::Values(gl::GlBackend::OsMesa, gl::GlBackend::Egl),
