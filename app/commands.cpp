@@ -159,6 +159,37 @@ int cmdGlInfo(const std::vector<std::string>& argv) {
   return 0;
 }
 
+namespace {
+// The per-pixel buffers every frame type carries (TracedFrame, gl::RasterFrame).
+template <class Frame>
+void takePixels(RenderedFrame& out, Frame& f) {
+  out.width = f.width;
+  out.height = f.height;
+  out.color = std::move(f.color);
+  out.seen = std::move(f.seen);
+  out.element = std::move(f.element);
+  out.element_point = std::move(f.element_point);
+  out.frame_ms = f.frame_ms;
+}
+}  // namespace
+
+RenderedFrame timedFrame(LoadedScene& ls, const std::string& mode, const std::string& gl_backend_name, int frames,
+                         double* median_ms) {
+  RenderSession session;
+  std::vector<double> times;
+  RenderedFrame f;
+  // One warm-up frame (shader compilation, first uploads), then the median of N with the cache cleared, so
+  // every measured frame does all of its stages.
+  for (int i = 0; i <= frames; ++i) {
+    session.cache = gl::FrameCache{};
+    f = renderFrame(ls, mode, gl_backend_name, &session);
+    if (i > 0) times.push_back(f.frame_ms);
+  }
+  std::sort(times.begin(), times.end());
+  *median_ms = times[times.size() / 2];
+  return f;
+}
+
 // Renders one frame of a loaded scene in `mode` (raytrace or a raster mode). Used by render and compare.
 RenderedFrame renderFrame(LoadedScene& ls, const std::string& mode, const std::string& gl_backend_name,
                           RenderSession* session) {
@@ -182,13 +213,7 @@ RenderedFrame renderFrame(LoadedScene& ls, const std::string& mode, const std::s
       }
     });
     if (shown) std::fprintf(stderr, "\rray tracing: done \n");
-    out.width = f.width;
-    out.height = f.height;
-    out.color = std::move(f.color);
-    out.seen = std::move(f.seen);
-    out.element = std::move(f.element);
-    out.element_point = std::move(f.element_point);
-    out.frame_ms = f.frame_ms;
+    takePixels(out, f);
     out.stages.ran("ray-trace", f.frame_ms);
     out.gl_backend = "none (CPU, Embree)";
     return out;
@@ -212,13 +237,7 @@ RenderedFrame renderFrame(LoadedScene& ls, const std::string& mode, const std::s
     session->renderer = std::make_unique<gl::Renderer>(scene, *session->rays, ro);
   }
   gl::RasterFrame f = session->renderer->render(rm, &session->cache);
-  out.width = f.width;
-  out.height = f.height;
-  out.color = std::move(f.color);
-  out.seen = std::move(f.seen);
-  out.element = std::move(f.element);
-  out.element_point = std::move(f.element_point);
-  out.frame_ms = f.frame_ms;
+  takePixels(out, f);
   out.stages = std::move(f.stages);
   out.elements = elementsJson(scene, f.elements);
   out.gl_backend = session->context->backendName() + " (" + session->context->glRenderer() + ")";

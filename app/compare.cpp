@@ -174,18 +174,8 @@ int cmdCompare(const std::vector<std::string>& argv) {
   json jm = json::object();
   std::string gl_used;
   for (const std::string& m : modes) {
-    RenderSession session;
-    std::vector<double> times;
-    RenderedFrame f;
-    // One warm-up frame (shader compilation, first uploads), then the median of N with the cache cleared,
-    // so every measured frame does all of its stages.
-    for (int i = 0; i <= frames; ++i) {
-      session.cache = gl::FrameCache{};
-      f = renderFrame(ls, m, gl_name, &session);
-      if (i > 0) times.push_back(f.frame_ms);
-    }
-    std::sort(times.begin(), times.end());
-    const double frame_ms = times[times.size() / 2];
+    double frame_ms = 0;
+    const RenderedFrame f = timedFrame(ls, m, gl_name, frames, &frame_ms);
     gl_used = f.gl_backend;
     std::vector<double> err;
     const ErrorStats st = compareToReference(ref, f, &err);

@@ -31,6 +31,9 @@ struct RenderSession {
 
 RenderedFrame renderFrame(LoadedScene& ls, const std::string& mode, const std::string& gl_backend_name,
                           RenderSession* session);
+// A measured frame: one warm-up, then the median frame time of `frames` frames, each doing every stage.
+RenderedFrame timedFrame(LoadedScene& ls, const std::string& mode, const std::string& gl_backend_name, int frames,
+                         double* median_ms);
 nlohmann::json elementsJson(const Scene& scene, const std::vector<ElementFrame>& frames);
 // Per-vertex data as VTK PolyData (.vtp) for ParaView: the grid of each element with point arrays.
 void writeVerticesVtp(const std::string& path, const Scene& scene, const std::vector<ElementFrame>& frames);

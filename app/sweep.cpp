@@ -101,15 +101,8 @@ int cmdSweep(const std::vector<std::string>& argv) {
         long vertices = 0;
         for (const Element& el : ls.scene.elements) vertices += long(el.tess_u) * long(el.tess_v);
         for (const std::string& m : modes) {
-          RenderSession session;
-          std::vector<double> times;
-          RenderedFrame f;
-          for (int i = 0; i <= frames; ++i) {
-            session.cache = gl::FrameCache{};
-            f = renderFrame(ls, m, gl_name, &session);
-            if (i > 0) times.push_back(f.frame_ms);
-          }
-          std::sort(times.begin(), times.end());
+          double frame_ms = 0;
+          const RenderedFrame f = timedFrame(ls, m, gl_name, frames, &frame_ms);
           const ErrorStats st = compareToReference(ref, f, nullptr);
           SweepRow r;
           r.mode = m;
@@ -117,7 +110,7 @@ int cmdSweep(const std::vector<std::string>& argv) {
           r.map_size = map;
           r.vary = vary_label;
           r.vertices = vertices;
-          r.frame_ms = times[times.size() / 2];
+          r.frame_ms = frame_ms;
           r.reference_ms = ref.frame_ms;
           r.median_arcmin = st.median_arcmin;
           r.p95_arcmin = st.p95_arcmin;
