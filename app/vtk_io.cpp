@@ -63,7 +63,9 @@ void writeAtomicWith(Writer* w, const std::string& path) {
   const fs::path target(path);
   std::error_code ec;
   if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
-  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
+  // Keep the extension: some VTK writers decide details by it.
+  const std::string tmp = (target.parent_path() / ("." + target.stem().string() + ".tmp-" + std::to_string(::getpid()) +
+                                                    target.extension().string())).string();
   w->SetFileName(tmp.c_str());
   if (w->Write() != 1 || !fs::exists(tmp)) {
     fs::remove(tmp, ec);

@@ -204,6 +204,12 @@ TEST_F(Cli, MeshExportsObjWithNormals) {
   EXPECT_EQ(v, 81);
   EXPECT_EQ(vn, 81);
   EXPECT_GT(f, 100);
+  for (const char* ext : {"ply", "vtp"}) {
+    const std::string out = path(std::string("m.") + ext);
+    Result o = pvrr("mesh models/saddle-mirror.json --element saddle-mirror --tessellation 5 --out '" + out + "'");
+    ASSERT_EQ(o.code, 0) << o.err;
+    EXPECT_GT(fs::file_size(out), 100u) << ext;
+  }
   std::ofstream(path("broken.step")) << "ISO-10303-21;\nHEADER;\n";
   Result bad = pvrr("mesh '" + path("broken.step") + "' --out '" + path("b.obj") + "'");
   EXPECT_EQ(bad.code, 1);

@@ -93,3 +93,29 @@ TEST(SweepCsv, RoundTripsAndNamesBadLines) {
 
 }  // namespace
 }  // namespace pvrr::app
+
+namespace pvrr::app {
+namespace {
+
+// Environment meshes: OBJ and PLY through VTK, triangulated, with their positions intact.
+TEST(MeshFiles, ObjAndPlyAreReadWithVtk) {
+  const auto dir = std::filesystem::temp_directory_path() / ("pvrr-mesh-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string obj = (dir / "quad.obj").string(), ply = (dir / "tri.ply").string();
+  std::ofstream(obj) << "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1 4//1\n";
+  std::ofstream(ply) << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                        "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 3 0\n3 0 1 2\n";
+  const MeshData q = readMeshFile(obj);
+  EXPECT_EQ(q.positions.size(), 4u);
+  EXPECT_EQ(q.triangles.size(), 2u);  // the quad, triangulated
+  EXPECT_EQ(q.positions[2], Vec3(2, 1, 0));
+  const MeshData t = readMeshFile(ply);
+  EXPECT_EQ(t.triangles.size(), 1u);
+  EXPECT_EQ(t.positions[2], Vec3(0, 3, 0));
+  EXPECT_THROW(readMeshFile((dir / "missing.obj").string()), Error);
+  EXPECT_THROW(readMeshFile((dir / "quad.stl").string()), Error);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace pvrr::app
