@@ -284,9 +284,6 @@ int cmdRender(const std::vector<std::string>& argv) {
       if (s.ran) stage_ms[s.name].push_back(s.ms);
       else skip_reason[s.name] = s.reason;
     }
-    if (mode == "raytrace" && frames > 1) {
-      // The reference does not cache; more frames only repeat the same work.
-    }
   }
   const size_t bad = writeLinearPng(out_path, last.width, last.height, last.color);
   if (bad) std::fprintf(stderr, "pvrr render: warning: %zu non-finite pixels written as black\n", bad);

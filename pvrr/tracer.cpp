@@ -24,7 +24,9 @@ DispersionMode parseDispersionMode(const std::string& s) {
 }
 
 Tracer::Tracer(const RayScene& rays, TraceOptions options)
-    : rays_(rays), scene_(rays.scene()), options_(options) {}
+    : rays_(rays), scene_(rays.scene()), options_(options) {
+  if (options_.dispersion == DispersionMode::Spectral) spectral_ = spectralSamples(options_.spectral_samples);
+}
 
 namespace {
 
@@ -164,11 +166,10 @@ TraceResult Tracer::tracePixel(double px, double py) const {
       return g;
     }
     case DispersionMode::Spectral: {
-      const std::vector<SpectralSample> samples = spectralSamples(options_.spectral_samples);
       TraceResult centre = trace(ob.eye, d, 0);
       if (!centre.hit_lens) return centre;
       Vec3 sum(0.0);
-      for (const SpectralSample& s : samples) sum += s.rgb_weight * trace(ob.eye, d, s.wavelength_nm).color;
+      for (const SpectralSample& s : spectral_) sum += s.rgb_weight * trace(ob.eye, d, s.wavelength_nm).color;
       centre.color = sum;
       return centre;
     }

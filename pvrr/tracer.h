@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "pvrr/ray_scene.h"
+#include "pvrr/spectrum.h"
 
 namespace pvrr {
 
@@ -74,6 +75,7 @@ class Tracer {
   const RayScene& rays_;
   const Scene& scene_;
   TraceOptions options_;
+  std::vector<SpectralSample> spectral_;  // the spectral mode's wavelengths and weights, computed once
 };
 
 }  // namespace pvrr

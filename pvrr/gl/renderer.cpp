@@ -8,6 +8,7 @@
 
 #include "cad/error.h"
 #include "pvrr/gl/gl.h"
+#include "pvrr/gl/framebuffer.h"
 #include "pvrr/gl/program.h"
 
 namespace pvrr::gl {
@@ -32,16 +33,16 @@ Mat4 relativeViewProj(const Mat4& proj, const Mat4& view, const Vec3& origin) {
   return proj * view * glm::translate(Mat4(1.0), origin);
 }
 
-// A render target: N colour attachments (2D or one face of cube maps) and a depth buffer.
-struct Target {
+// Cube-map render target for the envmap baseline (Framebuffer covers the 2D targets): N colour cube maps
+// and a depth buffer; selectFace() attaches one face of each.
+struct CubeTarget {
   GLuint fbo = 0, depth = 0;
   std::vector<GLuint> colors;
-  int width = 0, height = 0;
-  bool cube = false;
-  Target() = default;
-  Target(const Target&) = delete;
-  Target& operator=(const Target&) = delete;
-  ~Target() { release(); }
+  int size = 0;
+  CubeTarget() = default;
+  CubeTarget(const CubeTarget&) = delete;
+  CubeTarget& operator=(const CubeTarget&) = delete;
+  ~CubeTarget() { release(); }
   void release() {
     if (fbo) glDeleteFramebuffers(1, &fbo);
     if (depth) glDeleteRenderbuffers(1, &depth);
@@ -49,59 +50,47 @@ struct Target {
     fbo = depth = 0;
     colors.clear();
   }
-  // formats: internal formats of the colour attachments; filters: GL_LINEAR or GL_NEAREST each.
-  void create(int w, int h, const std::vector<GLenum>& formats, const std::vector<GLenum>& filters, bool as_cube) {
+  void create(int n, const std::vector<GLenum>& formats) {
     release();
-    width = w;
-    height = h;
-    cube = as_cube;
+    size = n;
     glGenFramebuffers(1, &fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
     colors.resize(formats.size());
     glGenTextures(GLsizei(colors.size()), colors.data());
     for (size_t i = 0; i < formats.size(); ++i) {
-      const GLenum target = cube ? GL_TEXTURE_CUBE_MAP : GL_TEXTURE_2D;
-      glBindTexture(target, colors[i]);
-      if (cube) {
-        for (int f = 0; f < 6; ++f)
-          glTexImage2D(GLenum(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f), 0, GLint(formats[i]), w, h, 0, GL_RGBA, GL_FLOAT, nullptr);
-        glTexParameteri(target, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
-      } else {
-        glTexImage2D(GL_TEXTURE_2D, 0, GLint(formats[i]), w, h, 0, GL_RGBA, GL_FLOAT, nullptr);
-      }
-      glTexParameteri(target, GL_TEXTURE_MIN_FILTER, GLint(filters[i]));
-      glTexParameteri(target, GL_TEXTURE_MAG_FILTER, GLint(filters[i]));
-      glTexParameteri(target, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-      glTexParameteri(target, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-      if (!cube) glFramebufferTexture2D(GL_FRAMEBUFFER, GLenum(GL_COLOR_ATTACHMENT0 + i), GL_TEXTURE_2D, colors[i], 0);
+      glBindTexture(GL_TEXTURE_CUBE_MAP, colors[i]);
+      for (int f = 0; f < 6; ++f)
+        glTexImage2D(GLenum(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f), 0, GLint(formats[i]), n, n, 0, GL_RGBA, GL_FLOAT, nullptr);
+      // Colour and seen points both filter linearly (see the 2D maps below).
+      glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+      glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
     }
     glGenRenderbuffers(1, &depth);
     glBindRenderbuffer(GL_RENDERBUFFER, depth);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, w, h);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, n, n);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
-    if (cube) selectFace(0);
+    selectFace(0);
     std::vector<GLenum> bufs(formats.size());
     for (size_t i = 0; i < bufs.size(); ++i) bufs[i] = GLenum(GL_COLOR_ATTACHMENT0 + i);
     glDrawBuffers(GLsizei(bufs.size()), bufs.data());
-    GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
     if (status != GL_FRAMEBUFFER_COMPLETE)
-      throw Error("GL: framebuffer " + std::to_string(w) + "x" + std::to_string(h) + " incomplete (status 0x" +
-                  std::to_string(status) + ")");
-    checkGlError("creating a render target");
+      throw Error("GL: cube-map framebuffer " + std::to_string(n) + "^2 incomplete (status " + std::to_string(status) + ")");
+    checkGlError("creating a cube-map target");
   }
-  void selectFace(int face) {
+  // Binds the target with `face` attached, sets the viewport and clears it.
+  void selectFace(int face) const {
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
     for (size_t i = 0; i < colors.size(); ++i)
       glFramebufferTexture2D(GL_FRAMEBUFFER, GLenum(GL_COLOR_ATTACHMENT0 + i), GLenum(GL_TEXTURE_CUBE_MAP_POSITIVE_X + face),
                              colors[i], 0);
-  }
-  std::vector<float> read(int attachment) const {
-    std::vector<float> px(size_t(width) * size_t(height) * 4);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-    glReadBuffer(GLenum(GL_COLOR_ATTACHMENT0 + attachment));
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, px.data());
-    return px;
+    glViewport(0, 0, size, size);
+    const float zero[4] = {0, 0, 0, 0}, far_depth = 1.0f;
+    for (size_t i = 0; i < colors.size(); ++i) glClearBufferfv(GL_COLOR, GLint(i), zero);
+    glClearBufferfv(GL_DEPTH, 0, &far_depth);
   }
 };
 
@@ -193,30 +182,25 @@ struct Renderer::Impl {
   Program lens3_program = makeProgram("element.vert", "element.frag", {"#define MODE_PVRR", "#define CHANNELS 3", "#define LENS"});
   GLuint empty_vao = 0;
   std::vector<MeshBuffers> env_meshes;
-  std::vector<GLuint> textures;
-  Target frame_target;
-  std::vector<std::unique_ptr<Target>> maps;   // first-pass maps, one per patch view (reused)
-  std::vector<std::unique_ptr<Target>> cubes;  // envmap cubes, one per element
+  std::vector<Texture> textures;  // environment textures, in Scene::textures order
+  std::unique_ptr<Framebuffer> frame_target;      // the second pass: colour, seen point, surface point
+  std::vector<std::unique_ptr<Framebuffer>> maps;  // first-pass maps, one per patch view (reused)
+  std::vector<std::unique_ptr<CubeTarget>> cubes;  // envmap cubes, one per element
   std::vector<MeshBuffers> element_meshes;     // per (element, patch) in pvrr mode; per element otherwise
 
   Impl(const Scene& s, const RayScene& r, RendererOptions o) : scene(s), rays(r), options(std::move(o)) {
     glGenVertexArrays(1, &empty_vao);
-    for (const Texture& t : scene.textures) {
-      GLuint id = 0;
-      glGenTextures(1, &id);
-      glBindTexture(GL_TEXTURE_2D, id);
-      // Rows bottom-up for GL, so that v = 0 is the image's bottom row (pvrr/shading.cpp samples the same).
-      std::vector<uint8_t> flipped(t.rgb.size());
-      const size_t row = size_t(t.width) * 3;
-      for (int y = 0; y < t.height; ++y)
-        std::copy_n(&t.rgb[size_t(t.height - 1 - y) * row], row, &flipped[size_t(y) * row]);
-      glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-      glTexImage2D(GL_TEXTURE_2D, 0, GL_SRGB8, t.width, t.height, 0, GL_RGB, GL_UNSIGNED_BYTE, flipped.data());
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    for (const pvrr::Texture& t : scene.textures) {
+      ImageRGB8 image;
+      image.width = t.width;
+      image.height = t.height;
+      image.rgb = t.rgb;
+      // sRGB, flipped so v = 0 is the image's bottom row, no mipmaps: bilinear sampling with repeat wrapping,
+      // exactly what the tracer does (pvrr/shading.cpp).
+      textures.push_back(createTexture2D(image, TextureEncoding::Srgb, false));
+      glBindTexture(GL_TEXTURE_2D, textures.back().name());
       glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
       glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
-      textures.push_back(id);
     }
     env_meshes.resize(scene.meshes.size());
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
@@ -239,7 +223,6 @@ struct Renderer::Impl {
   ~Impl() {
     for (auto& m : env_meshes) m.release();
     for (auto& m : element_meshes) m.release();
-    if (!textures.empty()) glDeleteTextures(GLsizei(textures.size()), textures.data());
     if (empty_vao) glDeleteVertexArrays(1, &empty_vao);
   }
 
@@ -293,18 +276,9 @@ struct Renderer::Impl {
       env_program.set("u_offset", glm::vec3(mesh.anchor - origin));
       env_program.set("u_albedo", glm::vec3(mat.color));
       env_program.set("u_has_texture", mat.texture >= 0 ? 1 : 0);
-      if (mat.texture >= 0) glBindTexture(GL_TEXTURE_2D, textures[size_t(mat.texture)]);
+      if (mat.texture >= 0) glBindTexture(GL_TEXTURE_2D, textures[size_t(mat.texture)].name());
       draw(env_meshes[m]);
     }
-  }
-
-  void clearTarget(const Target& t, bool reversed_depth = false) const {
-    glBindFramebuffer(GL_FRAMEBUFFER, t.fbo);
-    glViewport(0, 0, t.width, t.height);
-    const float zero[4] = {0, 0, 0, 0};
-    for (size_t i = 0; i < t.colors.size(); ++i) glClearBufferfv(GL_COLOR, GLint(i), zero);
-    const float depth = reversed_depth ? 0.0f : 1.0f;
-    glClearBufferfv(GL_DEPTH, 0, &depth);
   }
 
   void setElementMaterial(const Program& p, const Element& el, int index) const {
@@ -355,15 +329,21 @@ struct Renderer::Impl {
     uploadMesh(mb, data, {3, 3, 3, 3, 3, 3}, idx);
   }
 
-  Target& mapTarget(size_t i) {
-    while (maps.size() <= i) maps.push_back(std::make_unique<Target>());
-    Target& t = *maps[i];
-    if (t.width != options.map_size)
-      // Seen points are filtered linearly too: exact within a surface, a blend only across depth edges
-      // (nearest filtering would quantise every seen point by up to half a texel).
-      t.create(options.map_size, options.map_size, {GL_RGBA16F, GL_RGBA32F, GL_RGBA32F}, {GL_LINEAR, GL_LINEAR, GL_NEAREST},
-               false);
-    return t;
+  Framebuffer& mapTarget(size_t i) {
+    if (maps.size() <= i) maps.resize(i + 1);
+    if (!maps[i] || maps[i]->width() != options.map_size) {
+      maps[i] = std::make_unique<Framebuffer>(options.map_size, options.map_size,
+                                              std::vector<ColorFormat>{ColorFormat::RGBA16F, ColorFormat::RGBA32F},
+                                              DepthFormat::Depth32F);
+      // Colour and seen points filter linearly: seen points are exact within a surface and blend only across
+      // depth edges (nearest filtering would quantise every seen point by up to half a texel).
+      for (int a = 0; a < 2; ++a) {
+        glBindTexture(GL_TEXTURE_2D, maps[i]->colorTexture(a));
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      }
+    }
+    return *maps[i];
   }
 
   RasterFrame render(RasterMode mode, FrameCache* cache);
@@ -471,8 +451,9 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       // In a reversed (zooming) map the rays come from the mirror, not from the viewpoint.
       const Vec3 element_centre = Vec3(scene.elements[size_t(f.element)].local_to_world[3]);
       for (PatchView& pv : f.views) {
-        Target& t = mapTarget(next++);
-        clearTarget(t, pv.volume.backward);
+        const Framebuffer& t = mapTarget(next++);
+        t.bind();
+        t.clear({0, 0, 0, 0}, pv.volume.backward ? 0.0f : 1.0f);
         drawEnvironment(pv.volume.view, pv.volume.projection, pv.volume.eye, pv.volume.backward,
                         pv.volume.backward ? &element_centre : nullptr);
       }
@@ -480,17 +461,15 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     glFinish();
     out.stages.ran("first-pass", msSince(t0));
   } else if (mode == RasterMode::Envmap && n_el > 0) {
-    while (cubes.size() < n_el) cubes.push_back(std::make_unique<Target>());
+    while (cubes.size() < n_el) cubes.push_back(std::make_unique<CubeTarget>());
     for (size_t e = 0; e < n_el; ++e) {
-      Target& c = *cubes[e];
-      if (c.width != options.map_size)
-        c.create(options.map_size, options.map_size, {GL_RGBA16F, GL_RGBA32F}, {GL_LINEAR, GL_LINEAR}, true);
+      CubeTarget& c = *cubes[e];
+      if (c.size != options.map_size) c.create(options.map_size, {GL_RGBA16F, GL_RGBA32F});
       const Vec3 centre = Vec3(scene.elements[e].local_to_world[3]);
       const double near_m = 1e-3, far_m = 2.0 * (scene.boundsRadius() + glm::length(centre - scene.bounds_min)) + 1.0;
       const Mat4 proj = glm::perspective(kPi / 2, 1.0, near_m, far_m);
       for (int face = 0; face < 6; ++face) {
         c.selectFace(face);
-        clearTarget(c);
         drawEnvironment(glm::lookAt(centre, centre + kCubeDir[face], kCubeUp[face]), proj, centre);
       }
     }
@@ -502,17 +481,18 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
 
   // --- second pass ---
   t0 = Clock::now();
-  if (frame_target.width != ob.width || frame_target.height != ob.height)
-    frame_target.create(ob.width, ob.height, {GL_RGBA32F, GL_RGBA32F, GL_RGBA32F}, {GL_NEAREST, GL_NEAREST, GL_NEAREST},
-                        false);
-  clearTarget(frame_target);
+  if (!frame_target || frame_target->width() != ob.width || frame_target->height() != ob.height)
+    frame_target = std::make_unique<Framebuffer>(
+        ob.width, ob.height, std::vector<ColorFormat>{ColorFormat::RGBA32F, ColorFormat::RGBA32F, ColorFormat::RGBA32F},
+        DepthFormat::Depth32F);
+  frame_target->bind();
+  frame_target->clear({0, 0, 0, 0});
   const double near_m = 1e-3;
   const double far_m = 4.0 * (scene.boundsRadius() + glm::length(ob.eye - 0.5 * (scene.bounds_min + scene.bounds_max))) + 1.0;
   const Mat4 view = ob.view(), proj = ob.projection(near_m, far_m);
   drawEnvironment(view, proj, ob.eye);
   const Mat4 vp = relativeViewProj(proj, view, ob.eye);
   size_t next_map = 0;
-  element_meshes.resize(std::max(element_meshes.size(), size_t(1)));
   size_t next_mesh = 0;
   auto meshSlot = [&]() -> MeshBuffers& {
     if (element_meshes.size() <= next_mesh) element_meshes.resize(next_mesh + 1);
@@ -534,16 +514,15 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       setLights(p, ob.eye);
       setElementMaterial(p, el, int(e));
       for (const PatchView& pv : f.views) {
-        const Target& map = *maps[next_map++];
+        const Framebuffer& map = *maps[next_map++];
         glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, map.colors[0]);
+        glBindTexture(GL_TEXTURE_2D, map.colorTexture(0));
         glActiveTexture(GL_TEXTURE1);
-        glBindTexture(GL_TEXTURE_2D, map.colors[1]);
+        glBindTexture(GL_TEXTURE_2D, map.colorTexture(1));
         p.set("u_seen_offset", glm::vec3(pv.volume.eye - ob.eye));
         MeshBuffers& mb = meshSlot();
         uploadPatch(mb, f, pv, anchor);
-        glBindFramebuffer(GL_FRAMEBUFFER, frame_target.fbo);
-        glViewport(0, 0, ob.width, ob.height);
+        frame_target->bind();
         draw(mb);
       }
       glActiveTexture(GL_TEXTURE0);
@@ -569,8 +548,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       }
       MeshBuffers& mb = meshSlot();
       uploadElementGrid(mb, f, anchor);
-      glBindFramebuffer(GL_FRAMEBUFFER, frame_target.fbo);
-      glViewport(0, 0, ob.width, ob.height);
+      frame_target->bind();
       draw(mb);
     }
   }
@@ -580,7 +558,8 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   out.elements = std::move(frames);
 
   if (options.read_back) {
-    const std::vector<float> color = frame_target.read(0), seen = frame_target.read(1), surf = frame_target.read(2);
+    const std::vector<float> color = frame_target->readFloat4(0), seen = frame_target->readFloat4(1),
+                             surf = frame_target->readFloat4(2);  // rows top-down
     const size_t n = size_t(ob.width) * size_t(ob.height);
     out.color.resize(n);
     out.seen.resize(n);
@@ -588,8 +567,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     out.element_point.resize(n);
     for (int y = 0; y < ob.height; ++y) {
       for (int x = 0; x < ob.width; ++x) {
-        const size_t src = (size_t(ob.height - 1 - y) * size_t(ob.width) + size_t(x)) * 4;  // GL rows are bottom-up
-        const size_t dst = size_t(y) * size_t(ob.width) + size_t(x);
+        const size_t dst = size_t(y) * size_t(ob.width) + size_t(x), src = 4 * dst;
         out.color[dst] = Vec3(color[src], color[src + 1], color[src + 2]);
         out.seen[dst] = ob.eye + Vec3(seen[src], seen[src + 1], seen[src + 2]);
         const int id = int(std::lround(surf[src + 3])) - 1;

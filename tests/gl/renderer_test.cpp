@@ -52,6 +52,19 @@ std::vector<bool> awayFromDepthEdges(const TracedFrame& ref, const Vec3& eye) {
   return ok;
 }
 
+// Median angular error over the reference's element pixels for one pvrr / envmap frame.
+double medianArcmin(const TracedFrame& ref, const gl::RasterFrame& f) {
+  std::vector<double> e;
+  for (size_t i = 0; i < ref.color.size(); ++i)
+    if (ref.element[i] >= 0) {
+      const double a = arcminutes(angleBetween(ref.seen[i] - ref.element_point[i], f.seen[i] - ref.element_point[i]));
+      EXPECT_TRUE(std::isfinite(a)) << "pixel " << i;
+      e.push_back(a);
+    }
+  std::sort(e.begin(), e.end());
+  return e.empty() ? 1e9 : e[e.size() / 2];
+}
+
 class RendererTest : public ::testing::TestWithParam<gl::GlBackend> {};
 
 TEST_P(RendererTest, RasterEnvironmentMatchesTheTracer) {
@@ -120,32 +133,11 @@ TEST_P(RendererTest, ConvexMirrorPvrrBeatsTheCubeMap) {
   gl::RendererOptions opt;
   opt.map_size = 512;
   gl::Renderer r(s, rays, opt);
-  auto medianError = [&](const gl::RasterFrame& f) {
-    std::vector<double> e;
-    for (size_t i = 0; i < ref.color.size(); ++i) {
-      if (ref.element[i] != 0) continue;
-      const double a = arcminutes(angleBetween(ref.seen[i] - ref.element_point[i], f.seen[i] - ref.element_point[i]));
-      EXPECT_TRUE(std::isfinite(a));
-      e.push_back(a);
-    }
-    std::sort(e.begin(), e.end());
-    return e.empty() ? 1e9 : e[e.size() / 2];
-  };
-  const double pvrr = medianError(r.render(gl::RasterMode::Pvrr));
-  const double envmap = medianError(r.render(gl::RasterMode::Envmap));
+  const double pvrr = medianArcmin(ref, r.render(gl::RasterMode::Pvrr));
+  const double envmap = medianArcmin(ref, r.render(gl::RasterMode::Envmap));
   EXPECT_LT(pvrr, 1.0);
   EXPECT_LT(pvrr * 3, envmap) << "pvrr " << pvrr << "', envmap " << envmap << "'";
   for (const Vec3& c : r.render(gl::RasterMode::Pvrr).color) ASSERT_TRUE(isFinite(c));
-}
-
-// Median angular error over the reference's element pixels for one pvrr / envmap frame.
-double medianArcmin(const TracedFrame& ref, const gl::RasterFrame& f) {
-  std::vector<double> e;
-  for (size_t i = 0; i < ref.color.size(); ++i)
-    if (ref.element[i] >= 0)
-      e.push_back(arcminutes(angleBetween(ref.seen[i] - ref.element_point[i], f.seen[i] - ref.element_point[i])));
-  std::sort(e.begin(), e.end());
-  return e.empty() ? 1e9 : e[e.size() / 2];
 }
 
 // The car mirror (issue 5): median error <= 1 arcmin at the scene's default tessellation, at least 10x below
