@@ -10,6 +10,9 @@
 
 #include <Eigen/Dense>
 #include <ceres/ceres.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+#include <tbb/partitioner.h>
 
 #include "cad/error.h"
 
@@ -119,13 +122,19 @@ struct Eval {
   Vector3d g{0, 0, 0};
 };
 
-Eval evaluate(const Data& D, const Vector3d& e, double b, const Prior& prior, bool derivatives) {
-  Eval E;
-  double sum = 0;
-  // Symmetric H accumulated in 6 scalars.
-  double hxx = 0, hxy = 0, hxz = 0, hyy = 0, hyz = 0, hzz = 0, gx = 0, gy = 0, gz = 0;
+// Partial sums of one block of rays: the data term of F, the symmetric H in 6 scalars and g.
+struct Partial {
+  double sum = 0, hxx = 0, hxy = 0, hxz = 0, hyy = 0, hyz = 0, hzz = 0, gx = 0, gy = 0, gz = 0;
+  void add(const Partial& o) {
+    sum += o.sum, hxx += o.hxx, hxy += o.hxy, hxz += o.hxz, hyy += o.hyy, hyz += o.hyz, hzz += o.hzz;
+    gx += o.gx, gy += o.gy, gz += o.gz;
+  }
+};
+
+Partial evaluateRange(const Data& D, const Vector3d& e, double b, bool derivatives, size_t begin, size_t end) {
+  Partial P;
   const double inv_b = b > 0 ? 1.0 / b : 0.0;
-  for (size_t i = 0; i < D.size(); ++i) {
+  for (size_t i = begin; i < end; ++i) {
     const Vector3d& d = D.d[i];
     const double vx = D.h[i].x() - e.x(), vy = D.h[i].y() - e.y(), vz = D.h[i].z() - e.z();
     const double n2 = vx * vx + vy * vy + vz * vz;
@@ -136,7 +145,7 @@ Eval evaluate(const Data& D, const Vector3d& e, double b, const Prior& prior, bo
     const double px = ux - du * d.x(), py = uy - du * d.y(), pz = uz - du * d.z();
     const double s = px * px + py * py + pz * pz;
     const double x = s * inv_b;
-    sum += b > 0 ? b * log1pFast(x) : s;
+    P.sum += b > 0 ? b * log1pFast(x) : s;
     if (!derivatives) continue;
     const double w = 1.0 / (1.0 + x);  // rho'
     const double qx = d.x() - du * ux, qy = d.y() - du * uy, qz = d.z() - du * uz;
@@ -144,19 +153,46 @@ Eval evaluate(const Data& D, const Vector3d& e, double b, const Prior& prior, bo
     const double c = w * inv_n * inv_n;
     double k = 0;  // coefficient of (J^T r)(J^T r)^T
     if (b > 0 && s > 0) k = (std::max(w - 2.0 * x * w * w, 0.0) - w) / s;
-    hxx += c * (1 - ux * ux - qx * qx) + k * jx * jx;
-    hxy += c * (-ux * uy - qx * qy) + k * jx * jy;
-    hxz += c * (-ux * uz - qx * qz) + k * jx * jz;
-    hyy += c * (1 - uy * uy - qy * qy) + k * jy * jy;
-    hyz += c * (-uy * uz - qy * qz) + k * jy * jz;
-    hzz += c * (1 - uz * uz - qz * qz) + k * jz * jz;
-    gx += w * jx, gy += w * jy, gz += w * jz;
+    P.hxx += c * (1 - ux * ux - qx * qx) + k * jx * jx;
+    P.hxy += c * (-ux * uy - qx * qy) + k * jx * jy;
+    P.hxz += c * (-ux * uz - qx * qz) + k * jx * jz;
+    P.hyy += c * (1 - uy * uy - qy * qy) + k * jy * jy;
+    P.hyz += c * (-uy * uz - qy * qz) + k * jy * jz;
+    P.hzz += c * (1 - uz * uz - qz * qz) + k * jz * jz;
+    P.gx += w * jx, P.gy += w * jy, P.gz += w * jz;
   }
-  E.F = 0.5 * sum;
+  return P;
+}
+
+// Rays per block of the parallel evaluation. Blocks are fixed and summed in a fixed tree
+// (parallel_deterministic_reduce with a simple partitioner), so F, H and g, and hence the fitted eye, are
+// bit-identical whatever the number of threads. Below two blocks the loop runs serially.
+constexpr size_t kEvalBlock = 512;
+
+Eval evaluate(const Data& D, const Vector3d& e, double b, const Prior& prior, bool derivatives) {
+  const size_t n = D.size();
+  Partial P;
+  if (n < 2 * kEvalBlock) {
+    P = evaluateRange(D, e, b, derivatives, 0, n);
+  } else {
+    P = tbb::parallel_deterministic_reduce(
+        tbb::blocked_range<size_t>(0, n, kEvalBlock), Partial{},
+        [&](const tbb::blocked_range<size_t>& r, Partial acc) {
+          acc.add(evaluateRange(D, e, b, derivatives, r.begin(), r.end()));
+          return acc;
+        },
+        [](Partial a, const Partial& c) {
+          a.add(c);
+          return a;
+        },
+        tbb::simple_partitioner());
+  }
+  Eval E;
+  E.F = 0.5 * P.sum;
   if (prior.active) E.F += 0.5 * prior.k * prior.k * (e - prior.nominal).squaredNorm();
   if (derivatives) {
-    E.H << hxx, hxy, hxz, hxy, hyy, hyz, hxz, hyz, hzz;
-    E.g = Vector3d(gx, gy, gz);
+    E.H << P.hxx, P.hxy, P.hxz, P.hxy, P.hyy, P.hyz, P.hxz, P.hyz, P.hzz;
+    E.g = Vector3d(P.gx, P.gy, P.gz);
     if (prior.active) {
       E.H.diagonal().array() += prior.k * prior.k;
       E.g += prior.k * prior.k * (e - prior.nominal);
@@ -348,13 +384,16 @@ ViewpointFit fitViewpoint(const std::vector<ViewpointRay>& rays, const Viewpoint
   ViewpointFit fit;
 
   // 1. Closed form (relative to the centroid): A x = y, A = sum P_d, y = sum P_d o.
-  Matrix3d A = Matrix3d::Zero();
-  Vector3d y(0, 0, 0);
+  // Summed as A = N I - sum d d^T and y = sum o - sum d (d . o): no 3x3 matrix per ray.
+  Matrix3d ddt = Matrix3d::Zero();
+  Vector3d sum_o(0, 0, 0), sum_dd_o(0, 0, 0);
   for (size_t i = 0; i < n; ++i) {
-    const Matrix3d P = Matrix3d::Identity() - D.d[i] * D.d[i].transpose();
-    A += P;
-    y += P * D.o[i];
+    ddt.noalias() += D.d[i] * D.d[i].transpose();
+    sum_o += D.o[i];
+    sum_dd_o += D.d[i] * D.d[i].dot(D.o[i]);
   }
+  const Matrix3d A = double(n) * Matrix3d::Identity() - ddt;
+  const Vector3d y = sum_o - sum_dd_o;
   Eigen::SelfAdjointEigenSolver<Matrix3d> es(A);
   const Vector3d lambda = es.eigenvalues();  // ascending
   const Matrix3d V = es.eigenvectors();
