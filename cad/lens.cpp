@@ -1,10 +1,13 @@
-// Lens solids: validation that both sags exist over the outline and that the surfaces do not meet inside it.
+// Lens solids: validation that both sags exist over the outline and that the surfaces do not meet inside it;
+// NURBS surfaces as sag graphs (makeNurbsSag).
 #include "cad/lens.h"
 
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <sstream>
+#include <vector>
 
 #include "cad/error.h"
 
@@ -54,7 +57,198 @@ double sagGap(const SagSurface& front, const SagSurface& back, Vec2 p) {
   return back.sag(p.x, p.y).z - front.sag(p.x, p.y).z;
 }
 
+// ---- NURBS surfaces as sag graphs ----
+
+// Samples per direction of the (u, v) -> (x, y) table: the affine guess is fitted to it and the nearest
+// sample restarts Newton when the affine guess fails (strongly non-affine parametrisations).
+constexpr int kGraphTable = 33;
+
+// What every copy of one NURBS sag shares (withVertex makes copies).
+struct NurbsGraph {
+  std::shared_ptr<const NurbsSurface> surface;
+  std::optional<Outline> trim;
+  double trim_tol = 0;
+  std::string what;
+  ParamDomain dom;
+  double scale = 1;     // largest |x|, |y| over the table (metres): the scale of the inversion's rounding
+  double z_axis = 0;    // z of the surface over the local origin
+  Vec2 uv_axis{0};
+  // Affine guess (u, v) ~ A (x, y) + b, least squares over the table.
+  double a[2][3] = {{0, 0, 0}, {0, 0, 0}};
+  std::vector<Vec2> table_uv, table_xy;
+  double min_nz = 0;    // cos(max slope)
+
+  Vec2 clampUv(Vec2 uv) const {
+    return Vec2(std::clamp(uv.x, dom.u0, dom.u1), std::clamp(uv.y, dom.v0, dom.v1));
+  }
+
+  // Newton on (x(u, v), y(u, v)) = (x, y) from `start`, clamped to the domain. 1: converged; 0: stopped at
+  // the domain boundary (the point is not over the surface); -1: failed (singular or not converging).
+  int newton(double x, double y, Vec2 start, Vec2& uv, SurfaceDerivs& d) const {
+    const double eps = std::numeric_limits<double>::epsilon();
+    const double tol = 8 * eps * scale, accept = 256 * eps * scale;
+    uv = clampUv(start);
+    double r_len = kInf;
+    for (int it = 0; it < 40; ++it) {
+      d = surface->evaluate(uv.x, uv.y);
+      const double rx = d.p.x - x, ry = d.p.y - y;
+      r_len = std::hypot(rx, ry);
+      if (!std::isfinite(r_len)) return -1;
+      if (r_len <= tol) return 1;
+      const double det = d.du.x * d.dv.y - d.dv.x * d.du.y;
+      if (!std::isfinite(det) || det == 0) return -1;
+      const Vec2 next = clampUv(uv + Vec2((-d.dv.y * rx + d.dv.x * ry) / det, (d.du.y * rx - d.du.x * ry) / det));
+      if (next == uv) return r_len <= accept ? 1 : 0;  // stalled: at rounding, or pinned at the boundary
+      uv = next;
+    }
+    d = surface->evaluate(uv.x, uv.y);
+    r_len = std::hypot(d.p.x - x, d.p.y - y);
+    if (r_len <= accept) return 1;
+    const bool on_edge = uv.x == dom.u0 || uv.x == dom.u1 || uv.y == dom.v0 || uv.y == dom.v1;
+    return on_edge ? 0 : -1;
+  }
+
+  // (u, v) over (x, y) and the derivatives there; false when (x, y) is beyond the surface, with `uv` then
+  // the boundary point the inversion stopped at.
+  bool invert(double x, double y, Vec2& uv, SurfaceDerivs& d) const {
+    const Vec2 guess(a[0][0] * x + a[0][1] * y + a[0][2], a[1][0] * x + a[1][1] * y + a[1][2]);
+    const int first = newton(x, y, guess, uv, d);
+    if (first == 1) return true;
+    size_t best = 0;
+    double best_d2 = kInf;
+    for (size_t k = 0; k < table_xy.size(); ++k) {
+      const double dx = table_xy[k].x - x, dy = table_xy[k].y - y, d2 = dx * dx + dy * dy;
+      if (d2 < best_d2) {
+        best_d2 = d2;
+        best = k;
+      }
+    }
+    Vec2 uv2;
+    SurfaceDerivs d2;
+    const int second = newton(x, y, table_uv[best], uv2, d2);
+    if (second == 1 || first == -1) {
+      uv = uv2;
+      d = d2;
+    }
+    return second == 1;
+  }
+
+  // Graph z(x, y) = z of the surface and its derivatives, from the derivatives at the (u, v) over (x, y):
+  // with J = d(x, y)/d(u, v) and a_i = J^-1 e_i, z_i = grad z . a_i and, differentiating F(u(x)) = x twice,
+  // z_ij = Q_z(a_i, a_j) - grad z . J^-1 Q_xy(a_i, a_j), Q(a, b) = P_uu a0 b0 + P_uv (a0 b1 + a1 b0) + P_vv a1 b1.
+  static SagDerivs graph(const SurfaceDerivs& d) {
+    const double det = d.du.x * d.dv.y - d.dv.x * d.du.y;
+    const Vec2 a1(d.dv.y / det, -d.du.y / det), a2(-d.dv.x / det, d.du.x / det);
+    const Vec2 gz(d.du.z, d.dv.z);
+    auto q = [&](Vec2 p, Vec2 r) { return d.duu * (p.x * r.x) + d.duv * (p.x * r.y + p.y * r.x) + d.dvv * (p.y * r.y); };
+    auto second = [&](Vec2 p, Vec2 r) {
+      const Vec3 qq = q(p, r);
+      // J^-1 (qx, qy) = qx a1 + qy a2.
+      const Vec2 duv = qq.x * a1 + qq.y * a2;
+      return qq.z - glm::dot(gz, duv);
+    };
+    SagDerivs g;
+    g.z = d.p.z;
+    g.zx = glm::dot(gz, a1);
+    g.zy = glm::dot(gz, a2);
+    g.zxx = second(a1, a1);
+    g.zxy = second(a1, a2);
+    g.zyy = second(a2, a2);
+    return g;
+  }
+};
+
+class NurbsSag final : public SagSurface {
+ public:
+  NurbsSag(std::shared_ptr<const NurbsGraph> g, const Outline& outline, double z_vertex)
+      : SagSurface(outline, z_vertex), g_(std::move(g)) {}
+
+  bool defined(double x, double y) const override {
+    Vec2 uv;
+    SurfaceDerivs d;
+    if (!g_->invert(x, y, uv, d)) return false;
+    if (g_->trim && !g_->trim->contains(uv, g_->trim_tol)) return false;
+    const Vec3 c = glm::cross(d.du, d.dv);
+    return std::abs(c.z) >= g_->min_nz * glm::length(c);
+  }
+
+  // Sag Z = z_axis - z(x, y) (cad/sag.h: the point is (x, y, z_vertex - Z)); beyond the surface, its
+  // second-order Taylor expansion at the boundary point.
+  SagDerivs sag(double x, double y) const override {
+    Vec2 uv;
+    SurfaceDerivs d;
+    const bool over = g_->invert(x, y, uv, d);
+    SagDerivs z = NurbsGraph::graph(d);
+    if (!over) {
+      const double dx = x - d.p.x, dy = y - d.p.y;
+      z.z += z.zx * dx + z.zy * dy + 0.5 * (z.zxx * dx * dx + 2 * z.zxy * dx * dy + z.zyy * dy * dy);
+      z.zx += z.zxx * dx + z.zxy * dy;
+      z.zy += z.zxy * dx + z.zyy * dy;
+    }
+    return SagDerivs{g_->z_axis - z.z, -z.zx, -z.zy, -z.zxx, -z.zxy, -z.zyy};
+  }
+
+  std::shared_ptr<const SagSurface> withVertex(double z_vertex) const override {
+    return std::make_shared<NurbsSag>(g_, outline(), z_vertex);
+  }
+
+  std::string describe() const override {
+    const Vec3 lo = g_->surface->evaluate(g_->dom.u0, g_->dom.v0).p, hi = g_->surface->evaluate(g_->dom.u1, g_->dom.v1).p;
+    return g_->surface->describe() + " from " + g_->what + " (spanning (" + num(lo.x) + ", " + num(lo.y) +
+           ") to (" + num(hi.x) + ", " + num(hi.y) + ") m" + (g_->trim ? ", trimmed)" : ")");
+  }
+
+ private:
+  std::shared_ptr<const NurbsGraph> g_;
+};
+
 }  // namespace
+
+SagSurfacePtr makeNurbsSag(std::shared_ptr<const NurbsSurface> surface, const Outline& outline,
+                           std::optional<Outline> trim_uv, double trim_tolerance_uv, const std::string& what,
+                           double z_vertex) {
+  if (!surface) throw Error(what + ": no surface");
+  auto g = std::make_shared<NurbsGraph>();
+  g->surface = std::move(surface);
+  g->trim = std::move(trim_uv);
+  g->trim_tol = trim_tolerance_uv;
+  g->what = what;
+  g->dom = g->surface->domain();
+  g->min_nz = std::cos(radians(kNurbsSagMaxSlope_deg));
+  // The table, and the affine guess fitted to it by least squares (3 x 3 normal equations per coordinate).
+  Mat3 ata(0.0);
+  Vec3 atu(0.0), atv(0.0);
+  double scale = 0;
+  for (int i = 0; i < kGraphTable; ++i)
+    for (int j = 0; j < kGraphTable; ++j) {
+      const Vec2 uv(g->dom.u0 + (g->dom.u1 - g->dom.u0) * i / (kGraphTable - 1),
+                    g->dom.v0 + (g->dom.v1 - g->dom.v0) * j / (kGraphTable - 1));
+      const Vec3 p = g->surface->evaluate(uv.x, uv.y).p;
+      if (!isFinite(p)) throw Error(what + ": the surface is not finite at (u, v) = (" + num(uv.x) + ", " + num(uv.y) + ")");
+      g->table_uv.push_back(uv);
+      g->table_xy.emplace_back(p.x, p.y);
+      scale = std::max({scale, std::abs(p.x), std::abs(p.y)});
+      const Vec3 row(p.x, p.y, 1.0);
+      ata += glm::outerProduct(row, row);
+      atu += uv.x * row;
+      atv += uv.y * row;
+    }
+  g->scale = std::max(scale, 1e-300);
+  if (std::abs(glm::determinant(ata)) > 0) {
+    const Mat3 inv = glm::inverse(ata);
+    const Vec3 cu = inv * atu, cv = inv * atv;
+    for (int k = 0; k < 3; ++k) {
+      g->a[0][k] = cu[k];
+      g->a[1][k] = cv[k];
+    }
+  }
+  SurfaceDerivs d;
+  if (!g->invert(0, 0, g->uv_axis, d))
+    throw Error(what + ": the surface (" + g->surface->describe() + ") does not lie over the lens axis (x, y) = (0, 0)"
+                " of the lens frame; its x and y must be the lens's local x and y, in the file's unit");
+  g->z_axis = d.p.z;
+  return std::make_shared<NurbsSag>(std::move(g), outline, z_vertex);
+}
 
 // front z = z_front - Zf, back z = z_back - Zb.
 double LensSolid::thicknessAt(double x, double y) const {

@@ -188,6 +188,58 @@ void writeLensIges(const std::string& path) {
   writeIges(path, g.surface, g.trim, "mm");
 }
 
+namespace {
+
+// The progressive design's corridor coordinate t, the smooth step S = s(t) and G (cad/model_generator.h).
+struct Corridor {
+  double t, s, g;
+};
+Corridor corridorAt(double y_mm) {
+  using D = ProgressiveBackDesign;
+  const double l = D::corridor_length_mm;
+  const double t = (D::corridor_top_mm - y_mm) / l;
+  if (t <= 0) return {t, 0.0, 0.0};
+  if (t >= 1) {
+    // G(1) = L^2 / 7, G'(1) = L^2 / 2 (per unit t), G'' = L^2 beyond.
+    const double e = t - 1;
+    return {t, 1.0, l * l * (1.0 / 7 + 0.5 * e + 0.5 * e * e)};
+  }
+  const double t3 = t * t * t, t5 = t3 * t * t;
+  return {t, t3 * (10 + t * (-15 + 6 * t)), l * l * t5 * (0.5 + t * (-0.5 + t / 7))};
+}
+
+}  // namespace
+
+double ProgressiveBackDesign::z(double x_mm, double y_mm) {
+  const double c = 1 / base_radius_mm, r2 = x_mm * x_mm + y_mm * y_mm;
+  const double kappa = -add_d / (n_d - 1) * 1e-3;  // per mm
+  const Corridor k = corridorAt(y_mm);
+  const double sag = c * r2 / (1 + std::sqrt(1 - c * c * r2)) + kappa * (k.g + 0.5 * k.s * x_mm * x_mm);
+  return -sag;
+}
+
+double ProgressiveBackDesign::addAt(double y_mm) { return add_d * corridorAt(y_mm).s; }
+
+GeneratedSurface progressiveBackSurface() {
+  using D = ProgressiveBackDesign;
+  const double hu = 0.5 * D::blank_width_mm, hv = 0.5 * D::blank_height_mm;
+  std::vector<double> iu;
+  for (int k = 1; k < 8; ++k) iu.push_back(-hu + 2 * hu * k / 8);  // 8 equal spans: 11 poles
+  const double top = D::corridor_top_mm, bottom = D::corridor_top_mm - D::corridor_length_mm;
+  // 16 spans (19 poles): 8 of 1.5 mm along the corridor (the smooth step's fit error falls as h^4, its
+  // curvature error as h^2), knots at both of its ends.
+  std::vector<double> iv = {-19, -15.5};
+  for (int k = 0; k <= 8; ++k) iv.push_back(bottom + (top - bottom) * k / 8);
+  for (double y : {3.5, 8.0, 13.0, 18.0}) iv.push_back(y);
+  return fitGraph(clamped(-hu, hu, iu), clamped(-hv, hv, iv), &ProgressiveBackDesign::z,
+                  Outline::ellipse(D::lens_width_mm, D::lens_height_mm));
+}
+
+void writeProgressiveBackIges(const std::string& path) {
+  const GeneratedSurface g = progressiveBackSurface();
+  writeIges(path, g.surface, std::nullopt, "mm");
+}
+
 double FreeformCageDesign::z(double x_mm, double y_mm) {
   return x_mm * x_mm / (2 * radius_x_mm) - y_mm * y_mm / (2 * radius_y_mm);
 }

@@ -43,6 +43,39 @@ struct LensFrontDesign {
 GeneratedSurface lensFrontSurface();
 void writeLensIges(const std::string& path);
 
+// Progressive-lens-like object-side ("back") surface, in the lens frame of cad/lens.h (+z towards the eye,
+// y up, x across), for a plano-distance lens with a +2.00 D add in CR-39.
+// Design, as a sag Z (measured from the vertex away from +z, cad/sag.h) with the surface at z = -Z:
+//   Z(x, y) = c r^2 / (1 + sqrt(1 - c^2 r^2)) + kappa (G(y) + S(y) x^2 / 2),
+//   c = 1 / base_radius (base_radius = -124.5 mm: a +4.00 D object-side base curve, (n - 1) / 124.5 mm),
+//   kappa = -add / (n - 1) (the change of sag curvature that adds `add` dioptres to this surface's power
+//   F = -(n - 1) Z'' , n = n_d of CR-39),
+//   S(y) = s(t) with t = (corridor_top - y) / corridor_length clamped to [0, 1] and s(t) = 6t^5 - 15t^4 + 10t^3
+//   (C2 smooth step: 0 in the distance zone above the corridor, 1 in the near zone below it),
+//   G'' = S, G = 0 above the corridor: G = L^2 (t^7/7 - t^6/2 + t^5/2) in it and continued quadratically below.
+// Along the corridor line x = 0 the add term is umbilic (Z_xx = Z_yy = kappa S, Z_xy = 0): the mean power
+// grows smoothly from 0 at y = corridor_top to `add` at corridor_top - corridor_length with no astigmatism,
+// while astigmatism kappa |S'| |x| (Z_xy = kappa S' x) grows away from it on both sides, as Minkwitz's theorem
+// requires of every real progressive surface. The fitting point (the lens axis, the origin) is at the top of
+// the corridor, so the vertex region is the plain base sphere.
+// Bicubic B-spline over the blank [-28, 28] x [-23, 23] mm (x(u) = u, y(v) = v), 11 x 19 poles, 1.5 mm knot
+// spacing in y along the corridor and knots at both its ends (the design is C2 there); fitted by least squares; written untrimmed as IGES (the blank:
+// the lens outline, an ellipse of 50 x 40 mm in models/progressive-lens.json, lies inside it with a 3 mm margin
+// that carries the lens's rim rays). GeneratedSurface::trim is that ellipse: the region the fit is measured on.
+struct ProgressiveBackDesign {
+  static constexpr double n_d = 1.498;  // CR-39: the powers below hold at the d line
+  static constexpr double base_radius_mm = -124.5, add_d = 2.0;
+  static constexpr double corridor_top_mm = 0, corridor_length_mm = 12;
+  static constexpr double blank_width_mm = 56, blank_height_mm = 46;
+  static constexpr double lens_width_mm = 50, lens_height_mm = 40;
+  // Surface z (mm) in the lens frame, z(0, 0) = 0 with tangent plane z = 0.
+  static double z(double x_mm, double y_mm);
+  // The add (dioptres) of the design along the corridor at height y: add_d S(y).
+  static double addAt(double y_mm);
+};
+GeneratedSurface progressiveBackSurface();
+void writeProgressiveBackIges(const std::string& path);
+
 // Catmull-Clark cage of a gently saddle-shaped freeform mirror: 7 x 6 vertices over 300 x 200 mm
 // (x in [-150, 150] step 50, y in [-100, 100] step 40), z = x^2/(2*1500) - y^2/(2*900), quads wound
 // counter-clockwise seen from +z (normal +z). Written as OBJ with a comment header (units mm).

@@ -60,6 +60,35 @@ cad::SagSurfacePtr makeSag(const SurfaceDesc& s, const cad::Outline& outline, do
   throw InternalError("makeSag: not a sag surface");
 }
 
+// A lens surface in the lens frame: analytic, or a face of a STEP/IGES file as a NURBS graph over the lens
+// plane (cad::makeNurbsSag), in the file's unit converted to metres and translated along z only, so that
+// its point over the lens axis is the vertex. The face's trim loop, when it has one, must contain the lens
+// outline (within the loop's own chord error). `where` ("<scene>: elements[i].back") starts every message.
+cad::SagSurfacePtr makeLensSurface(const SurfaceDesc& s, const cad::Outline& outline, const std::string& where) {
+  if (s.isSag()) return makeSag(s, outline, 0.0);
+  if (s.type != SurfaceDesc::Type::Cad) throw InternalError("makeLensSurface: not a lens surface type");
+  cad::ImportedModel model;
+  try {
+    model = cad::importCadFile(s.file);
+  } catch (const Error& err) {
+    throw Error(where + ".file: " + err.what());
+  }
+  if (s.face < 0 || size_t(s.face) >= model.faces.size())
+    throw Error(where + ".face: " + s.file + ": face " + std::to_string(s.face) + " requested, the file has " +
+                std::to_string(model.faces.size()) + " face(s) (indices from 0)");
+  const cad::ImportedFace& face = model.faces[size_t(s.face)];
+  auto surface = std::make_shared<cad::NurbsSurface>(cad::scaled(*face.surface, model.unit_to_metres));
+  double trim_tol = 0;
+  if (face.trim)
+    trim_tol = 1.01 * face.trim_chord_error_uv + 1e-9 * std::max(face.trim->width(), face.trim->height());
+  try {
+    return cad::makeNurbsSag(std::move(surface), outline, face.trim, trim_tol,
+                             s.file + " face " + std::to_string(s.face));
+  } catch (const Error& err) {
+    throw Error(where + ": " + err.what());
+  }
+}
+
 // Local frame -> world: z = normal, y = up orthogonalised, x = y x z.
 Mat4 poseMatrix(const PoseDesc& p) {
   const Vec3 z = glm::normalize(p.normal);
@@ -258,6 +287,7 @@ Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
             el.mirror.metal = true;
             el.mirror.n = m.n_rgb();
             el.mirror.k = m.k_rgb();
+            el.mirror.metal_table = std::make_shared<const Metal>(m);
             break;
           }
           case MirrorMaterialDesc::Kind::Conductor:
@@ -293,8 +323,9 @@ Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
           else
             front = cad::makeToric(r.front_radius_a_m, r.front_radius_b_m, radians(p.axis_deg), el.outline);
         } else {
-          front = makeSag(e.front, el.outline, 0.0);
-          back = makeSag(e.back, el.outline, 0.0);
+          const std::string where = file + ": elements[" + std::to_string(i) + "]";
+          front = makeLensSurface(e.front, el.outline, where + ".front");
+          back = makeLensSurface(e.back, el.outline, where + ".back");
         }
         el.lens = cad::makeLens(front, back, el.outline, t, e.min_edge_thickness_m, what);
       }

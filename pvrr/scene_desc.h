@@ -167,8 +167,9 @@ struct ElementDesc {
   SurfaceDesc surface;
   MirrorMaterialDesc mirror_material;
 
-  // Lens (cad/lens.h): front = eye side at z = 0, back = far side; both sag surfaces (isSag()). Either the
-  // two surfaces are given, or a prescription (then front and back are left default-constructed).
+  // Lens (cad/lens.h): front = eye side at z = 0, back = far side; each a sag surface (isSag()) or a CAD
+  // face (Type::Cad, a NURBS graph over the lens's xy plane, cad::makeNurbsSag). Either the two surfaces
+  // are given, or a prescription (then front and back are left default-constructed).
   SurfaceDesc front, back;
   std::optional<PrescriptionDesc> prescription;
   double centre_thickness_m = 0;    // 0: not given

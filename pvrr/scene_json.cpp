@@ -578,8 +578,9 @@ EnvObjectDesc readEnvObject(const Ctx& c, const json* j, const std::string& path
 
 // --- elements ---
 
-const std::vector<std::string> kSagTypes = {"plane", "sphere", "asphere", "toric", "cylinder"};
 const std::vector<std::string> kAllSurfaceTypes = {"plane", "sphere", "asphere", "toric", "cylinder", "cad", "subdivision"};
+// A lens surface: analytic, or a CAD face that is a graph over the lens plane (cad::makeNurbsSag).
+const std::vector<std::string> kLensSurfaceTypes = {"plane", "sphere", "asphere", "toric", "cylinder", "cad"};
 
 double nonZeroRadius(const Obj& o, const std::string& k) {
   const double r = o.number(k, kAny, "a length");
@@ -589,9 +590,9 @@ double nonZeroRadius(const Obj& o, const std::string& k) {
   return r * o.ctx().unit_m;
 }
 
-SurfaceDesc readSurface(const Ctx& c, const json* j, const std::string& path, bool sag_only) {
+SurfaceDesc readSurface(const Ctx& c, const json* j, const std::string& path, const std::vector<std::string>& types) {
   const std::string what = "a surface {\"type\": ...}";
-  const std::string type = peekChoice(c, j, path, what, "type", sag_only ? kSagTypes : kAllSurfaceTypes);
+  const std::string type = peekChoice(c, j, path, what, "type", types);
   SurfaceDesc s;
   if (type == "plane") {
     Obj o(c, j, path, what, {"type"});
@@ -821,7 +822,7 @@ ElementDesc readElement(const Ctx& c, const json* j, const std::string& path, si
   // Surfaces first: whether an outline is required depends on them.
   bool analytic = true;
   if (e.type == ElementDesc::Type::Mirror) {
-    e.surface = readSurface(c, o.get("surface"), o.at("surface"), false);
+    e.surface = readSurface(c, o.get("surface"), o.at("surface"), kAllSurfaceTypes);
     analytic = e.surface.isSag();
     e.mirror_material = readMirrorMaterial(c, o.get("material"), o.at("material"));
   } else {
@@ -838,8 +839,8 @@ ElementDesc readElement(const Ctx& c, const json* j, const std::string& path, si
       if (p.has("base_curve_d")) rx.base_curve_d = p.number("base_curve_d", leftOpen(0, 25), "a power in dioptres");
       e.prescription = rx;
     } else {
-      e.front = readSurface(c, o.get("front"), o.at("front"), true);
-      e.back = readSurface(c, o.get("back"), o.at("back"), true);
+      e.front = readSurface(c, o.get("front"), o.at("front"), kLensSurfaceTypes);
+      e.back = readSurface(c, o.get("back"), o.at("back"), kLensSurfaceTypes);
     }
     if (!o.has("centre_thickness") && !o.has("min_edge_thickness"))
       o.expected("centre_thickness", "a length > 0 (or \"min_edge_thickness\")");

@@ -7,6 +7,8 @@
 #include <fstream>
 
 #include "cad/error.h"
+#include "cad/model_generator.h"
+#include "pvrr/scene_build.h"
 #include "pvrr/scene_json.h"
 
 namespace pvrr {
@@ -86,7 +88,8 @@ void touch(const fs::path& p) {
 // Shipped scenes
 
 TEST(SceneJson, EveryShippedSceneLoadsAndValidates) {
-  for (const char* name : {"car-mirror", "plane-mirror", "concave-mirror", "spectacle-lens", "reading-lens"}) {
+  for (const char* name :
+       {"car-mirror", "plane-mirror", "concave-mirror", "spectacle-lens", "reading-lens", "progressive-lens"}) {
     const fs::path path = models() / (std::string(name) + ".json");
     ASSERT_TRUE(fs::exists(path)) << path;
     SceneDesc s;
@@ -298,9 +301,10 @@ TEST(SceneJson, ConflictingFormsAreRejected) {
   expectContains(errorOf(edited("\"centre_thickness\": 0.002,", "\"centre_thickness\": 0.002, \"prescription\": "
                                                                 "{\"sphere_d\": -3},")),
                  "elements[1].prescription: expected either \"prescription\" or \"front\" and \"back\", not both");
-  expectContains(errorOf(edited(R"({"type": "sphere", "radius": -0.07})", R"({"type": "cad", "file": "x.step"})")),
-                 "elements[1].front.type: expected one of \"plane\", \"sphere\", \"asphere\", \"toric\" or "
-                 "\"cylinder\", got \"cad\"");
+  // A lens surface may be analytic or a CAD face, not a subdivision cage.
+  expectContains(errorOf(edited(R"({"type": "sphere", "radius": -0.07})", R"({"type": "subdivision", "file": "x.obj"})")),
+                 "elements[1].front.type: expected one of \"plane\", \"sphere\", \"asphere\", \"toric\", "
+                 "\"cylinder\" or \"cad\", got \"subdivision\"");
 }
 
 TEST(SceneJson, DuplicateKeyIsRejected) {
@@ -586,6 +590,106 @@ TEST(SceneJson, LoadSceneReportsAMissingSceneFile) {
   } catch (const Error& e) {
     EXPECT_EQ(std::string(e.what()), "/nonexistent/scene.json: cannot open the scene file");
   }
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Lens surfaces from CAD files
+
+TEST(SceneJson, ProgressiveLensHasANurbsBackAndIsPlanoForDistance) {
+  const SceneDesc s = loadScene((models() / "progressive-lens.json").string());
+  const ElementDesc& l = s.elements.at(0);
+  EXPECT_EQ(l.type, ElementDesc::Type::Lens);
+  EXPECT_TRUE(l.attached_to_observer);
+  EXPECT_EQ(l.front.type, SurfaceDesc::Type::Sphere);
+  EXPECT_EQ(l.back.type, SurfaceDesc::Type::Cad);
+  EXPECT_EQ(fs::path(l.back.file), models() / "progressive-back.igs");
+  EXPECT_EQ(l.back.face, 0);
+  // Distance zone (the base sphere at the vertex): back vertex power F1 / (1 - (t/n) F1) + F2 = 0.
+  using D = cad::ProgressiveBackDesign;
+  const double n = l.lens_material.n_d, t = l.centre_thickness_m;
+  EXPECT_DOUBLE_EQ(n, D::n_d);
+  const double f1 = -(n - 1) / (D::base_radius_mm * 1e-3), f2 = (n - 1) / l.front.radius_m;
+  EXPECT_NEAR(f1 / (1 - t / n * f1) + f2, 0.0, kPowerTol_D);
+  // Built: the back is the file's NURBS surface as a sag graph in metres, its vertex at -t.
+  const Scene scene = buildScene(s);
+  const Element& e = scene.elements.at(0);
+  EXPECT_NE(e.lens.back->describe().find("progressive-back.igs face 0"), std::string::npos) << e.lens.back->describe();
+  EXPECT_EQ(e.lens.back->zVertex(), -t);
+  EXPECT_NEAR(e.lens.back->evaluate(0, 0).p.z, -t, 1e-15);
+  // Against the design, in metres, within the bicubic fit's error (0.5 um, tests/cad/lens_test.cpp).
+  EXPECT_NEAR(e.lens.back->evaluate(0.0, 0.01).p.z + t, D::z(0, 10) * 1e-3, 1e-6);
+  EXPECT_NEAR(e.lens.back->evaluate(0.012, -0.015).p.z + t, D::z(12, -15) * 1e-3, 1e-6);
+  EXPECT_GT(e.lens.minimumThickness(), 0.001);
+}
+
+// The scene kBase with its lens's back surface replaced by a CAD face, resolved against models/.
+std::string cadBackScene(const std::string& back, const std::string& front = R"({"type": "sphere", "radius": -0.07})",
+                         const std::string& thickness = "0.002") {
+  return edited(R"("front": {"type": "sphere", "radius": -0.07}, "back": {"type": "sphere", "radius": -0.12},
+     "centre_thickness": 0.002)",
+                R"("front": )" + front + R"(, "back": )" + back + R"(,
+     "centre_thickness": )" + thickness);
+}
+
+// The message of the pvrr::Error that building the scene raises.
+std::string buildErrorOf(const std::string& text, const std::string& base_dir) {
+  const SceneDesc desc = parseScene(text, kName, base_dir);
+  try {
+    buildScene(desc);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no error building the scene";
+  return "";
+}
+
+TEST(SceneJson, LensCadSurfaceIsParsedAndBuilt) {
+  const std::string text = cadBackScene(R"({"type": "cad", "file": "progressive-back.igs"})");
+  const SceneDesc s = parseScene(text, kName, models().string());
+  EXPECT_EQ(s.elements[1].back.type, SurfaceDesc::Type::Cad);
+  EXPECT_EQ(s.elements[1].back.face, 0);
+  const Scene scene = buildScene(s);
+  EXPECT_EQ(scene.elements[1].lens.back->zVertex(), -0.002);
+  // A lens surface cannot be a subdivision cage (only analytic and CAD surfaces are graphs over the lens).
+  expectContains(errorOf(cadBackScene(R"({"type": "subdivision", "file": "freeform-mirror-cage.obj"})"), {},
+                         models().string()),
+                 kName + ": elements[1].back.type: expected one of");
+}
+
+TEST(SceneJson, LensCadSurfaceErrorsNameThePathAndTheFile) {
+  const fs::path dir = tempDir("lens_cad");
+  fs::copy_file(models() / "progressive-back.igs", dir / "progressive-back.igs");
+  // Missing file: at parse time.
+  std::string m = errorOf(cadBackScene(R"({"type": "cad", "file": "nothere.igs"})"), {}, dir.string());
+  expectContains(m, kName + ": elements[1].back.file: expected an existing STEP or IGES file");
+  expectContains(m, (dir / "nothere.igs").string());
+  // A face index beyond the file's faces.
+  m = buildErrorOf(cadBackScene(R"({"type": "cad", "file": "progressive-back.igs", "face": 1})"), dir.string());
+  expectContains(m, kName + ": elements[1].back.face: ");
+  expectContains(m, (dir / "progressive-back.igs").string());
+  expectContains(m, "face 1 requested, the file has 1 face(s)");
+  // A valid STEP file without any surface (one point).
+  std::ofstream(dir / "point.step")
+      << "ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION((''),'2;1');\nFILE_NAME('point.step','2024-01-01T00:00:00',"
+         "(''),(''),'','','');\nFILE_SCHEMA(('AUTOMOTIVE_DESIGN { 1 0 10303 214 1 1 1 1 }'));\nENDSEC;\nDATA;\n"
+         "#1=CARTESIAN_POINT('',(0.,0.,0.));\nENDSEC;\nEND-ISO-10303-21;\n";
+  m = buildErrorOf(cadBackScene(R"({"type": "cad", "file": "point.step"})"), dir.string());
+  expectContains(m, kName + ": elements[1].back.file: ");
+  expectContains(m, (dir / "point.step").string());
+  // Surfaces crossing: the add raises the back towards the eye by ~0.8 mm at the bottom; 0.3 mm is too thin.
+  m = buildErrorOf(cadBackScene(R"({"type": "cad", "file": "progressive-back.igs"})",
+                                R"({"type": "sphere", "radius": -0.123668})", "0.0003"),
+                   dir.string());
+  expectContains(m, kName + ": elements[1] (l): the surfaces cross or touch inside the outline");
+  expectContains(m, "progressive-back.igs face 0");
+  // An outline reaching beyond the 56 x 46 mm blank.
+  m = buildErrorOf(edited(R"("width": 0.05, "height": 0.04)", R"("width": 0.07, "height": 0.04)",
+                          cadBackScene(R"({"type": "cad", "file": "progressive-back.igs"})")),
+                   dir.string());
+  expectContains(m, kName + ": elements[1] (l): back surface");
+  expectContains(m, "progressive-back.igs face 0");
+  expectContains(m, "is undefined at (x, y)");
+  fs::remove_all(dir);
 }
 
 }  // namespace
