@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 
 #include "cad/error.h"
@@ -19,6 +20,13 @@ void embreeError(void*, RTCError code, const char* message) {
   std::fprintf(stderr, "pvrr: Embree error %d: %s\n", int(code), message ? message : "");
 }
 
+// An environment triangle in world space, double precision, precomputed once so that resolving a candidate
+// costs no vertex gathering: vertex a, edges b - a and c - a, and the unit normal of (b - a) x (c - a).
+// 96 bytes per triangle, for about 10 % more incoherent rays per second (tests/bench/rays.cpp).
+struct EnvTriangle {
+  Vec3 a, e1, e2, n;
+};
+
 // What an Embree geometry ID stands for.
 struct GeomInfo {
   HitKind kind = HitKind::None;
@@ -26,12 +34,14 @@ struct GeomInfo {
   int surface = 0;   // element surface
   std::vector<Vec2> params;  // element tessellation: (u, v) per vertex
   std::vector<Vec3> local;   // element tessellation: local positions (to move it with the element)
+  std::vector<EnvTriangle> tris;  // environment: per triangle, in double
 };
 
-// Double-precision ray/triangle intersection (Moller-Trumbore); returns t or -1, and barycentrics.
-double intersectTriangle(const Vec3& o, const Vec3& d, const Vec3& a, const Vec3& b, const Vec3& c,
+
+// Double-precision ray/triangle intersection (Moller-Trumbore) with edges e1 = b - a, e2 = c - a; returns t
+// (or -1 for a ray parallel to the plane), and the barycentrics of b and c.
+double intersectTriangle(const Vec3& o, const Vec3& d, const Vec3& a, const Vec3& e1, const Vec3& e2,
                          double& bu, double& bv) {
-  Vec3 e1 = b - a, e2 = c - a;
   Vec3 pv = glm::cross(d, e2);
   double det = glm::dot(e1, pv);
   if (det == 0.0) return -1;
@@ -77,9 +87,16 @@ struct RayScene::Impl {
   RTCScene scene = nullptr;
   Vec3 anchor{0};  // world position subtracted before converting to float
   std::vector<GeomInfo> geoms;
-  // Element surface -> geometry ID, for single-surface queries.
+  // Element surface -> geometry ID in `scene`.
   std::vector<std::array<int, 2>> element_geoms;
+  // Element surface -> a scene holding only that surface's tessellation (the same Embree geometry as in
+  // `scene`, attached to both), for single-surface queries: one traversal of a small BVH instead of
+  // stepping through every other hit along the ray in the whole scene.
+  std::vector<std::array<RTCScene, 2>> element_scenes;
   ~Impl() {
+    for (auto& pair : element_scenes)
+      for (RTCScene s : pair)
+        if (s) rtcReleaseScene(s);
     if (scene) rtcReleaseScene(scene);
     if (device) rtcReleaseDevice(device);
   }
@@ -114,8 +131,11 @@ unsigned addTriangles(RTCDevice dev, RTCScene scn, const std::vector<glm::vec3>&
 
 RayScene::RayScene(const Scene& scene, RaySceneOptions options) : scene_(scene), impl_(std::make_unique<Impl>()) {
   Impl& im = *impl_;
-  im.device = rtcNewDevice(nullptr);
-  if (!im.device) throw Error("Embree: could not create a device (error " + std::to_string(rtcGetDeviceError(nullptr)) + ")");
+  const char* config = std::getenv("PVRR_EMBREE_CONFIG");
+  im.device = rtcNewDevice(config);
+  if (!im.device)
+    throw Error("Embree: could not create a device (error " + std::to_string(rtcGetDeviceError(nullptr)) + ")" +
+                (config ? std::string(" with PVRR_EMBREE_CONFIG=\"") + config + "\"" : std::string()));
   rtcSetDeviceErrorFunction(im.device, embreeError, nullptr);
   im.scene = rtcNewScene(im.device);
   rtcSetSceneBuildQuality(im.scene, RTC_BUILD_QUALITY_HIGH);
@@ -130,9 +150,19 @@ RayScene::RayScene(const Scene& scene, RaySceneOptions options) : scene_(scene),
     for (size_t i = 0; i < verts.size(); ++i) verts[i] = glm::vec3(Vec3(mesh.positions[i]) + shift);
     unsigned id = addTriangles(im.device, im.scene, verts, mesh.triangles);
     if (im.geoms.size() <= id) im.geoms.resize(id + 1);
-    im.geoms[id] = GeomInfo{HitKind::Environment, int(m), 0, {}, {}};
+    im.geoms[id] = GeomInfo{HitKind::Environment, int(m), 0, {}, {}, {}};
+    std::vector<EnvTriangle>& tris = im.geoms[id].tris;
+    tris.resize(mesh.triangles.size());
+    for (size_t t = 0; t < tris.size(); ++t) {
+      const glm::u32vec3 tri = mesh.triangles[t];
+      const Vec3 a = mesh.anchor + Vec3(mesh.positions[tri.x]);
+      const Vec3 b = mesh.anchor + Vec3(mesh.positions[tri.y]);
+      const Vec3 c = mesh.anchor + Vec3(mesh.positions[tri.z]);
+      tris[t] = EnvTriangle{a, b - a, c - a, glm::normalize(glm::cross(b - a, c - a))};
+    }
   }
   im.element_geoms.assign(scene.elements.size(), {-1, -1});
+  im.element_scenes.assign(scene.elements.size(), {nullptr, nullptr});
   for (size_t e = 0; e < scene.elements.size(); ++e) {
     const Element& el = scene.elements[e];
     const int nsurf = el.type == ElementType::Lens ? 2 : 1;
@@ -145,8 +175,13 @@ RayScene::RayScene(const Scene& scene, RaySceneOptions options) : scene_(scene),
       for (size_t i = 0; i < verts.size(); ++i) verts[i] = glm::vec3(el.toWorldPoint(tess.positions[i]) - im.anchor);
       unsigned id = addTriangles(im.device, im.scene, verts, tess.triangles);
       if (im.geoms.size() <= id) im.geoms.resize(id + 1);
-      im.geoms[id] = GeomInfo{HitKind::Element, int(e), s, std::move(tess.params), std::move(tess.positions)};
+      im.geoms[id] = GeomInfo{HitKind::Element, int(e), s, std::move(tess.params), std::move(tess.positions), {}};
       im.element_geoms[e][size_t(s)] = int(id);
+      RTCScene own = rtcNewScene(im.device);
+      im.element_scenes[e][size_t(s)] = own;
+      rtcSetSceneBuildQuality(own, RTC_BUILD_QUALITY_HIGH);
+      rtcAttachGeometryByID(own, rtcGetGeometry(im.scene, id), 0);
+      rtcCommitScene(own);
     }
   }
   rtcCommitScene(im.scene);
@@ -174,113 +209,195 @@ void RayScene::updateElementPoses() {
     rtcCommitGeometry(geom);
   }
   rtcCommitScene(im.scene);
+  for (auto& pair : im.element_scenes)
+    for (RTCScene s : pair)
+      if (s) rtcCommitScene(s);
+}
+
+namespace {
+
+// The float ray of one query: origin relative to the anchor, the interval widened by the float slack.
+struct FloatRay {
+  float org[3], dir[3], tnear, tfar;
+};
+
+// The float origin can be off by half an ulp of |o - anchor|; the interval is widened by that much and the
+// double-precision test decides.
+double floatSlack(const Vec3& ol) { return 4.0 * std::numeric_limits<float>::epsilon() * (glm::length(ol) + 1e-3); }
+
+FloatRay floatRay(const Vec3& o, const Vec3& d, const Vec3& anchor, double tnear, double t_max, float past) {
+  const Vec3 ol = o - anchor;
+  const double slack = floatSlack(ol);
+  FloatRay r;
+  r.org[0] = float(ol.x);
+  r.org[1] = float(ol.y);
+  r.org[2] = float(ol.z);
+  r.dir[0] = float(d.x);
+  r.dir[1] = float(d.y);
+  r.dir[2] = float(d.z);
+  r.tnear = std::max(float(std::max(0.0, tnear - slack)), past);
+  r.tfar = std::isfinite(t_max) ? float(t_max + slack) : std::numeric_limits<float>::infinity();
+  return r;
+}
+
+}  // namespace
+
+bool RayScene::resolveCandidate(const Vec3& o, const Vec3& d, double t_min, double t_max, unsigned geom_id,
+                                unsigned prim_id, float bu_f, float bv_f, float t_candidate, RayHit& hit) const {
+  const Impl& im = *impl_;
+  const GeomInfo& g = im.geoms[geom_id];
+  if (g.kind == HitKind::Environment) {
+    const EnvTriangle& et = g.tris[prim_id];
+    double bu = 0, bv = 0;
+    const double t = intersectTriangle(o, d, et.a, et.e1, et.e2, bu, bv);
+    // Float and double disagree at the interval's edge: the caller steps past this triangle.
+    if (!(t > t_min) || t >= t_max) return false;
+    hit = RayHit{};
+    hit.kind = HitKind::Environment;
+    hit.t = t;
+    hit.point = o + t * d;
+    hit.normal = et.n;
+    const EnvMesh& mesh = scene_.meshes[size_t(g.index)];
+    const glm::u32vec3 tri = mesh.triangles[prim_id];
+    const double bw = 1.0 - bu - bv;
+    hit.uv = bw * Vec2(mesh.uvs[tri.x]) + bu * Vec2(mesh.uvs[tri.y]) + bv * Vec2(mesh.uvs[tri.z]);
+    hit.mesh = g.index;
+    return true;
+  }
+  // Element candidate: interpolate the tessellation's parameters (Embree's (u, v) are the barycentrics of
+  // the triangle's vertices 1 and 2) and refine on the exact surface.
+  const RTCGeometry geom = rtcGetGeometry(im.scene, geom_id);
+  const auto* idx = static_cast<const unsigned*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_INDEX, 0));
+  const unsigned* tri = idx + 3 * size_t(prim_id);
+  const double bu = bu_f, bv = bv_f;
+  const Vec2 uv = (1.0 - bu - bv) * g.params[tri[0]] + bu * g.params[tri[1]] + bv * g.params[tri[2]];
+  hit = refineElementHit(g.index, g.surface, o, d, t_min, t_max, uv, double(t_candidate), true);
+  return hit.hit();
 }
 
 RayHit RayScene::intersect(const Vec3& o, const Vec3& d, double t_min, double t_max) const {
   const Impl& im = *impl_;
-  double tnear = t_min;
-  // After a rejected candidate the next query starts strictly beyond it (the float slack below must not
-  // bring the same triangle back).
+  // After a rejected candidate the next query starts strictly beyond it (the float slack must not bring the
+  // same triangle back).
   float past = 0.0f;
   // A candidate on an element's tessellation whose exact hit falls outside the element is skipped and the
   // ray continues; a handful of retries covers every case seen in practice.
   for (int attempt = 0; attempt < 8; ++attempt) {
+    // Default context flags: incoherent (secondary rays).
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
+    const FloatRay fr = floatRay(o, d, im.anchor, t_min, t_max, past);
     RTCRayHit rh{};
-    Vec3 ol = o - im.anchor;
-    rh.ray.org_x = float(ol.x);
-    rh.ray.org_y = float(ol.y);
-    rh.ray.org_z = float(ol.z);
-    rh.ray.dir_x = float(d.x);
-    rh.ray.dir_y = float(d.y);
-    rh.ray.dir_z = float(d.z);
-    // The float origin can be off by half an ulp of |o - anchor|; widen the interval by that much and
-    // let the double-precision refinement decide.
-    const double slack = 4.0 * std::numeric_limits<float>::epsilon() * (glm::length(ol) + 1e-3);
-    rh.ray.tnear = std::max(float(std::max(0.0, tnear - slack)), past);
-    rh.ray.tfar = std::isfinite(t_max) ? float(t_max + slack) : std::numeric_limits<float>::infinity();
+    rh.ray.org_x = fr.org[0];
+    rh.ray.org_y = fr.org[1];
+    rh.ray.org_z = fr.org[2];
+    rh.ray.dir_x = fr.dir[0];
+    rh.ray.dir_y = fr.dir[1];
+    rh.ray.dir_z = fr.dir[2];
+    rh.ray.tnear = fr.tnear;
+    rh.ray.tfar = fr.tfar;
     rh.ray.mask = ~0u;
     rh.ray.flags = 0;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(im.scene, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return RayHit{};
-
-    const GeomInfo& g = im.geoms[rh.hit.geomID];
     RayHit hit;
-    if (g.kind == HitKind::Environment) {
-      const EnvMesh& mesh = scene_.meshes[size_t(g.index)];
-      const glm::u32vec3 tri = mesh.triangles[rh.hit.primID];
-      Vec3 a = mesh.anchor + Vec3(mesh.positions[tri.x]);
-      Vec3 b = mesh.anchor + Vec3(mesh.positions[tri.y]);
-      Vec3 c = mesh.anchor + Vec3(mesh.positions[tri.z]);
-      double bu = rh.hit.u, bv = rh.hit.v;
-      double t = intersectTriangle(o, d, a, b, c, bu, bv);
-      if (!(t > tnear) || t >= t_max) {
-        // Float and double disagree at the interval's edge: step past this triangle.
-        past = std::nextafter(rh.ray.tfar, std::numeric_limits<float>::infinity());
-        continue;
-      }
-      hit.kind = HitKind::Environment;
-      hit.t = t;
-      hit.point = o + t * d;
-      hit.normal = glm::normalize(glm::cross(b - a, c - a));
-      double bw = 1.0 - bu - bv;
-      hit.uv = bw * Vec2(mesh.uvs[tri.x]) + bu * Vec2(mesh.uvs[tri.y]) + bv * Vec2(mesh.uvs[tri.z]);
-      hit.mesh = g.index;
+    if (resolveCandidate(o, d, t_min, t_max, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar, hit))
       return hit;
-    }
-    // Element candidate: interpolate the tessellation's parameters and refine on the exact surface.
-    RayHit exact = intersectElementSurface(g.index, g.surface, o, d, tnear, t_max, rh.ray.tnear);
-    if (exact.hit()) return exact;
     past = std::nextafter(rh.ray.tfar, std::numeric_limits<float>::infinity());
   }
   return RayHit{};
 }
 
+void RayScene::intersectPacket(const Vec3* o, const Vec3* d, int count, RayHit* out, double t_min,
+                               double t_max, bool coherent) const {
+  PVRR_CHECK(count >= 0 && count <= kPacketSize, << count);
+  const Impl& im = *impl_;
+  alignas(64) RTCRayHit16 rh;
+  alignas(64) int valid[kPacketSize];
+  for (int i = 0; i < kPacketSize; ++i) {
+    valid[i] = i < count ? -1 : 0;
+    // Inactive lanes still get a well-formed (empty) ray.
+    const FloatRay fr = i < count ? floatRay(o[i], d[i], im.anchor, t_min, t_max, 0.0f)
+                                  : FloatRay{{0, 0, 0}, {0, 0, 1}, 0.0f, -1.0f};
+    rh.ray.org_x[i] = fr.org[0];
+    rh.ray.org_y[i] = fr.org[1];
+    rh.ray.org_z[i] = fr.org[2];
+    rh.ray.dir_x[i] = fr.dir[0];
+    rh.ray.dir_y[i] = fr.dir[1];
+    rh.ray.dir_z[i] = fr.dir[2];
+    rh.ray.tnear[i] = fr.tnear;
+    rh.ray.tfar[i] = fr.tfar;
+    rh.ray.time[i] = 0.0f;
+    rh.ray.mask[i] = ~0u;
+    rh.ray.id[i] = unsigned(i);
+    rh.ray.flags[i] = 0;
+    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.primID[i] = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+  }
+  // Coherent rays: Embree's packet traversal is several times faster with this flag (and several times
+  // slower with it on incoherent rays; see shared/notes/platform.md).
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  ctx.flags = coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+  rtcIntersect16(valid, im.scene, &ctx, &rh);
+  for (int i = 0; i < count; ++i) {
+    if (rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) {
+      out[i] = RayHit{};
+      continue;
+    }
+    // The first candidate is resolved here exactly as intersect() resolves it; a rejected one sends the
+    // lane through the single-ray loop (which repeats this first step and goes on past the candidate).
+    if (!resolveCandidate(o[i], d[i], t_min, t_max, rh.hit.geomID[i], rh.hit.primID[i], rh.hit.u[i], rh.hit.v[i],
+                          rh.ray.tfar[i], out[i]))
+      out[i] = intersect(o[i], d[i], t_min, t_max);
+  }
+}
+
 RayHit RayScene::intersectElementSurface(int element, int surface, const Vec3& o, const Vec3& d, double t_min,
                                          double t_max, double search_from, bool within_outline) const {
   const Impl& im = *impl_;
-  const Element& el = scene_.elements[size_t(element)];
   const int gid = im.element_geoms[size_t(element)][size_t(surface)];
   if (gid < 0) return RayHit{};
-  const cad::Surface& surf = surface == 0 ? el.frontSurface() : *el.lens.back;
-  // Candidate from the tessellation of this surface alone.
+  const GeomInfo& g = im.geoms[size_t(gid)];
+  // Candidate: the nearest hit on this surface's own tessellation.
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
-  Vec3 ol = o - im.anchor;
-  const double slack = 4.0 * std::numeric_limits<float>::epsilon() * (glm::length(ol) + 1e-3);
-  // Query the whole scene but accept only this geometry: iterate over hits along the ray.
-  double tnear = search_from >= 0 ? search_from : std::max(0.0, t_min - slack);
+  const Vec3 ol = o - im.anchor;
+  const double slack = floatSlack(ol);
+  RTCRayHit rh{};
+  rh.ray.org_x = float(ol.x);
+  rh.ray.org_y = float(ol.y);
+  rh.ray.org_z = float(ol.z);
+  rh.ray.dir_x = float(d.x);
+  rh.ray.dir_y = float(d.y);
+  rh.ray.dir_z = float(d.z);
+  rh.ray.tnear = float(search_from >= 0 ? search_from : std::max(0.0, t_min - slack));
+  rh.ray.tfar = std::isfinite(t_max) ? float(t_max + slack) : std::numeric_limits<float>::infinity();
+  rh.ray.mask = ~0u;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(im.element_scenes[size_t(element)][size_t(surface)], &ctx, &rh);
   Vec2 uv{0};
-  double t = -1;
-  for (int attempt = 0; attempt < 16; ++attempt) {
-    RTCRayHit rh{};
-    rh.ray.org_x = float(ol.x);
-    rh.ray.org_y = float(ol.y);
-    rh.ray.org_z = float(ol.z);
-    rh.ray.dir_x = float(d.x);
-    rh.ray.dir_y = float(d.y);
-    rh.ray.dir_z = float(d.z);
-    rh.ray.tnear = float(tnear);
-    rh.ray.tfar = std::isfinite(t_max) ? float(t_max + slack) : std::numeric_limits<float>::infinity();
-    rh.ray.mask = ~0u;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(im.scene, &ctx, &rh);
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;  // no candidate: the direct solve below
-    if (int(rh.hit.geomID) == gid) {
-      const GeomInfo& g = im.geoms[size_t(gid)];
-      t = rh.ray.tfar;
-      // Embree's (u, v) are the barycentrics of the triangle's vertices 1 and 2.
-      RTCGeometry geom = rtcGetGeometry(im.scene, rh.hit.geomID);
-      const auto* idx = static_cast<const unsigned*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_INDEX, 0));
-      const unsigned* tri = idx + 3 * size_t(rh.hit.primID);
-      double bu = rh.hit.u, bv = rh.hit.v;
-      uv = (1.0 - bu - bv) * g.params[tri[0]] + bu * g.params[tri[1]] + bv * g.params[tri[2]];
-      break;
-    }
-    tnear = double(rh.ray.tfar) + slack;
+  double t = -1;  // no candidate: the direct solve in refineElementHit
+  if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
+    t = rh.ray.tfar;
+    // Embree's (u, v) are the barycentrics of the triangle's vertices 1 and 2.
+    const RTCGeometry geom = rtcGetGeometry(im.scene, unsigned(gid));
+    const auto* idx = static_cast<const unsigned*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_INDEX, 0));
+    const unsigned* tri = idx + 3 * size_t(rh.hit.primID);
+    const double bu = rh.hit.u, bv = rh.hit.v;
+    uv = (1.0 - bu - bv) * g.params[tri[0]] + bu * g.params[tri[1]] + bv * g.params[tri[2]];
   }
+  return refineElementHit(element, surface, o, d, t_min, t_max, uv, t, within_outline);
+}
+
+RayHit RayScene::refineElementHit(int element, int surface, const Vec3& o, const Vec3& d, double t_min,
+                                  double t_max, Vec2 uv, double t, bool within_outline) const {
+  const Element& el = scene_.elements[size_t(element)];
+  const cad::Surface& surf = surface == 0 ? el.frontSurface() : *el.lens.back;
   const Vec3 ol_local = el.toLocalPoint(o);
   const Vec3 dl = el.toLocalDir(d);
   if (t < 0) {

@@ -33,6 +33,8 @@ struct RaySceneOptions {
 
 class RayScene {
  public:
+  // The Embree device takes its configuration string from the environment variable PVRR_EMBREE_CONFIG when
+  // set (e.g. "max_isa=avx2" or "verbose=1"; Embree's rtcNewDevice syntax), for benchmarking kernels.
   explicit RayScene(const Scene& scene, RaySceneOptions options = {});
   ~RayScene();
   RayScene(const RayScene&) = delete;
@@ -40,6 +42,17 @@ class RayScene {
 
   // Nearest hit on o + t d (d unit) for t in (t_min, t_max).
   RayHit intersect(const Vec3& o, const Vec3& d, double t_min = 0, double t_max = kInf) const;
+
+  // The most rays one intersectPacket() call takes.
+  static constexpr int kPacketSize = 16;
+  // intersect() for `count` (<= kPacketSize) rays as one Embree packet: out[i] is
+  // intersect(o[i], d[i], t_min, t_max), to the last bit when Embree's packet and single-ray kernels agree
+  // on the candidate triangle. Lanes whose candidate needs more than the first query (a candidate rejected
+  // by the exact test) are finished with the single-ray code. `coherent`: the rays are coherent (e.g. the
+  // primary rays of a 4 x 4 pixel tile), which makes Embree's packet traversal several times faster; on
+  // incoherent rays the flag makes it several times slower, so pass false for those.
+  void intersectPacket(const Vec3* o, const Vec3* d, int count, RayHit* out, double t_min = 0,
+                       double t_max = kInf, bool coherent = true) const;
   // Exact intersection with one surface of one element only (e.g. a lens's back surface from inside).
   // `search_from` (>= 0) starts the candidate search on the tessellation there instead of at t_min.
   // `within_outline` false: a sag surface is intersected as its analytic extension beyond the outline
@@ -57,6 +70,14 @@ class RayScene {
 
  private:
   struct Impl;
+  // The exact hit behind Embree's candidate (geometry, primitive, barycentrics, float distance) on o + t d
+  // with t in (t_min, t_max); false when the exact test rejects the candidate.
+  bool resolveCandidate(const Vec3& o, const Vec3& d, double t_min, double t_max, unsigned geom_id,
+                        unsigned prim_id, float bu, float bv, float t_candidate, RayHit& hit) const;
+  // The exact hit on one element surface from a candidate (uv, t) on its tessellation, or (t < 0) with no
+  // candidate, by the direct solve of a sag surface.
+  RayHit refineElementHit(int element, int surface, const Vec3& o, const Vec3& d, double t_min, double t_max,
+                          Vec2 uv, double t, bool within_outline) const;
   const Scene& scene_;
   double epsilon_ = 1e-9;
   std::unique_ptr<Impl> impl_;

@@ -63,6 +63,9 @@ struct MirrorMaterial {
   bool metal = false;
   Vec3 reflectance{0.9};     // used when !metal
   Vec3 n{1.0}, k{0.0};       // conductor index per channel (R, G, B) when metal
+  // A named metal's measured table (null for a plain reflectance or an explicit per-channel conductor):
+  // the tracer's spectral mode reflects with metal_table->index(lambda) at each sample wavelength.
+  std::shared_ptr<const Metal> metal_table;
 };
 
 struct Element {

@@ -5,6 +5,7 @@
 #include <xmmintrin.h>
 #include <pmmintrin.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <mutex>
@@ -39,8 +40,13 @@ double lensIndex(const Element& el, double wavelength_nm) {
 
 }  // namespace
 
-TraceResult Tracer::trace(const Vec3& o_in, const Vec3& d_in, double wavelength_nm,
+TraceResult Tracer::trace(const Vec3& o, const Vec3& d, double wavelength_nm,
                           std::vector<PathSegment>* path) const {
+  return traceImpl(o, d, wavelength_nm, path, nullptr, false);
+}
+
+TraceResult Tracer::traceImpl(const Vec3& o_in, const Vec3& d_in, double wavelength_nm,
+                              std::vector<PathSegment>* path, const RayHit* first, bool metal_spectral) const {
   TraceResult r;
   Vec3 o = o_in, d = glm::normalize(d_in);
   Vec3 throughput(1.0);
@@ -48,7 +54,11 @@ TraceResult Tracer::trace(const Vec3& o_in, const Vec3& d_in, double wavelength_
   double t_min = 0;
   const double eps = rays_.epsilon();
   for (int depth = 0;; ++depth) {
-    RayHit hit = inside >= 0 ? RayHit{} : rays_.intersect(o, d, t_min);
+    RayHit hit;
+    if (depth == 0 && first)
+      hit = *first;
+    else if (inside < 0)
+      hit = rays_.intersect(o, d, t_min);
     if (inside >= 0) {
       // Inside a lens: the next event is on one of its own surfaces.
       RayHit back = rays_.intersectElementSurface(inside, 1, o, d, t_min);
@@ -112,8 +122,15 @@ TraceResult Tracer::trace(const Vec3& o_in, const Vec3& d_in, double wavelength_
         return r;
       }
       Vec3 refl = el.mirror.reflectance;
-      if (el.mirror.metal)
-        for (int c = 0; c < 3; ++c) refl[c] = fresnelConductor(cos_i, 1.0, el.mirror.n[c], el.mirror.k[c]);
+      if (el.mirror.metal) {
+        if (el.mirror.metal_table) r.hit_metal = true;
+        if (metal_spectral && el.mirror.metal_table) {
+          const ComplexIndex nk = el.mirror.metal_table->index(wavelength_nm > 0 ? wavelength_nm : kLineD_nm);
+          refl = Vec3(fresnelConductor(cos_i, 1.0, nk.n, nk.k));
+        } else {
+          for (int c = 0; c < 3; ++c) refl[c] = fresnelConductor(cos_i, 1.0, el.mirror.n[c], el.mirror.k[c]);
+        }
+      }
       throughput *= refl;
       seg.event = "reflect";
       if (path) path->push_back(seg);
@@ -150,32 +167,50 @@ TraceResult Tracer::trace(const Vec3& o_in, const Vec3& d_in, double wavelength_
 }
 
 TraceResult Tracer::tracePixel(double px, double py) const {
-  const Observer& ob = scene_.observer;
-  const Vec3 d = ob.pixelDirection(px, py);
+  return tracePrimary(scene_.observer.pixelDirection(px, py), nullptr, nullptr);
+}
+
+TraceResult Tracer::tracePrimary(const Vec3& d, const RayHit* first, std::array<Vec3, 3>* channel_seen) const {
+  const Vec3& eye = scene_.observer.eye;
+  // The primary hit does not depend on the wavelength: every trace below reuses `first`.
   switch (options_.dispersion) {
     case DispersionMode::Off:
-      return trace(ob.eye, d, 0);
+      return traceImpl(eye, d, 0, nullptr, first, false);
     case DispersionMode::Rgb: {
       const double* wl = kRgbWavelengths_nm;
-      TraceResult g = trace(ob.eye, d, wl[1]);
+      TraceResult g = traceImpl(eye, d, wl[1], nullptr, first, false);
       // Without any lens on the path the three channels follow the same path: skip the other two.
-      if (!g.hit_lens) return g;
-      TraceResult rr = trace(ob.eye, d, wl[0]);
-      TraceResult bb = trace(ob.eye, d, wl[2]);
+      if (!g.hit_lens) {
+        if (channel_seen) *channel_seen = {g.seen, g.seen, g.seen};
+        return g;
+      }
+      TraceResult rr = traceImpl(eye, d, wl[0], nullptr, first, false);
+      TraceResult bb = traceImpl(eye, d, wl[2], nullptr, first, false);
+      if (channel_seen) *channel_seen = {rr.seen, g.seen, bb.seen};
       g.color = Vec3(rr.color.r, g.color.g, bb.color.b);
       return g;
     }
     case DispersionMode::Spectral: {
-      TraceResult centre = trace(ob.eye, d, 0);
-      if (!centre.hit_lens) return centre;
+      TraceResult centre = traceImpl(eye, d, 0, nullptr, first, false);
+      // Only lenses (the path) and tabulated metals (the reflectance) depend on the wavelength.
+      if (!centre.hit_lens && !centre.hit_metal) return centre;
       Vec3 sum(0.0);
-      for (const SpectralSample& s : spectral_) sum += s.rgb_weight * trace(ob.eye, d, s.wavelength_nm).color;
+      for (const SpectralSample& s : spectral_)
+        sum += s.rgb_weight * traceImpl(eye, d, s.wavelength_nm, nullptr, first, true).color;
       centre.color = sum;
       return centre;
     }
   }
   return {};
 }
+
+namespace {
+
+// Primary rays are traced in square tiles of kTile x kTile pixels, one Embree packet each.
+constexpr int kTile = 4;
+static_assert(kTile * kTile == RayScene::kPacketSize, "one packet per tile");
+
+}  // namespace
 
 TracedFrame Tracer::render(const std::function<void(double)>& progress) const {
   const int w = scene_.observer.width, h = scene_.observer.height;
@@ -188,25 +223,56 @@ TracedFrame Tracer::render(const std::function<void(double)>& progress) const {
   f.element.resize(n);
   f.element_point.resize(n);
   f.bounces.resize(n);
+  const bool rgb = options_.dispersion == DispersionMode::Rgb;
+  if (rgb)
+    for (auto& c : f.channel_seen) c.resize(n);
   auto start = std::chrono::steady_clock::now();
   std::atomic<int> rows_done{0};
   std::mutex progress_mutex;
-  tbb::parallel_for(tbb::blocked_range<int>(0, h, 4), [&](const tbb::blocked_range<int>& rows) {
+  const Vec3 eye = scene_.observer.eye;
+  // Bands of kTile rows; each band is cut into kTile x kTile tiles.
+  const int bands = (h + kTile - 1) / kTile;
+  tbb::parallel_for(tbb::blocked_range<int>(0, bands, 1), [&](const tbb::blocked_range<int>& range) {
     // Denormals only slow the traversal down; flush them in every tracing thread (Embree's advice).
     _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
     _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
-    for (int y = rows.begin(); y < rows.end(); ++y) {
-      for (int x = 0; x < w; ++x) {
-        TraceResult r = tracePixel(x + 0.5, y + 0.5);
-        size_t i = size_t(y) * size_t(w) + size_t(x);
-        f.color[i] = r.color;
-        f.seen[i] = r.seen;
-        f.element[i] = r.first_element;
-        f.element_point[i] = r.element_point;
-        f.bounces[i] = r.bounces;
+    std::array<Vec3, RayScene::kPacketSize> origins, dirs, units;
+    std::array<RayHit, RayScene::kPacketSize> hits;
+    std::array<int, RayScene::kPacketSize> px, py;
+    origins.fill(eye);
+    int rows = 0;
+    for (int band = range.begin(); band < range.end(); ++band) {
+      const int y0 = band * kTile, y1 = std::min(h, y0 + kTile);
+      rows += y1 - y0;
+      for (int x0 = 0; x0 < w; x0 += kTile) {
+        const int x1 = std::min(w, x0 + kTile);
+        int count = 0;
+        for (int y = y0; y < y1; ++y)
+          for (int x = x0; x < x1; ++x) {
+            px[size_t(count)] = x;
+            py[size_t(count)] = y;
+            dirs[size_t(count)] = scene_.observer.pixelDirection(x + 0.5, y + 0.5);
+            // The direction traceImpl() will trace (it normalises), so that the hit is the same.
+            units[size_t(count)] = glm::normalize(dirs[size_t(count)]);
+            ++count;
+          }
+        if (options_.primary_packets) rays_.intersectPacket(origins.data(), units.data(), count, hits.data());
+        for (int k = 0; k < count; ++k) {
+          std::array<Vec3, 3> cs;
+          TraceResult r = tracePrimary(dirs[size_t(k)], options_.primary_packets ? &hits[size_t(k)] : nullptr,
+                                       rgb ? &cs : nullptr);
+          const size_t i = size_t(py[size_t(k)]) * size_t(w) + size_t(px[size_t(k)]);
+          f.color[i] = r.color;
+          f.seen[i] = r.seen;
+          f.element[i] = r.first_element;
+          f.element_point[i] = r.element_point;
+          f.bounces[i] = r.bounces;
+          if (rgb)
+            for (size_t c = 0; c < 3; ++c) f.channel_seen[c][i] = cs[c];
+        }
       }
     }
-    int done = rows_done.fetch_add(rows.size()) + int(rows.size());
+    int done = rows_done.fetch_add(rows) + rows;
     if (progress && progress_mutex.try_lock()) {
       progress(double(done) / h);
       progress_mutex.unlock();

@@ -8,8 +8,14 @@
 //
 // Dispersion: "off" traces one ray with each lens's index at the d line; "rgb" traces one ray per channel at
 // that channel's wavelength (pvrr/spectrum.h) and keeps that channel; "spectral" traces N wavelengths and
-// sums them with the colour-matching weights of pvrr/spectrum.h.
+// sums them with the colour-matching weights of pvrr/spectrum.h. A metal mirror with a measured table
+// (MirrorMaterial::metal_table) reflects with its per-channel (n, k) in the off and rgb modes, and in the
+// spectral mode with its conductor Fresnel reflectance at each sample's wavelength, Metal::index(lambda).
+//
+// Primary rays: render() intersects the primary rays of 4 x 4 pixel tiles as Embree packets
+// (RayScene::intersectPacket, the same exact hits as single rays); every secondary ray is a single ray.
 #pragma once
+#include <array>
 #include <functional>
 #include <string>
 #include <vector>
@@ -40,13 +46,16 @@ struct TraceResult {
   int first_element = -1;  // the first optical element the path met
   Vec3 element_point{0};   // where it met it
   int bounces = 0;         // specular events (reflections, refractions, TIRs)
-  bool hit_lens = false;   // the path crossed a lens (only then does the wavelength matter)
+  bool hit_lens = false;   // the path crossed a lens (the wavelength changes the path)
+  bool hit_metal = false;  // the path reflected off a mirror with a metal table (the wavelength changes
+                           // its spectral-mode colour, not its path)
 };
 
 struct TraceOptions {
   int max_depth = 8;
   DispersionMode dispersion = DispersionMode::Off;
   int spectral_samples = 16;
+  bool primary_packets = true;  // render(): primary rays of 4 x 4 tiles as packets (false: one ray each)
 };
 
 struct TracedFrame {
@@ -56,6 +65,9 @@ struct TracedFrame {
   std::vector<int> element;         // first element per pixel, -1 for none
   std::vector<Vec3> element_point;  // first element hit per pixel
   std::vector<int> bounces;
+  // DispersionMode::Rgb only (empty otherwise): the seen point of each channel's own ray (R = C line,
+  // G = d line, B = F line) per pixel. Equal to `seen` for all three where the path crosses no lens.
+  std::array<std::vector<Vec3>, 3> channel_seen;
   double frame_ms = 0;
 };
 
@@ -72,6 +84,15 @@ class Tracer {
   TracedFrame render(const std::function<void(double)>& progress = {}) const;
 
  private:
+  // `first`: the hit of the ray (o, d) for t > 0 when already known (a packet's lane), else null.
+  // `metal_spectral`: a metal mirror with a table reflects with its Fresnel reflectance at `wavelength_nm`
+  // in all three channels (a spectral-mode sample) instead of its per-channel (n, k).
+  TraceResult traceImpl(const Vec3& o, const Vec3& d, double wavelength_nm, std::vector<PathSegment>* path,
+                        const RayHit* first, bool metal_spectral) const;
+  // A pixel whose primary ray is `d` from the eye, honouring the dispersion mode; `channel_seen` (Rgb mode,
+  // optional) receives each channel's seen point.
+  TraceResult tracePrimary(const Vec3& d, const RayHit* first, std::array<Vec3, 3>* channel_seen) const;
+
   const RayScene& rays_;
   const Scene& scene_;
   TraceOptions options_;
