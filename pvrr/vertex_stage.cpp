@@ -6,6 +6,7 @@
 
 #include "cad/error.h"
 #include "pvrr/optics.h"
+#include "pvrr/spectrum.h"
 
 namespace pvrr {
 
@@ -17,6 +18,37 @@ const char* toString(VertexStatus s) {
   }
   return "?";
 }
+
+Vec3 channelWeight(const std::vector<ChannelSpec>& channels, size_t c) {
+  if (channels[c].rgb_weight) return *channels[c].rgb_weight;
+  if (channels.size() == 3) {
+    Vec3 w(0.0);
+    w[int(c)] = 1.0;
+    return w;
+  }
+  return Vec3(1.0);
+}
+
+std::vector<ChannelSpec> dispersionChannels(const Scene& scene, int element, const std::string& dispersion,
+                                            int spectral_samples) {
+  if (dispersion != "off" && dispersion != "rgb" && dispersion != "spectral")
+    throw Error("render.dispersion: expected one of off, rgb, spectral; got \"" + dispersion + "\"");
+  const Element& el = scene.elements.at(size_t(element));
+  if (dispersion == "off" || el.type != ElementType::Lens || !el.dispersion_on) return {ChannelSpec{}};
+  const std::vector<SpectralSample> samples =
+      dispersion == "rgb" ? rgbSamples() : spectralSamples(spectral_samples);  // throws for n < 3
+  std::vector<ChannelSpec> out;
+  for (const SpectralSample& s : samples) out.push_back(ChannelSpec{s.wavelength_nm, s.rgb_weight});
+  return out;
+}
+
+std::vector<ChannelSpec> dispersionChannels(const Scene& scene, int element) {
+  return dispersionChannels(scene, element, scene.render.dispersion, scene.render.spectral_samples);
+}
+
+// Both traceVertexRays: the incoming ray of vertex i starts at (*origins)[i], or at `eye` when null.
+static void traceVertexRaysFrom(const RayScene& rays, ElementFrame& f, const Vec3& eye,
+                                const std::vector<Vec3>* origins, const VertexStageOptions& opt);
 
 namespace {
 double msSince(std::chrono::steady_clock::time_point t0) {
@@ -42,12 +74,26 @@ ElementFrame prepareElement(const Scene& scene, int element) {
 }
 
 void traceVertexRays(const RayScene& rays, ElementFrame& f, const Vec3& eye, const VertexStageOptions& opt) {
+  traceVertexRaysFrom(rays, f, eye, nullptr, opt);
+}
+
+void traceVertexRays(const RayScene& rays, ElementFrame& f, const Vec3& eye, const std::vector<Vec3>& origins,
+                     const VertexStageOptions& opt) {
+  if (origins.size() != f.world_pos.size())
+    throw Error("traceVertexRays: " + std::to_string(origins.size()) + " ray origins for " +
+                std::to_string(f.world_pos.size()) + " vertices");
+  traceVertexRaysFrom(rays, f, eye, &origins, opt);
+}
+
+static void traceVertexRaysFrom(const RayScene& rays, ElementFrame& f, const Vec3& eye,
+                                const std::vector<Vec3>* origins, const VertexStageOptions& opt) {
   auto t0 = std::chrono::steady_clock::now();
   const Scene& scene = rays.scene();
   const Element& el = scene.elements[size_t(f.element)];
   const double eps = rays.epsilon();
   const double far = scene.render.far_distance_m;
   f.eye = eye;
+  f.channels = opt.channels;
   f.rays.assign(opt.channels.size(), std::vector<VertexRay>(f.world_pos.size()));
   for (size_t c = 0; c < opt.channels.size(); ++c) {
     const double wl = opt.channels[c].wavelength_nm > 0 ? opt.channels[c].wavelength_nm : kLineD_nm;
@@ -55,7 +101,7 @@ void traceVertexRays(const RayScene& rays, ElementFrame& f, const Vec3& eye, con
     tbb::parallel_for(size_t(0), f.world_pos.size(), [&](size_t i) {
       VertexRay& vr = f.rays[c][i];
       const Vec3 p = f.world_pos[i], n = f.world_normal[i];
-      const Vec3 d_in = glm::normalize(p - eye);
+      const Vec3 d_in = glm::normalize(p - (origins ? (*origins)[i] : eye));
       if (el.type == ElementType::Mirror) {
         vr.origin = p;
         vr.dir = reflect(d_in, n);
@@ -74,7 +120,9 @@ void traceVertexRays(const RayScene& rays, ElementFrame& f, const Vec3& eye, con
         // A rim vertex's internal ray may leave through the edge band within a fraction of a millimetre (the
         // vertex lies exactly on the rim). Continue it through the back surface's analytic extension, so the
         // rim triangles interpolate smoothly; the band where light truly leaves through the edge is then
-        // thinner than the drift, usually below a pixel.
+        // thinner than the drift, usually below a pixel. A back surface from a CAD file is a NURBS sag graph
+        // (cad::makeNurbsSag): its extension is the file's surface itself where it reaches past the outline
+        // (a lens blank), then its second-order Taylor continuation.
         if (!back.hit()) back = rays.intersectElementSurface(f.element, 1, p, in.direction, eps, kInf, -1, false);
         if (!back.hit()) {
           // The internal ray leaves through the edge band: no back point. Treated like TIR: flagged.

@@ -3,6 +3,7 @@
 // ("viewpoint-fit"), and each vertex's texture coordinates: the projection of its exact hit point through
 // that patch's virtual camera.
 #pragma once
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -42,12 +43,34 @@ struct PatchView {
   int rays_excluded = 0;  // flagged (tir / edge) rays left out of the fit
 };
 
+// One colour channel (wavelength sample) of the vertex stages. The second pass sums the channels' warped
+// maps: colour = sum_c rgb_weight_c (*) transmittance_c (*) map(st_c) ((*): per RGB component).
 struct ChannelSpec {
   double wavelength_nm = 0;  // <= 0: the d line
+  // Unset: channel c of three is RGB channel c (unit weight, RGB mode); a single channel has (1, 1, 1).
+  std::optional<Vec3> rgb_weight;
+  ChannelSpec() = default;
+  ChannelSpec(double wavelength, std::optional<Vec3> weight = std::nullopt)
+      : wavelength_nm(wavelength), rgb_weight(weight) {}
 };
 
+// The colour weight of channel c of `channels` (ChannelSpec::rgb_weight, or its default).
+Vec3 channelWeight(const std::vector<ChannelSpec>& channels, size_t c);
+
+// THE choice of colour channels for one element, used by every raster path and report: one channel at the
+// d line with weight (1, 1, 1) for a mirror, for a lens whose material disperses not ("dispersion": false)
+// and when `dispersion` is "off"; "rgb": the three channels of spectrum.h's RGB mode (C, d, F lines, unit
+// weights); "spectral": the `spectral_samples` samples of spectrum.h's spectral mode with their weights,
+// the same the tracer's spectral mode sums. Throws pvrr::Error for another `dispersion` or too few samples.
+std::vector<ChannelSpec> dispersionChannels(const Scene& scene, int element, const std::string& dispersion,
+                                            int spectral_samples);
+// The same with the scene's own settings (RenderSettings::dispersion and spectral_samples).
+std::vector<ChannelSpec> dispersionChannels(const Scene& scene, int element);
+
 struct VertexStageOptions {
-  std::vector<ChannelSpec> channels{ChannelSpec{}};  // 1 (no dispersion) or 3 (R, G, B)
+  // 1 (no dispersion), 3 (R, G, B) or N spectral samples. The renderer (pvrr/gl/renderer.h) chooses per
+  // element with dispersionChannels() when this is empty.
+  std::vector<ChannelSpec> channels{ChannelSpec{}};
   // Per frame the fit stops at a relative cost decrease of 1e-6: every vertex is exact whatever the
   // viewpoint, which only shapes the interpolation between vertices (docs/method.md), and the extra
   // iterations to 1e-12 changed no error figure measurably (docs/performance.md).
@@ -65,6 +88,7 @@ struct ElementFrame {
   Vec3 eye{0};
   cad::Tessellation grid;                   // local coordinates (from cad)
   std::vector<Vec3> world_pos, world_normal;
+  std::vector<ChannelSpec> channels;         // the channels the rays were traced for
   std::vector<std::vector<VertexRay>> rays;  // [channel][vertex]
   std::vector<cad::GridPatch> grid_patches;
   std::vector<PatchView> views;              // one per patch
@@ -77,6 +101,11 @@ struct ElementFrame {
 ElementFrame prepareElement(const Scene& scene, int element);
 // Stage "vertex-rays": traces every vertex's ray for every channel from `eye`.
 void traceVertexRays(const RayScene& rays, ElementFrame& f, const Vec3& eye, const VertexStageOptions& opt);
+// The same with one incoming-ray origin per vertex (multiple reflection: an element seen inside another's
+// map, each vertex lit along the ray that really reaches it from the outer element's surface); `eye` is
+// recorded as ElementFrame::eye. Throws pvrr::Error unless there is one origin per vertex.
+void traceVertexRays(const RayScene& rays, ElementFrame& f, const Vec3& eye, const std::vector<Vec3>& origins,
+                     const VertexStageOptions& opt);
 // Stage "viewpoint-fit": patches (split automatically if the element asks), viewpoints, view volumes and
 // texture coordinates. Throws nothing for degenerate input: each fit reports its condition and fallback.
 void fitPatchViews(const Scene& scene, ElementFrame& f, const VertexStageOptions& opt);

@@ -1,17 +1,23 @@
 #version 330 core
 // Optical elements. Variants by prepended defines:
-//   MODE_PVRR    the warped first-pass map (paper 3.4); CHANNELS 3 reads one map coordinate per colour
+//   MODE_PVRR    the warped first-pass map (paper 3.4). CHANNELS 1: one texture-coordinate set; CHANNELS 3:
+//                three sets (RGB dispersion, or three samples of a spectral set), colour = sum_i w_i * map(st_i).
+//                More than three channels: one additive draw per set of three (pvrr/gl/renderer.cpp).
 //   MODE_ENVMAP  the classic dynamic cube map from the element centre (lens: looked up along the
 //                interpolated exact exit directions of the vertices, the 'refraction vectors' baseline)
-//   MODE_PLAIN   a plain grey shaded surface (raster mode)
+//   MODE_PLAIN   a plain grey shaded surface (raster mode); u_dark: black, an element met at the depth limit
+//                inside another element's map (the tracer absorbs there)
 //   LENS         the element is a lens (transmission) rather than a mirror (reflection)
 in vec3 v_pos;
 in vec3 v_normal;
 in vec3 v_st0;
 in vec3 v_st1;
 in vec3 v_st2;
-in vec3 v_trans;
-uniform vec3 u_view_origin;
+in vec3 v_w0;
+in vec3 v_w1;
+in vec3 v_w2;
+in vec3 v_st_seen;
+uniform vec3 u_view_origin;      // where the viewing rays start, relative to the camera origin
 uniform float u_element_id;      // index + 1
 uniform bool u_metal;
 uniform vec3 u_reflectance;
@@ -24,6 +30,8 @@ uniform sampler2D u_seen_map;    // first pass seen points, relative to the map'
 #elif defined(MODE_ENVMAP)
 uniform samplerCube u_cube;
 uniform samplerCube u_seen_cube;
+#elif defined(MODE_PLAIN)
+uniform bool u_dark;
 #endif
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out vec4 o_seen;
@@ -49,13 +57,11 @@ void main() {
   o_surface = vec4(v_pos, u_element_id);
 #if defined(MODE_PLAIN)
   vec3 nf = cos_i < 0.0 ? -n : n;
-  o_color = vec4(shadeDiffuse(vec3(0.6), v_pos, nf), 1.0);
+  o_color = u_dark ? vec4(0.0, 0.0, 0.0, 1.0) : vec4(shadeDiffuse(vec3(0.6), v_pos, nf), 1.0);
   o_seen = vec4(v_pos, 1.0);
 #else
-  vec3 weight;
-#if defined(LENS)
-  weight = v_trans;
-#else
+  vec3 weight = vec3(1.0);
+#if !defined(LENS)
   if (cos_i <= 0.0) {  // the mirror's back: dark (tracer: kMirrorBackAlbedo)
     o_color = vec4(0.05 * shadeDiffuse(vec3(1.0), v_pos, -n), 1.0);
     o_seen = vec4(v_pos, 1.0);
@@ -67,17 +73,15 @@ void main() {
                   fresnelConductor(cos_i, u_metal_n.b, u_metal_k.b));
 #endif
 #if defined(MODE_PVRR)
+  vec3 c = v_w0 * texture(u_map, v_st0.xy / v_st0.z).rgb;
 #if CHANNELS == 3
-  vec3 c = vec3(texture(u_map, v_st0.xy / v_st0.z).r, texture(u_map, v_st1.xy / v_st1.z).g,
-                texture(u_map, v_st2.xy / v_st2.z).b);
-  vec4 seen = texture(u_seen_map, v_st1.xy / v_st1.z);
-#else
-  vec3 c = texture(u_map, v_st0.xy / v_st0.z).rgb;
-  vec4 seen = texture(u_seen_map, v_st0.xy / v_st0.z);
+  c += v_w1 * texture(u_map, v_st1.xy / v_st1.z).rgb + v_w2 * texture(u_map, v_st2.xy / v_st2.z).rgb;
 #endif
+  vec4 seen = texture(u_seen_map, v_st_seen.xy / v_st_seen.z);
 #else
 #if defined(LENS)
   vec3 dir = normalize(v_st0);  // the exact exit direction at the vertices, interpolated
+  weight = v_w0;
 #else
   vec3 dir = reflect(view, n);
 #endif

@@ -10,6 +10,7 @@
 #include "pvrr/gl/gl.h"
 #include "pvrr/gl/framebuffer.h"
 #include "pvrr/gl/program.h"
+#include "pvrr/spectrum.h"
 
 namespace pvrr::gl {
 
@@ -161,6 +162,43 @@ Program makeProgram(const std::string& vert, const std::string& frag, const std:
                               defines);
 }
 
+// The element vertex layout (shaders/element.vert): position, normal, three texture-coordinate sets, three
+// weights, the seen point's texture coordinates.
+const std::vector<int> kElementLayout = {3, 3, 3, 3, 3, 3, 3, 3, 3};
+constexpr size_t kElementFloats = 27;
+
+// At most this many first passes per frame (top-level and nested): each holds a map_size^2 colour, seen-point
+// and depth target. Elements that would need more are drawn dark in their map, and the stats say so.
+constexpr size_t kMaxFirstPasses = 16;
+
+// A camera of one pass (the second pass, or a first pass from a virtual viewpoint): positions are relative
+// to `origin`.
+struct PassCamera {
+  Vec3 origin{0};
+  Mat4 view_proj{1.0};   // relativeViewProj: acts on positions relative to origin
+  Vec3 rays_from{0};     // where the viewing rays start, relative to origin (0: the camera itself)
+  bool reversed_depth = false;
+};
+
+// Whether any part of the convex hull of `points` can be inside the view volume: false only when every
+// point lies outside one and the same clip plane (homogeneous outcodes; exact for a convex hull).
+bool mayBeInVolume(const std::vector<Vec3>& points, const Mat4& m) {
+  unsigned all = 0x3f;
+  for (const Vec3& p : points) {
+    const Vec4 c = m * Vec4(p, 1.0);
+    unsigned code = 0;
+    if (c.x < -c.w) code |= 1;
+    if (c.x > c.w) code |= 2;
+    if (c.y < -c.w) code |= 4;
+    if (c.y > c.w) code |= 8;
+    if (c.z < -c.w) code |= 16;
+    if (c.z > c.w) code |= 32;
+    all &= code;
+    if (!all) return true;
+  }
+  return all == 0;
+}
+
 // Cube-map faces in GL order (+X, -X, +Y, -Y, +Z, -Z): view direction and up vector.
 const Vec3 kCubeDir[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
 const Vec3 kCubeUp[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
@@ -289,44 +327,56 @@ struct Renderer::Impl {
     p.set("u_metal_k", glm::vec3(el.mirror.k));
   }
 
-  // Whole-element mesh (plain and envmap modes): position relative to the element's origin, normal; for an
-  // envmap lens the exact exit direction of each vertex's ray in the first coordinate slot and its Fresnel
-  // transmittance (the "refraction vectors" baseline).
+  // Whole-element mesh (plain and envmap modes, and elements drawn dark at the depth limit): position
+  // relative to the element's origin, normal; for an envmap lens the exact exit direction of each vertex's
+  // ray in a_st0 and its Fresnel transmittance in a_w0 (the "refraction vectors" baseline).
   void uploadElementGrid(MeshBuffers& mb, const ElementFrame& f, const Vec3& anchor) {
     std::vector<float> data;
+    data.reserve(f.world_pos.size() * kElementFloats);
     const bool has_rays = !f.rays.empty();
     for (size_t i = 0; i < f.world_pos.size(); ++i) {
       glm::vec3 p(f.world_pos[i] - anchor), n(f.world_normal[i]);
       const glm::vec3 d = has_rays ? glm::vec3(f.rays[0][i].dir) : glm::vec3(0, 0, 1);
       const glm::vec3 tr = has_rays ? glm::vec3(f.rays[0][i].transmittance) : glm::vec3(1);
-      data.insert(data.end(), {p.x, p.y, p.z, n.x, n.y, n.z, d.x, d.y, d.z, 0, 0, 1, 0, 0, 1, tr.x, tr.y, tr.z});
+      data.insert(data.end(), {p.x, p.y, p.z, n.x, n.y, n.z, d.x, d.y, d.z, 0, 0, 1, 0, 0, 1, tr.x, tr.y, tr.z,
+                               0, 0, 0, 0, 0, 0, 0, 0, 1});
     }
     std::vector<uint32_t> idx;
     for (const auto& t : f.grid.triangles) idx.insert(idx.end(), {t.x, t.y, t.z});
-    uploadMesh(mb, data, {3, 3, 3, 3, 3, 3}, idx);
+    uploadMesh(mb, data, kElementLayout, idx);
   }
 
-  void uploadPatch(MeshBuffers& mb, const ElementFrame& f, const PatchView& pv, const Vec3& anchor) {
+  // One patch of a PVRR element for one set of (up to) three channels, `set` = 0, 1, ...: the projective
+  // texture coordinates of channels 3 set + j, their weights (colour weight * transmittance, 0 for the
+  // padding of the last set), and the coordinates of channel `seen_channel` for the seen point.
+  void uploadPatch(MeshBuffers& mb, const ElementFrame& f, const PatchView& pv, const Vec3& anchor, size_t set,
+                   size_t seen_channel) {
     const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
     const size_t channels = pv.st.size();
     std::vector<float> data;
-    data.reserve(gp.vertices.size() * 18);
+    data.reserve(gp.vertices.size() * kElementFloats);
+    Vec3 weight[3];
+    for (size_t j = 0; j < 3; ++j)
+      weight[j] = 3 * set + j < channels ? channelWeight(f.channels, 3 * set + j) : Vec3(0.0);
     for (size_t k = 0; k < gp.vertices.size(); ++k) {
       const uint32_t vi = gp.vertices[k];
       glm::vec3 p(f.world_pos[vi] - anchor), n(f.world_normal[vi]);
       data.insert(data.end(), {p.x, p.y, p.z, n.x, n.y, n.z});
       const double q = pv.q[k];
-      for (size_t c = 0; c < 3; ++c) {
-        const Vec2 st = pv.st[std::min(c, channels - 1)][k];
+      for (size_t j = 0; j < 3; ++j) {
+        const Vec2 st = pv.st[std::min(3 * set + j, channels - 1)][k];
         data.insert(data.end(), {float(st.x * q), float(st.y * q), float(q)});
       }
-      Vec3 tr(1.0);
-      for (size_t c = 0; c < 3; ++c) tr[int(c)] = f.rays[std::min(c, channels - 1)][vi].transmittance[int(c)];
-      data.insert(data.end(), {float(tr.x), float(tr.y), float(tr.z)});
+      for (size_t j = 0; j < 3; ++j) {
+        const Vec3 w = weight[j] * f.rays[std::min(3 * set + j, channels - 1)][vi].transmittance;
+        data.insert(data.end(), {float(w.x), float(w.y), float(w.z)});
+      }
+      const Vec2 st = pv.st[seen_channel][k];
+      data.insert(data.end(), {float(st.x * q), float(st.y * q), float(q)});
     }
     std::vector<uint32_t> idx;
     for (const auto& t : gp.triangles) idx.insert(idx.end(), {t.x, t.y, t.z});
-    uploadMesh(mb, data, {3, 3, 3, 3, 3, 3}, idx);
+    uploadMesh(mb, data, kElementLayout, idx);
   }
 
   Framebuffer& mapTarget(size_t i) {
@@ -346,6 +396,238 @@ struct Renderer::Impl {
     return *maps[i];
   }
 
+  // --- multiple reflection (recursive PVRR with an explicit work list) ---
+
+  // An element drawn inside a first pass besides the environment: with its own PVRR maps (its vertex rays
+  // start from that pass's viewpoint), or dark where the tracer reaches its depth limit.
+  struct NestedDraw {
+    int element = -1;
+    const ElementFrame* frame = nullptr;  // null: drawn dark
+    size_t first_slot = 0;                // map slot of frame->views[0]; views[v] uses first_slot + v
+  };
+  // One first pass: the map of one patch view.
+  struct MapPass {
+    const ElementFrame* owner = nullptr;
+    size_t view = 0;
+    int depth = 0;     // the tracer's depth (events before) of what this map shows: 1 behind a mirror seen
+                       // from the eye, 2 behind a lens (two interfaces)
+    size_t slot = 0;   // index into `maps`
+    bool visible = true;  // false: a top-level element the observer cannot see; its map is left as it is
+    std::vector<NestedDraw> nested;
+  };
+  std::vector<MapPass> passes;                            // this frame's first passes, parents before children
+  std::vector<std::unique_ptr<ElementFrame>> nested_frames;  // elements as seen from virtual viewpoints
+  size_t next_mesh = 0;
+
+  static int interfaces(const Element& el) { return el.type == ElementType::Lens ? 2 : 1; }
+
+  VertexStageOptions optionsFor(size_t e) const {
+    VertexStageOptions o = options.vertex;
+    if (o.channels.empty()) o.channels = dispersionChannels(scene, int(e));
+    return o;
+  }
+
+  MeshBuffers& meshSlot() {
+    if (element_meshes.size() <= next_mesh) element_meshes.resize(next_mesh + 1);
+    return element_meshes[next_mesh++];
+  }
+
+  // Where the light that reaches each of `points` through the owner's patch leaves the owner (beyond the
+  // paper, which starts the nested rays at the outer virtual viewpoint and so inherits its fit residual):
+  // the outgoing-ray origins of the owner's vertices (mirror points, lens back points), interpolated at the
+  // point's position in the patch's map with the barycentric coordinates, in texture space, of the owner
+  // triangle that holds it there. A point outside the patch's image extrapolates from the nearest
+  // triangle, up to half a triangle; beyond that (or behind the map camera) it uses the viewpoint itself.
+  static std::vector<Vec3> rayOrigins(const ElementFrame& owner, const PatchView& pv, const std::vector<Vec3>& points) {
+    const cad::GridPatch& gp = owner.grid_patches[size_t(pv.patch)];
+    const size_t fc = owner.rays.size() / 2;
+    const std::vector<Vec2>& st = pv.st[fc];
+    std::vector<Vec3> out(points.size(), pv.volume.eye);
+    for (size_t i = 0; i < points.size(); ++i) {
+      const Vec2 p = projectToTexture(pv.volume, points[i]);
+      if (!std::isfinite(p.x) || !std::isfinite(p.y)) continue;
+      double best = -kInf, l[3] = {0, 0, 0};
+      const cad::Triangle* best_tri = nullptr;
+      for (const cad::Triangle& t : gp.triangles) {
+        const Vec2 a = st[t.x], e1 = st[t.y] - a, e2 = st[t.z] - a, r = p - a;
+        const double den = e1.x * e2.y - e2.x * e1.y;
+        if (!(std::abs(den) > 0)) continue;
+        const double l1 = (r.x * e2.y - e2.x * r.y) / den, l2 = (e1.x * r.y - r.x * e1.y) / den, l0 = 1 - l1 - l2;
+        const double m = std::min(l0, std::min(l1, l2));
+        if (m > best) {
+          best = m;
+          l[0] = l0;
+          l[1] = l1;
+          l[2] = l2;
+          best_tri = &t;
+          if (m >= 0) break;
+        }
+      }
+      if (!best_tri || best < -0.5) continue;
+      const auto origin = [&](uint32_t k) { return owner.rays[fc][gp.vertices[k]].origin; };
+      out[i] = l[0] * origin(best_tri->x) + l[1] * origin(best_tri->y) + l[2] * origin(best_tri->z);
+    }
+    return out;
+  }
+
+  // Plans this frame's first passes: the top-level patch views of `frames` (slots 0..), then, breadth
+  // first, for every pass the other elements inside its view volume, each traced and fitted from the pass's
+  // viewpoint with its own maps appended to the list, down to the scene's depth limit. Children always
+  // follow their parent, so rendering the list backwards renders every map before the pass that reads it.
+  // Returns the number of nested passes; `dark` counts elements drawn dark at the depth limit or budget.
+  size_t planPasses(const std::vector<ElementFrame>& frames, const std::vector<VertexStageOptions>& opts,
+                    size_t* dark, bool* budget_hit) {
+    passes.clear();
+    nested_frames.clear();
+    *dark = 0;
+    *budget_hit = false;
+    size_t slot = 0;
+    for (const ElementFrame& f : frames)
+      for (size_t v = 0; v < f.views.size(); ++v)
+        passes.push_back({&f, v, interfaces(scene.elements[size_t(f.element)]), slot++, true, {}});
+    const size_t top = passes.size();
+    // A top-level element outside the observer's view needs no map (its second-pass triangles are clipped).
+    const Observer& ob = scene.observer;
+    const Mat4 eye_clip = ob.projection(1e-3, 1e6) * ob.view();
+    for (MapPass& mp : passes) mp.visible = mayBeInVolume(mp.owner->world_pos, eye_clip);
+    const int max_depth = scene.render.max_depth;
+    for (size_t i = 0; i < passes.size(); ++i) {
+      if (!passes[i].visible) continue;
+      const ElementFrame& owner = *passes[i].owner;
+      const PatchView& pv = owner.views[passes[i].view];
+      const int depth = passes[i].depth;
+      for (size_t b = 0; b < frames.size(); ++b) {
+        if (int(b) == owner.element || !mayBeInVolume(frames[b].world_pos, pv.volume.projection * pv.volume.view)) continue;
+        const Element& el = scene.elements[b];
+        const size_t views_needed = size_t(std::max(1, el.patches_u * el.patches_v));
+        if (depth >= max_depth || passes.size() + views_needed > kMaxFirstPasses) {
+          *budget_hit = *budget_hit || depth < max_depth;
+          ++*dark;
+          passes[i].nested.push_back({int(b), nullptr, 0});
+          continue;
+        }
+        // The element as the owner's patch sees it: the geometry is the top-level frame's; each vertex's
+        // incoming ray comes from where the owner's rays that reach it leave the owner (rayOrigins), and
+        // the fit gives its own viewpoints and maps.
+        auto nf = std::make_unique<ElementFrame>();
+        nf->element = int(b);
+        nf->grid = frames[b].grid;
+        nf->world_pos = frames[b].world_pos;
+        nf->world_normal = frames[b].world_normal;
+        nf->patches_u = el.patches_u;
+        nf->patches_v = el.patches_v;
+        traceVertexRays(rays, *nf, pv.volume.eye, rayOrigins(owner, pv, nf->world_pos), opts[b]);
+        fitPatchViews(scene, *nf, opts[b]);
+        if (passes.size() + nf->views.size() > kMaxFirstPasses) {  // an automatic split needed more maps
+          *budget_hit = true;
+          ++*dark;
+          passes[i].nested.push_back({int(b), nullptr, 0});
+          continue;
+        }
+        const size_t first = slot;
+        for (size_t v = 0; v < nf->views.size(); ++v)
+          passes.push_back({nf.get(), v, depth + interfaces(el), slot++, true, {}});
+        passes[i].nested.push_back({int(b), nf.get(), first});
+        nested_frames.push_back(std::move(nf));
+      }
+    }
+    return passes.size() - top;
+  }
+
+  // Draws one element with its PVRR maps into the bound target, as seen by `cam`. More than three channels
+  // (spectral): one draw per set of three, added into colour attachment 0 only (same vertices, depth test
+  // LEQUAL); the seen point and the surface attachments come from the first draw.
+  void drawPvrrElement(const ElementFrame& f, size_t first_slot, const PassCamera& cam, int seen_channel) {
+    const Element& el = scene.elements[size_t(f.element)];
+    const Vec3 anchor = Vec3(el.local_to_world[3]);
+    const bool lens = el.type == ElementType::Lens;
+    const size_t channels = f.rays.size();
+    const Program& p = lens ? (channels > 1 ? lens3_program : lens_program) : (channels > 1 ? pvrr3_program : pvrr_program);
+    p.use();
+    p.set("u_view_proj", toFloat(cam.view_proj));
+    p.set("u_offset", glm::vec3(anchor - cam.origin));
+    p.set("u_view_origin", glm::vec3(cam.rays_from));
+    p.set("u_map", 0);
+    p.set("u_seen_map", 1);
+    setLights(p, cam.origin);
+    setElementMaterial(p, el, f.element);
+    const size_t seen_c = seen_channel < 0 ? channels / 2 : std::min(size_t(seen_channel), channels - 1);
+    const size_t sets = channels > 1 ? (channels + 2) / 3 : 1;
+    for (size_t v = 0; v < f.views.size(); ++v) {
+      const PatchView& pv = f.views[v];
+      const Framebuffer& map = *maps[first_slot + v];
+      glActiveTexture(GL_TEXTURE0);
+      glBindTexture(GL_TEXTURE_2D, map.colorTexture(0));
+      glActiveTexture(GL_TEXTURE1);
+      glBindTexture(GL_TEXTURE_2D, map.colorTexture(1));
+      p.set("u_seen_offset", glm::vec3(pv.volume.eye - cam.origin));
+      for (size_t set = 0; set < sets; ++set) {
+        MeshBuffers& mb = meshSlot();
+        uploadPatch(mb, f, pv, anchor, set, seen_c);
+        if (set == 1) {
+          glEnablei(GL_BLEND, 0);
+          glBlendFunc(GL_ONE, GL_ONE);
+          glColorMaski(1, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+          glColorMaski(2, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+          glDepthFunc(cam.reversed_depth ? GL_GEQUAL : GL_LEQUAL);
+          glDepthMask(GL_FALSE);
+        }
+        draw(mb);
+      }
+      if (sets > 1) {
+        glDisablei(GL_BLEND, 0);
+        glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+        glColorMaski(2, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+        glDepthFunc(cam.reversed_depth ? GL_GREATER : GL_LESS);
+        glDepthMask(GL_TRUE);
+      }
+    }
+    glActiveTexture(GL_TEXTURE0);
+  }
+
+  // An element met at the depth limit: black, its seen point its own surface (the tracer's "absorb").
+  void drawDarkElement(const ElementFrame& f, const PassCamera& cam) {
+    const Element& el = scene.elements[size_t(f.element)];
+    const Vec3 anchor = Vec3(el.local_to_world[3]);
+    plain_program.use();
+    plain_program.set("u_view_proj", toFloat(cam.view_proj));
+    plain_program.set("u_offset", glm::vec3(anchor - cam.origin));
+    plain_program.set("u_view_origin", glm::vec3(cam.rays_from));
+    plain_program.set("u_dark", 1);
+    setLights(plain_program, cam.origin);
+    setElementMaterial(plain_program, el, f.element);
+    MeshBuffers& mb = meshSlot();
+    uploadElementGrid(mb, f, anchor);
+    draw(mb);
+  }
+
+  // Renders the planned first passes, deepest first.
+  void renderPasses(const std::vector<ElementFrame>& frames) {
+    for (size_t i = passes.size(); i-- > 0;) {
+      const MapPass& mp = passes[i];
+      const PatchView& pv = mp.owner->views[mp.view];
+      const Framebuffer& t = mapTarget(mp.slot);
+      if (!mp.visible) continue;
+      t.bind();
+      t.clear({0, 0, 0, 0}, pv.volume.backward ? 0.0f : 1.0f);
+      // In a reversed (zooming) map the rays come from the mirror, not from the viewpoint.
+      const Vec3 element_centre = Vec3(scene.elements[size_t(mp.owner->element)].local_to_world[3]);
+      drawEnvironment(pv.volume.view, pv.volume.projection, pv.volume.eye, pv.volume.backward,
+                      pv.volume.backward ? &element_centre : nullptr);
+      PassCamera cam;
+      cam.origin = pv.volume.eye;
+      cam.view_proj = relativeViewProj(pv.volume.projection, pv.volume.view, pv.volume.eye);
+      cam.rays_from = pv.volume.backward ? element_centre - pv.volume.eye : Vec3(0.0);
+      cam.reversed_depth = pv.volume.backward;
+      for (const NestedDraw& nd : mp.nested) {
+        t.bind();
+        if (nd.frame) drawPvrrElement(*nd.frame, nd.first_slot, cam, -1);
+        else drawDarkElement(frames[size_t(nd.element)], cam);
+      }
+    }
+    glDepthFunc(GL_LESS);
+  }
+
   RasterFrame render(RasterMode mode, FrameCache* cache);
 };
 
@@ -363,14 +645,16 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   out.height = ob.height;
   const bool has_lens = std::any_of(scene.elements.begin(), scene.elements.end(),
                                     [](const Element& e) { return e.type == ElementType::Lens; });
-  const size_t channels = options.vertex.channels.size();
   const size_t n_el = scene.elements.size();
+  next_mesh = 0;
 
   // --- CPU stages (pvrr mode) ---
   std::vector<ElementFrame> frames;
+  std::vector<VertexStageOptions> opts;
   bool skip_first_pass = false;
   if (mode == RasterMode::Pvrr && n_el > 0) {
     frames.resize(n_el);
+    for (size_t e = 0; e < n_el; ++e) opts.push_back(optionsFor(e));
     // Eye-fixed caching (paper 5): an element whose pose relative to the eye is unchanged keeps its rays
     // (in the eye's frame) and its fitted viewpoints; only the scene intersections and texture coordinates
     // are redone, after moving the cached frame rigidly with the eye.
@@ -384,6 +668,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     std::vector<bool> reuse(n_el, false);
     for (size_t e = 0; e < n_el; ++e)
       reuse[e] = cache && cache->valid && cache->elements.size() == n_el &&
+                 cache->elements[e].rays.size() == opts[e].channels.size() &&
                  same(cache->element_to_eye[e], view * scene.elements[e].local_to_world);
     const bool all_reused = std::all_of(reuse.begin(), reuse.end(), [](bool b) { return b; });
     const bool nothing_moved = all_reused && same(motion, Mat4(1.0)) && !cache->environment_changed;
@@ -403,7 +688,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
         continue;
       }
       frames[e] = prepareElement(scene, int(e));
-      traceVertexRays(rays, frames[e], ob.eye, options.vertex);
+      traceVertexRays(rays, frames[e], ob.eye, opts[e]);
       if (scene.elements[e].type == ElementType::Lens) refraction_ms += frames[e].rays_ms;
     }
     const double cpu_ms = msSince(t0);
@@ -414,14 +699,30 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     else out.stages.ran("refraction", refraction_ms);
     t0 = Clock::now();
     for (size_t e = 0; e < n_el; ++e)
-      if (!reuse[e]) fitPatchViews(scene, frames[e], options.vertex);
+      if (!reuse[e]) fitPatchViews(scene, frames[e], opts[e]);
     if (all_reused) out.stages.skipped("viewpoint-fit", cached);
     else out.stages.ran("viewpoint-fit", msSince(t0));
     if (any_texcoords) out.stages.ran("texture-coordinates", texcoord_ms);
     else out.stages.skipped("texture-coordinates", nothing_moved ? "nothing moved since the last frame"
                                                                  : "computed with the viewpoint fit");
-    if (channels > 1) out.stages.ran("colour-channels", 0);
-    else out.stages.skipped("colour-channels", has_lens ? "dispersion off: one colour pass" : "no lens: one colour pass");
+    size_t most_channels = 1;
+    bool spectral = false;
+    for (const ElementFrame& f : frames) {
+      most_channels = std::max(most_channels, f.rays.size());
+      const bool rgb = f.channels.size() == 3 && f.channels[0].wavelength_nm == kRgbWavelengths_nm[0] &&
+                       f.channels[1].wavelength_nm == kRgbWavelengths_nm[1] &&
+                       f.channels[2].wavelength_nm == kRgbWavelengths_nm[2];
+      spectral = spectral || (f.channels.size() > 1 && !rgb);
+    }
+    if (most_channels > 1) {
+      const size_t sets = (most_channels + 2) / 3;
+      out.stages.ran("colour-channels", 0, int(most_channels),
+                     std::to_string(most_channels) + (spectral ? " spectral samples" : " RGB channels (C, d, F lines)") +
+                         " from one shared first pass, in " + std::to_string(sets) +
+                         (sets == 1 ? " draw" : " additive draws") + " per patch");
+    } else {
+      out.stages.skipped("colour-channels", has_lens ? "dispersion off: one colour pass" : "no lens: one colour pass");
+    }
     skip_first_pass = nothing_moved;
     if (cache) {
       cache->element_to_eye.resize(n_el);
@@ -440,26 +741,51 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     out.stages.skipped("colour-channels", why);
   }
 
-  // --- first pass ---
+  // --- first pass (and the nested passes of elements seen in other elements' maps) ---
   auto t0 = Clock::now();
-  std::vector<size_t> map_index_of_view;
-  if (mode == RasterMode::Pvrr && !frames.empty() && skip_first_pass) {
-    out.stages.skipped("first-pass", "eye-fixed cache: neither the elements nor the environment moved relative to the eye");
-  } else if (mode == RasterMode::Pvrr && !frames.empty()) {
-    size_t next = 0;
-    for (ElementFrame& f : frames) {
-      // In a reversed (zooming) map the rays come from the mirror, not from the viewpoint.
-      const Vec3 element_centre = Vec3(scene.elements[size_t(f.element)].local_to_world[3]);
-      for (PatchView& pv : f.views) {
-        const Framebuffer& t = mapTarget(next++);
-        t.bind();
-        t.clear({0, 0, 0, 0}, pv.volume.backward ? 0.0f : 1.0f);
-        drawEnvironment(pv.volume.view, pv.volume.projection, pv.volume.eye, pv.volume.backward,
-                        pv.volume.backward ? &element_centre : nullptr);
-      }
+  std::vector<size_t> top_slot(n_el, 0);  // map slot of frames[e].views[0] (pvrr mode)
+  {
+    size_t slot = 0;
+    for (size_t e = 0; e < frames.size(); ++e) {
+      top_slot[e] = slot;
+      slot += frames[e].views.size();
     }
+  }
+  if (mode == RasterMode::Pvrr && !frames.empty() && skip_first_pass) {
+    const std::string why = "eye-fixed cache: neither the elements nor the environment moved relative to the eye";
+    out.stages.skipped("first-pass", why);
+    out.stages.skipped("nested-passes", why);
+  } else if (mode == RasterMode::Pvrr && !frames.empty()) {
+    size_t dark = 0;
+    bool budget_hit = false;
+    const size_t nested = planPasses(frames, opts, &dark, &budget_hit);
+    const double plan_ms = msSince(t0);
+    int deepest = 0, rendered = 0;
+    for (const MapPass& mp : passes) {
+      deepest = std::max(deepest, mp.depth);
+      rendered += mp.visible;
+    }
+    const auto t1 = Clock::now();
+    renderPasses(frames);
     glFinish();
-    out.stages.ran("first-pass", msSince(t0));
+    out.stages.ran("first-pass", msSince(t1), rendered,
+                   rendered == int(passes.size()) ? ""
+                                                  : std::to_string(passes.size() - size_t(rendered)) +
+                                                        " map(s) of elements outside the observer's view not rendered");
+    const std::string dark_note =
+        dark == 0 ? "" : std::to_string(dark) + " element(s) in a map drawn dark (" +
+                             (budget_hit ? "the budget of " + std::to_string(kMaxFirstPasses) + " first passes"
+                                         : "render.max_depth = " + std::to_string(scene.render.max_depth)) + ")";
+    if (nested > 0)
+      out.stages.ran("nested-passes", plan_ms, int(nested),
+                     std::to_string(nested) + " nested first pass(es), maps down to depth " + std::to_string(deepest) +
+                         (dark_note.empty() ? "" : "; " + dark_note));
+    else if (n_el == 1)
+      out.stages.skipped("nested-passes", std::string("one ") + (has_lens ? "lens" : "mirror") + ": no nesting");
+    else if (dark > 0)
+      out.stages.skipped("nested-passes", dark_note);
+    else
+      out.stages.skipped("nested-passes", "no element is inside another element's view volume");
   } else if (mode == RasterMode::Envmap && n_el > 0) {
     while (cubes.size() < n_el) cubes.push_back(std::make_unique<CubeTarget>());
     for (size_t e = 0; e < n_el; ++e) {
@@ -475,8 +801,10 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     }
     glFinish();
     out.stages.ran("first-pass", msSince(t0));
+    out.stages.skipped("nested-passes", "mode envmap: other elements are absent from the cube maps");
   } else {
     out.stages.skipped("first-pass", n_el == 0 ? "no mirror or lens in the scene" : "mode raster");
+    out.stages.skipped("nested-passes", n_el == 0 ? "no mirror or lens in the scene" : "mode raster");
   }
 
   // --- second pass ---
@@ -492,40 +820,16 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   const Mat4 view = ob.view(), proj = ob.projection(near_m, far_m);
   drawEnvironment(view, proj, ob.eye);
   const Mat4 vp = relativeViewProj(proj, view, ob.eye);
-  size_t next_map = 0;
-  size_t next_mesh = 0;
-  auto meshSlot = [&]() -> MeshBuffers& {
-    if (element_meshes.size() <= next_mesh) element_meshes.resize(next_mesh + 1);
-    return element_meshes[next_mesh++];
-  };
+  PassCamera eye_cam;
+  eye_cam.origin = ob.eye;
+  eye_cam.view_proj = vp;
   for (size_t e = 0; e < n_el; ++e) {
     const Element& el = scene.elements[e];
     const Vec3 anchor = Vec3(el.local_to_world[3]);
     const bool lens = el.type == ElementType::Lens;
+    frame_target->bind();
     if (mode == RasterMode::Pvrr) {
-      const ElementFrame& f = frames[e];
-      const Program& p = lens ? (channels == 3 ? lens3_program : lens_program) : (channels == 3 ? pvrr3_program : pvrr_program);
-      p.use();
-      p.set("u_view_proj", toFloat(vp));
-      p.set("u_offset", glm::vec3(anchor - ob.eye));
-      p.set("u_view_origin", glm::vec3(0.0f));
-      p.set("u_map", 0);
-      p.set("u_seen_map", 1);
-      setLights(p, ob.eye);
-      setElementMaterial(p, el, int(e));
-      for (const PatchView& pv : f.views) {
-        const Framebuffer& map = *maps[next_map++];
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, map.colorTexture(0));
-        glActiveTexture(GL_TEXTURE1);
-        glBindTexture(GL_TEXTURE_2D, map.colorTexture(1));
-        p.set("u_seen_offset", glm::vec3(pv.volume.eye - ob.eye));
-        MeshBuffers& mb = meshSlot();
-        uploadPatch(mb, f, pv, anchor);
-        frame_target->bind();
-        draw(mb);
-      }
-      glActiveTexture(GL_TEXTURE0);
+      drawPvrrElement(frames[e], top_slot[e], eye_cam, options.seen_channel);
     } else {
       ElementFrame f = prepareElement(scene, int(e));
       if (lens && mode == RasterMode::Envmap) traceVertexRays(rays, f, ob.eye, VertexStageOptions{});
@@ -536,6 +840,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       p.set("u_view_origin", glm::vec3(0.0f));
       setLights(p, ob.eye);
       setElementMaterial(p, el, int(e));
+      if (mode == RasterMode::Raster) p.set("u_dark", 0);
       if (mode == RasterMode::Envmap) {
         glActiveTexture(GL_TEXTURE0);
         glBindTexture(GL_TEXTURE_CUBE_MAP, cubes[e]->colors[0]);
@@ -548,7 +853,6 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       }
       MeshBuffers& mb = meshSlot();
       uploadElementGrid(mb, f, anchor);
-      frame_target->bind();
       draw(mb);
     }
   }

@@ -1,6 +1,14 @@
 // The raster paths on the GPU: "raster" (elements drawn as plain surfaces), "pvrr" (the paper's two passes,
 // with the CPU stages of pvrr/vertex_stage.h), and "envmap" (a dynamic cube map from each element's centre,
 // the classic baseline). A current GL context (pvrr/gl/context.h) is required.
+//
+// Multiple reflection (pvrr mode): an element inside another element's view volume is drawn in that
+// element's first pass with its own PVRR maps, its vertex rays starting where the outer element's rays that
+// reach it leave the outer surface; recursively (an explicit work list, parents before children, rendered
+// deepest first) down to the scene's render.max_depth, beyond which it is drawn black with its own surface
+// as the seen point, as the tracer absorbs there. Stage "nested-passes" reports the recursion.
+// Spectral dispersion: N channels share one first pass per patch; the second pass adds ceil(N / 3) draws
+// of three channels each, weighted per channel (pvrr/spectrum.h), into the colour attachment only.
 #pragma once
 #include <memory>
 #include <string>
@@ -30,8 +38,14 @@ struct RasterFrame {
 
 struct RendererOptions {
   int map_size = 1024;              // first-pass map (pvrr) or cube face (envmap) size
-  VertexStageOptions vertex;        // channels, viewpoint options
+  // Viewpoint options and channels. Channels empty: each element gets dispersionChannels(scene, element)
+  // (the scene's render.dispersion and spectral_samples); otherwise every element gets these channels.
+  VertexStageOptions vertex;
   bool read_back = true;            // false: leave the frame on the GPU (benchmarks of the draw alone)
+  // Which colour channel's texture coordinates feed the per-pixel seen point (RasterFrame::seen) in pvrr
+  // mode: -1 the fit channel (the middle one with dispersion, else the only one); c >= 0 channel c (clamped
+  // to the last channel), e.g. 0 and 2 give red's and blue's seen points on a dispersive lens.
+  int seen_channel = -1;
 };
 
 // Reuse across frames (paper section 5, eye-fixed caching): when an element has not moved relative to the

@@ -2,9 +2,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
+#include <set>
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "cad/error.h"
 #include "pvrr/gl/context.h"
 #include "pvrr/gl/renderer.h"
 #include "pvrr/scene_build.h"
@@ -288,6 +291,318 @@ TEST_P(RendererTest, PatchesCoverTheMirrorAndKeepTheAccuracy) {
     EXPECT_LE(v.volume.fov_y_rad, radians(20.0));
   }
   EXPECT_LE(medianArcmin(ref, automatic), 1.0);
+}
+
+const StageTiming& stage(const gl::RasterFrame& f, const std::string& name) {
+  static const StageTiming none{};
+  const StageTiming* t = f.stages.find(name);
+  EXPECT_NE(t, nullptr) << "no stage " << name;
+  return t ? *t : none;
+}
+
+// Per-channel seen points (RendererOptions::seen_channel) on the reading lens with RGB dispersion: at every
+// lens pixel the direction to the seen point deviates from the eye ray (a plus lens bends towards its axis);
+// blue (F line) deviates more than red (C line), in the same direction, by the fraction of the deviation
+// that the Abbe number predicts for a thin lens: (n_F - n_C) / (n_d - 1) = 1 / V_d.
+TEST_P(RendererTest, SeenChannelGivesEachChannelsSeenPoint) {
+  auto ctx = makeContext(GetParam());
+  if (!ctx) return;
+  Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/reading-lens.json", {"observer.image_size=[160,120]"}));
+  RayScene rays(s);
+  auto renderChannel = [&](int c) {
+    gl::RendererOptions opt;
+    opt.vertex.channels = dispersionChannels(s, 0, "rgb", 0);
+    opt.seen_channel = c;
+    gl::Renderer r(s, rays, opt);
+    return r.render(gl::RasterMode::Pvrr);
+  };
+  const gl::RasterFrame red = renderChannel(0), green = renderChannel(-1), blue = renderChannel(2);
+  const Dispersion& d = s.elements[0].dispersion;
+  const double expected = (d.index(kLineF_nm) - d.index(kLineC_nm)) / (d.index(kLineD_nm) - 1.0);
+  std::vector<double> ratio;
+  size_t lens = 0, same_direction = 0;
+  for (size_t i = 0; i < red.seen.size(); ++i) {
+    if (green.element[i] != 0) continue;
+    const Vec3 p = green.element_point[i];
+    const Vec3 in = glm::normalize(p - s.observer.eye);
+    const Vec3 r = glm::normalize(red.seen[i] - p), g = glm::normalize(green.seen[i] - p), b = glm::normalize(blue.seen[i] - p);
+    const Vec3 deviation = g - in;
+    if (glm::length(deviation) < radians(1.0)) continue;  // near the axis the spread is below the map's texel
+    ++lens;
+    const double spread = glm::dot(b - r, glm::normalize(deviation));
+    same_direction += spread > 0;
+    ratio.push_back(spread / glm::length(deviation));
+  }
+  ASSERT_GT(lens, 300u);
+  std::sort(ratio.begin(), ratio.end());
+  const double median = ratio[ratio.size() / 2];
+  std::printf("seen channels: %zu lens pixels, %zu blue beyond red, median spread/deviation %.5f (1/V_d %.5f)\n", lens,
+              same_direction, median, expected);
+  EXPECT_GE(double(same_direction), 0.95 * double(lens));
+  // Measured 0.03305 against 1 / V_d = 0.03333 (thin-lens estimate; the seen points are taken from the front
+  // surface point, not the exit point).
+  EXPECT_NEAR(median, expected, 0.1 * expected);
+}
+
+// Multiple reflection (models/mirror-pair.json): the back-wall mirror seen inside the convex mirror, the
+// convex mirror again inside that, and so on down to render.max_depth (4). Pixels whose reference path
+// reflects twice or more are drawn from nested first passes. Against the tracer they match within
+// kNestedMedianArcmin, and are far better than with the depth limited to 1, where the other mirror is black
+// at its own surface; that limited frame in turn matches the tracer limited to depth 1.
+TEST_P(RendererTest, MirrorSeenInAMirror) {
+  // Measured 1.19' (nested) and 0.77' (all mirror pixels) at 160 x 120 with 512^2 maps: each nested
+  // element is interpolated between its own vertices, whose rays are exact up to the interpolation of the
+  // outer mirror's ray origins (rayOrigins in pvrr/gl/renderer.cpp); starting them at the outer virtual
+  // viewpoint instead, as the paper does, gave 6.4'.
+  constexpr double kNestedMedianArcmin = 2.0;
+  auto ctx = makeContext(GetParam());
+  if (!ctx) return;
+  Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/mirror-pair.json", {"observer.image_size=[160,120]"}));
+  RayScene rays(s);
+  auto reference = [&](int max_depth) {
+    TraceOptions to;
+    to.max_depth = max_depth;
+    return Tracer(rays, to).render();
+  };
+  const TracedFrame ref4 = reference(4), ref1 = reference(1);
+  auto render = [&](int max_depth) {
+    s.render.max_depth = max_depth;
+    gl::RendererOptions opt;
+    opt.map_size = 512;
+    return gl::Renderer(s, rays, opt).render(gl::RasterMode::Pvrr);
+  };
+  const gl::RasterFrame f4 = render(4), f1 = render(1);
+  // Median angular error over the reference's mirror pixels whose path has at least `min_bounces`.
+  auto median = [&](const TracedFrame& ref, const gl::RasterFrame& f, int min_bounces, int max_bounces = 99) {
+    std::vector<double> e;
+    for (size_t i = 0; i < ref.color.size(); ++i) {
+      if (ref4.element[i] < 0 || ref4.bounces[i] < min_bounces || ref4.bounces[i] > max_bounces) continue;
+      const double a = arcminutes(angleBetween(ref.seen[i] - ref.element_point[i], f.seen[i] - ref.element_point[i]));
+      EXPECT_TRUE(std::isfinite(a)) << "pixel " << i;
+      e.push_back(a);
+    }
+    std::sort(e.begin(), e.end());
+    return std::make_pair(e.empty() ? 1e9 : e[e.size() / 2], e.size());
+  };
+  const auto all4 = median(ref4, f4, 1), nested4 = median(ref4, f4, 2), nested1 = median(ref4, f1, 2);
+  std::printf("mirror pair: mirror pixels %.3f' (%zu px), nested %.3f' (%zu px); by bounces:", all4.first, all4.second,
+              nested4.first, nested4.second);
+  for (int b = 2; b <= 4; ++b) {
+    const auto m = median(ref4, f4, b, b);
+    std::printf(" %d: %.3f' (%zu px)", b, m.first, m.second);
+  }
+  std::printf("; depth limited to 1: nested %.1f'\n", nested1.first);
+  EXPECT_GT(nested4.second, 500u);
+  EXPECT_LE(nested4.first, kNestedMedianArcmin);
+  EXPECT_LE(all4.first, 1.0);
+  EXPECT_GT(nested1.first, 100 * nested4.first);
+  // At depth 1 both draw the other mirror black with its own surface as the seen point.
+  EXPECT_LE(median(ref1, f1, 2).first, kNestedMedianArcmin);
+  size_t black = 0;
+  for (size_t i = 0; i < ref4.color.size(); ++i)
+    if (ref4.element[i] >= 0 && ref4.bounces[i] >= 2) black += glm::length(f1.color[i]) < 1e-6 && glm::length(ref1.color[i]) < 1e-6;
+  EXPECT_GT(double(black), 0.9 * double(nested4.second));
+  // The stats report the recursion, and its omission.
+  const StageTiming& nest = stage(f4, "nested-passes");
+  EXPECT_TRUE(nest.ran);
+  EXPECT_EQ(nest.count, 3);  // the back mirror in the convex, the convex in that, the back mirror again
+  std::printf("nested-passes: %s\n", nest.note.c_str());
+  EXPECT_FALSE(stage(f1, "nested-passes").ran);
+  EXPECT_NE(stage(f1, "nested-passes").reason.find("max_depth"), std::string::npos);
+}
+
+// A scene with one mirror says why nothing was nested.
+TEST_P(RendererTest, OneMirrorHasNoNesting) {
+  auto ctx = makeContext(GetParam());
+  if (!ctx) return;
+  Scene s = test::roomScene(Vec3(0.3, 0.2, 2.0), Vec3(0, 0, 0), 32, 24);
+  const cad::Outline outline = cad::Outline::rectangle(1.2, 0.9, 0.1);
+  test::addMirror(s, cad::makePlane(outline), outline, test::pose(Vec3(0, 0, -0.5), Vec3(0, 0, 1)), 5, 0.9);
+  s.updateBounds();
+  RayScene rays(s);
+  gl::RendererOptions opt;
+  opt.map_size = 64;
+  const gl::RasterFrame f = gl::Renderer(s, rays, opt).render(gl::RasterMode::Pvrr);
+  EXPECT_FALSE(stage(f, "nested-passes").ran);
+  EXPECT_EQ(stage(f, "nested-passes").reason, "one mirror: no nesting");
+}
+
+// Spectral PVRR (issue 6): "dispersion": "spectral" with N samples renders N channels from one shared first
+// pass per patch, summed with the spectral mode's colour weights in ceil(N / 3) additive draws; its colour
+// matches the tracer's spectral mode over the lens, and more closely than the RGB mode does.
+TEST_P(RendererTest, SpectralPvrrMatchesTheSpectralTracer) {
+  auto ctx = makeContext(GetParam());
+  if (!ctx) return;
+  Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/reading-lens.json",
+                                 {"observer.image_size=[160,120]", "render.dispersion=spectral", "render.spectral_samples=16"}));
+  RayScene rays(s);
+  TraceOptions to;
+  to.max_depth = s.render.max_depth;
+  to.dispersion = DispersionMode::Spectral;
+  to.spectral_samples = s.render.spectral_samples;
+  const TracedFrame ref = Tracer(rays, to).render();
+  auto render = [&](const std::string& dispersion) {
+    gl::RendererOptions opt;
+    opt.vertex.channels = dispersionChannels(s, 0, dispersion, s.render.spectral_samples);
+    gl::Renderer r(s, rays, opt);
+    return r.render(gl::RasterMode::Pvrr);
+  };
+  gl::RendererOptions per_element;  // empty channels: the renderer asks dispersionChannels() per element
+  per_element.vertex.channels.clear();
+  const gl::RasterFrame spectral = gl::Renderer(s, rays, per_element).render(gl::RasterMode::Pvrr);
+  const gl::RasterFrame rgb = render("rgb"), off = render("off");
+  const StageTiming& cc = stage(spectral, "colour-channels");
+  EXPECT_TRUE(cc.ran);
+  EXPECT_EQ(cc.count, 16);
+  std::printf("colour-channels: %s\n", cc.note.c_str());
+  ASSERT_EQ(spectral.elements[0].views.size(), 1u);
+  EXPECT_EQ(spectral.elements[0].views[0].st.size(), 16u);
+  const std::vector<bool> smooth = awayFromDepthEdges(ref, s.observer.eye);
+  auto meanError = [&](const gl::RasterFrame& f) {
+    double sum = 0;
+    size_t n = 0;
+    for (size_t i = 0; i < ref.color.size(); ++i) {
+      if (ref.element[i] != 0 || !smooth[i]) continue;
+      sum += glm::length(f.color[i] - ref.color[i]) / std::sqrt(3.0);
+      ++n;
+    }
+    return n ? sum / double(n) : 1e9;
+  };
+  const double e_spectral = meanError(spectral), e_rgb = meanError(rgb), e_off = meanError(off);
+  std::printf("lens colour vs the spectral tracer: spectral pvrr %.5f, rgb pvrr %.5f, no dispersion %.5f\n", e_spectral,
+              e_rgb, e_off);
+  // Mean over lens pixels away from depth edges of the colour difference (linear units): the same samples
+  // and weights as the tracer; what remains is the map's resampling of the page's fine text (40 lines
+  // magnified 1.6x) and sub-arcminute interpolation error. Measured 0.0052 at 160 x 120; RGB mode, whose C/d/F
+  // samples the text's fringes tell apart from the spectral sum, is 10x farther (0.056).
+  constexpr double kSpectralMeanColourTol = 0.01;
+  EXPECT_LE(e_spectral, kSpectralMeanColourTol);
+  EXPECT_LT(4 * e_spectral, e_rgb);
+  EXPECT_LT(e_rgb, e_off);  // RGB dispersion is closer to the spectral reference than none
+}
+
+// The one choice of colour channels (dispersionChannels): one d-line channel unless a dispersive lens is
+// rendered with dispersion; RGB mode's C, d, F lines with unit weights; spectral mode's samples and weights.
+TEST(DispersionChannels, FollowTheSceneAndTheTracersSamples) {
+  Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/reading-lens.json", {}));
+  ASSERT_EQ(s.elements[0].type, ElementType::Lens);
+  EXPECT_EQ(dispersionChannels(s, 0).size(), 3u);  // the scene says "rgb"
+  const std::vector<ChannelSpec> rgb = dispersionChannels(s, 0, "rgb", 0);
+  ASSERT_EQ(rgb.size(), 3u);
+  for (size_t c = 0; c < 3; ++c) {
+    EXPECT_EQ(rgb[c].wavelength_nm, kRgbWavelengths_nm[c]);
+    Vec3 unit(0.0);
+    unit[int(c)] = 1.0;
+    EXPECT_EQ(channelWeight(rgb, c), unit);
+  }
+  const std::vector<ChannelSpec> spectral = dispersionChannels(s, 0, "spectral", 7);
+  const std::vector<SpectralSample> samples = spectralSamples(7);
+  ASSERT_EQ(spectral.size(), 7u);
+  Vec3 sum(0.0);
+  for (size_t c = 0; c < 7; ++c) {
+    EXPECT_EQ(spectral[c].wavelength_nm, samples[c].wavelength_nm);
+    EXPECT_EQ(channelWeight(spectral, c), samples[c].rgb_weight);
+    sum += channelWeight(spectral, c);
+  }
+  EXPECT_LT(glm::length(sum - Vec3(1.0)), 1e-12);  // no tint where nothing disperses
+  EXPECT_EQ(dispersionChannels(s, 0, "off", 16).size(), 1u);
+  EXPECT_EQ(channelWeight(dispersionChannels(s, 0, "off", 16), 0), Vec3(1.0));
+  EXPECT_THROW(dispersionChannels(s, 0, "spectrum", 16), Error);
+  EXPECT_THROW(dispersionChannels(s, 0, "spectral", 2), Error);
+  s.elements[0].dispersion_on = false;  // the material's "dispersion": false
+  EXPECT_EQ(dispersionChannels(s, 0, "spectral", 16).size(), 1u);
+  Scene m = buildScene(loadScene(PVRR_SOURCE_DIR "/models/car-mirror.json", {"render.dispersion=rgb"}));
+  EXPECT_EQ(dispersionChannels(m, 0).size(), 1u);  // a mirror never disperses
+}
+
+// Patch seams (issue 5: "discontinuity <= 1 texel of the map"). The car mirror split into 2 x 2 patches:
+// along every boundary edge the two patches interpolate their own texture coordinates in their own maps.
+// At fractions of each edge (where both sides' fragments lie; the GPU interpolates (s q, t q, q) linearly
+// along the 3D edge), each side's seen point is what its map shows there: the first environment hit of its
+// camera's ray through that map point. Each side's seen point is projected through the other side's camera
+// and compared with the other side's own map point, in texels of the map. The seen points are cast with the
+// exact ray scene, so the figure is the geometric seam, free of rasterisation. Samples across a scene edge
+// (the edge's two hits on different surfaces, or either camera seeing an object in front of the chord
+// between them: occlusion inconsistency and parallax, paper section 6) are reported on their own.
+TEST(PatchSeam, CarMirrorSeamIsBelowOneTexel) {
+  // The issue's bound.
+  constexpr double kMaxSeamTexels = 1.0;
+  Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/car-mirror.json", {"elements[0].patches=[2,2]"}));
+  RayScene rays(s);
+  const VertexStageOptions opt;
+  ElementFrame f = prepareElement(s, 0);
+  traceVertexRays(rays, f, s.observer.eye, opt);
+  fitPatchViews(s, f, opt);
+  ASSERT_EQ(f.views.size(), 4u);
+  const double map_size = s.render.map_size;
+  auto seenAt = [&](const ViewVolume& v, const Vec2& st) {
+    const double x = v.left + st.x * (v.right_ - v.left), y = v.bottom + st.y * (v.top - v.bottom);
+    const Vec3 on_near = v.eye + v.near_m * v.forward + x * v.right + y * v.up;
+    const Vec3 d = glm::normalize(on_near - v.eye);
+    RayHit h = rays.intersect(on_near, d, 0);
+    while (h.hit() && h.kind == HitKind::Element)  // the mirror is not in its own map
+      h = rays.intersect(h.point, d, rays.epsilon());
+    return h.hit() ? h.point : on_near + s.render.far_distance_m * d;
+  };
+  auto interpolate = [](const PatchView& pv, size_t ka, size_t kb, double lambda) {
+    const double qa = (1 - lambda) * pv.q[ka], qb = lambda * pv.q[kb];
+    return (qa * pv.st[0][ka] + qb * pv.st[0][kb]) / (qa + qb);
+  };
+  // Whether the hits of two vertices lie on one surface: both escape, or the same mesh and face plane.
+  auto sameSurface = [&](uint32_t a, uint32_t b) {
+    const VertexRay &ra = f.rays[0][a], &rb = f.rays[0][b];
+    const RayHit ha = rays.intersect(ra.origin, ra.dir, rays.epsilon()), hb = rays.intersect(rb.origin, rb.dir, rays.epsilon());
+    if (!ha.hit() || !hb.hit()) return !ha.hit() && !hb.hit();
+    return ha.kind == HitKind::Environment && hb.kind == HitKind::Environment && ha.mesh == hb.mesh &&
+           std::abs(glm::dot(ha.normal, hb.normal)) > 0.999;
+  };
+  std::vector<double> jumps, edge_jumps;
+  size_t edges = 0;
+  for (size_t p0 = 0; p0 < f.views.size(); ++p0)
+    for (size_t p1 = p0 + 1; p1 < f.views.size(); ++p1) {
+      const cad::GridPatch &g0 = f.grid_patches[p0], &g1 = f.grid_patches[p1];
+      std::map<uint32_t, size_t> local1;
+      for (size_t k = 0; k < g1.vertices.size(); ++k) local1[g1.vertices[k]] = k;
+      std::set<std::pair<uint32_t, uint32_t>> edges1, done;
+      for (const auto& t : g1.triangles)
+        for (int e = 0; e < 3; ++e) {
+          const uint32_t a = g1.vertices[t[e]], b = g1.vertices[t[(e + 1) % 3]];
+          edges1.insert({std::min(a, b), std::max(a, b)});
+        }
+      for (const auto& t : g0.triangles)
+        for (int e = 0; e < 3; ++e) {
+          const size_t ka0 = t[e], kb0 = t[(e + 1) % 3];
+          const uint32_t a = g0.vertices[ka0], b = g0.vertices[kb0];
+          const std::pair<uint32_t, uint32_t> key{std::min(a, b), std::max(a, b)};
+          if (!edges1.count(key) || !done.insert(key).second) continue;
+          ++edges;
+          const bool same_surface = sameSurface(a, b);
+          const size_t ka1 = local1.at(a), kb1 = local1.at(b);
+          const PatchView &v0 = f.views[p0], &v1 = f.views[p1];
+          for (double lambda : {0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 0.875}) {
+            const Vec2 st0 = interpolate(v0, ka0, kb0, lambda), st1 = interpolate(v1, ka1, kb1, lambda);
+            const Vec3 x0 = seenAt(v0.volume, st0), x1 = seenAt(v1.volume, st1);
+            // Both cameras see the chord between the two hits there, not an object in front of it.
+            const Vec3 y = (1 - lambda) * f.rays[0][a].hit + lambda * f.rays[0][b].hit;
+            const bool unoccluded = glm::length(x0 - y) < 0.01 * glm::length(y - v0.volume.eye) &&
+                                    glm::length(x1 - y) < 0.01 * glm::length(y - v1.volume.eye);
+            std::vector<double>& out = same_surface && unoccluded ? jumps : edge_jumps;
+            out.push_back(map_size * glm::length(projectToTexture(v0.volume, x1) - st0));
+            out.push_back(map_size * glm::length(projectToTexture(v1.volume, x0) - st1));
+          }
+        }
+    }
+  // Measured: on one surface max 0.085 texels (median 0.007) over 246 samples; across scene edges up to
+  // 16 texels (146 samples: a car body or the own door between two vertices' hits).
+  ASSERT_GE(edges, 2u * 14u);  // two boundary lines across the 15 x 15 grid
+  ASSERT_GT(jumps.size(), edge_jumps.size());
+  std::sort(jumps.begin(), jumps.end());
+  std::sort(edge_jumps.begin(), edge_jumps.end());
+  std::printf("seam: %zu boundary edges; on one surface: jump median %.4f, p95 %.4f, max %.4f texels of a %d^2 map "
+              "(%zu samples); across scene edges: max %.3f texels (%zu samples)\n",
+              edges, jumps[jumps.size() / 2], jumps[jumps.size() * 95 / 100], jumps.back(), int(map_size), jumps.size(),
+              edge_jumps.empty() ? 0.0 : edge_jumps.back(), edge_jumps.size());
+  EXPECT_LE(jumps.back(), kMaxSeamTexels);
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, RendererTest, ::testing::Values(gl::GlBackend::OsMesa, gl::GlBackend::Egl),
