@@ -29,7 +29,9 @@ const std::map<std::string, Command>& commands() {
         "  Renders SCENE (default models/car-mirror.json) and prints the output path and the frame time.\n"
         "  --stats writes {\"frame_ms\", \"stages\":[{\"name\",\"ms\",\"ran\",\"reason\"}], \"elements\":[...]}.\n"
         "  --frames N renders N frames (the observer turning by --orbit DEG in total about the vertical axis\n"
-        "  through the eye; elements attached to the observer turn with it) and reports per-stage counts."}},
+        "  through the eye; elements attached to the observer turn with it) and reports per-stage counts.\n"
+        "  The stats' \"memory\" holds the resident memory after frame 100 (the first frame when N < 100), at\n"
+        "  the end, their difference (rss_growth_mb), the peak, and 20 samples over the run."}},
       {"gl-info",
        {cmdGlInfo, "print the GL backend, GL_VERSION and GL_RENDERER",
         "pvrr gl-info [--gl auto|egl|osmesa]\n  The backend can also be chosen with the PVRR_GL variable."}},
@@ -45,7 +47,11 @@ const std::map<std::string, Command>& commands() {
         "  (+ ix,iy,iz,bx,by,bz,bnx,bny,bnz for lenses); FILE.json beside it holds each patch's camera."}},
       {"compare",
        {cmdCompare, "render the reference and each mode; write images, error heat maps and metrics.json",
-        "pvrr compare SCENE [--modes pvrr,envmap,raster] [--size WxH] [--frames N] [--gl B] [--set PATH=VALUE]... --out DIR"}},
+        "pvrr compare SCENE [--modes pvrr,envmap,raster] [--size WxH] [--frames N] [--gl B] [--set PATH=VALUE]... --out DIR\n"
+        "  Writes DIR/reference.png, DIR/MODE.png, DIR/MODE-error.png and DIR/metrics.json: per mode the frame\n"
+        "  time, stages and angular error (median, p95, max), split into the zooming region and the rest\n"
+        "  (\"regions\"); with rgb dispersion also per colour channel (\"channels\") and the fringes' sign\n"
+        "  (\"fringe\"). metrics.json's \"definitions\" says how each figure is measured."}},
       {"sweep",
        {cmdSweep, "compare over a grid of tessellations and map sizes; write sweep.csv and error-vs-time plots",
         "pvrr sweep SCENE [--tessellation N1,N2,...] [--map-size S1,S2,...] [--vary PATH=V1,V2,...]... [--modes M1,...]\n"

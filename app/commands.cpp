@@ -213,6 +213,8 @@ RenderedFrame renderFrame(LoadedScene& ls, const std::string& mode, const std::s
       }
     });
     if (shown) std::fprintf(stderr, "\rray tracing: done \n");
+    out.channel_seen = std::move(f.channel_seen);
+    out.bounces = std::move(f.bounces);
     takePixels(out, f);
     out.stages.ran("ray-trace", f.frame_ms);
     out.gl_backend = "none (CPU, Embree)";
@@ -225,6 +227,7 @@ RenderedFrame renderFrame(LoadedScene& ls, const std::string& mode, const std::s
   if (!session->renderer) {
     gl::RendererOptions ro;
     ro.map_size = scene.render.map_size;
+    ro.seen_channel = session->seen_channel;
     ro.vertex.channels.clear();
     const bool any_dispersive_lens = std::any_of(scene.elements.begin(), scene.elements.end(), [](const Element& e) {
       return e.type == ElementType::Lens && e.dispersion_on;
@@ -260,10 +263,18 @@ int cmdRender(const std::vector<std::string>& argv) {
   RenderSession session;
   RenderedFrame last;
   std::vector<double> frame_times;
+  frame_times.reserve(size_t(frames));
   std::map<std::string, std::pair<int, int>> stage_counts;  // name -> (ran, skipped)
-  std::map<std::string, std::vector<double>> stage_ms;
+  std::map<std::string, double> stage_ms_sum;  // running sums: the bookkeeping of a long run stays O(1) a frame
   std::map<std::string, std::string> skip_reason;
   const Vec3 eye0 = ls.scene.observer.eye, target0 = ls.scene.observer.target;
+  const bool any_attached = std::any_of(ls.scene.elements.begin(), ls.scene.elements.end(),
+                                        [](const Element& e) { return e.attached_to_observer; });
+  // Memory soak (issue 7): resident memory after the baseline frame and at the end; a long run must not grow.
+  const int rss_frame = rssBaselineFrame(frames);
+  double rss_baseline_mb = 0;
+  json rss_samples = json::array();  // [frame, MB] at about 20 points of the run, to tell growth from settling
+  const int sample_every = std::max(1, frames / 20);
   for (int i = 0; i < frames; ++i) {
     if (frames > 1 && orbit_deg != 0) {
       // Turn the head about the vertical axis through the eye.
@@ -272,19 +283,24 @@ int cmdRender(const std::vector<std::string>& argv) {
       ls.scene.observer.eye = eye0;
       ls.scene.observer.target = eye0 + Vec3(rot * Vec4(target0 - eye0, 0.0));
       updateAttachedElements(ls.scene, ls.desc);
-      if (session.rays) session.rays->updateElementPoses();
+      // Re-committing the Embree scene rebuilds its BVH (~25 ms for the car mirror's scene): only when some
+      // element moves with the head.
+      if (session.rays && any_attached) session.rays->updateElementPoses();
       session.cache.environment_changed = false;
     }
     if (i > 0 && orbit_deg == 0) session.cache.environment_changed = false;
     last = renderFrame(ls, mode, gl_name, &session);
+    if (i + 1 == rss_frame) rss_baseline_mb = currentRssMb();
+    if ((i + 1) % sample_every == 0 || i + 1 == frames) rss_samples.push_back({i + 1, currentRssMb()});
     frame_times.push_back(last.frame_ms);
     for (const StageTiming& s : last.stages.stages) {
       auto& c = stage_counts[s.name];
       (s.ran ? c.first : c.second)++;
-      if (s.ran) stage_ms[s.name].push_back(s.ms);
+      if (s.ran) stage_ms_sum[s.name] += s.ms;
       else skip_reason[s.name] = s.reason;
     }
   }
+  const double rss_end_mb = currentRssMb();
   const size_t bad = writeLinearPng(out_path, last.width, last.height, last.color);
   if (bad) std::fprintf(stderr, "pvrr render: warning: %zu non-finite pixels written as black\n", bad);
   const double frame_ms = median(frame_times);
@@ -295,14 +311,18 @@ int cmdRender(const std::vector<std::string>& argv) {
     json j = {{"scene", scene_path}, {"mode", mode}, {"size", {last.width, last.height}}, {"gl", last.gl_backend},
               {"frame_ms", frame_ms}, {"frames", frames}, {"stages", stagesJson(last.stages)},
               {"elements", last.elements}, {"peak_rss_mb", peakRssMb()}};
+    // Resident memory (MB) after frame `after_frame` and after the last frame, before the PNG is written.
+    j["memory"] = {{"after_frame", rss_frame},
+                   {"rss_after_frame_mb", rss_baseline_mb},
+                   {"rss_end_mb", rss_end_mb},
+                   {"rss_growth_mb", rss_end_mb - rss_baseline_mb},
+                   {"peak_rss_mb", peakRssMb()},
+                   {"rss_samples", rss_samples}};
     if (frames > 1) {
       json per = json::array();
       for (const auto& [name, c] : stage_counts) {
-        const auto& v = stage_ms[name];
-        double mean = 0;
-        for (double x : v) mean += x;
         per.push_back({{"name", name}, {"frames_ran", c.first}, {"frames_skipped", c.second},
-                       {"mean_ms", v.empty() ? 0.0 : mean / double(v.size())},
+                       {"mean_ms", c.first > 0 ? stage_ms_sum[name] / double(c.first) : 0.0},
                        {"reason", c.second ? skip_reason[name] : ""}});
       }
       j["stage_frames"] = per;

@@ -6,7 +6,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
+#include <unistd.h>
 
 #include "app/args.h"
 #include "app/report.h"
@@ -26,6 +28,15 @@ double peakRssMb() {
     if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
   return 0;
 }
+
+double currentRssMb() {
+  std::ifstream in("/proc/self/statm");
+  long pages_total = 0, pages_resident = 0;
+  if (!(in >> pages_total >> pages_resident)) return 0;
+  return double(pages_resident) * double(::sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
+}
+
+int rssBaselineFrame(int frames) { return frames < 100 ? 1 : 100; }
 
 namespace {
 
@@ -142,6 +153,157 @@ ErrorStats compareToReference(const RenderedFrame& ref, const RenderedFrame& mod
   return s;
 }
 
+std::vector<double> angularErrors(const RenderedFrame& ref, const std::vector<Vec3>& ref_seen,
+                                  const std::vector<Vec3>& mode_seen) {
+  const size_t n = ref.element.size();
+  std::vector<double> e(n, std::nan(""));
+  if (ref_seen.size() != n || mode_seen.size() != n || ref.element_point.size() != n) return e;
+  for (size_t i = 0; i < n; ++i) {
+    if (ref.element[i] < 0) continue;
+    const double a = arcminutes(seenAngle(ref.element_point[i], ref_seen[i], mode_seen[i]));
+    if (std::isfinite(a)) e[i] = a;
+  }
+  return e;
+}
+
+ErrorStats summarizeErrors(const std::vector<double>& errors_arcmin, const std::vector<int8_t>* region, int8_t value) {
+  std::vector<double> e;
+  for (size_t i = 0; i < errors_arcmin.size(); ++i)
+    if (std::isfinite(errors_arcmin[i]) && (!region || (i < region->size() && (*region)[i] == value))) e.push_back(errors_arcmin[i]);
+  ErrorStats s;
+  s.pixels = e.size();
+  if (e.empty()) return s;
+  s.median_arcmin = quantile(e, 0.5);
+  s.p95_arcmin = quantile(e, 0.95);
+  s.max_arcmin = *std::max_element(e.begin(), e.end());
+  return s;
+}
+
+std::vector<int8_t> zoomingRegion(const RenderedFrame& ref, const std::vector<ElementFrame>& frames, const Scene* scene) {
+  const size_t n = ref.element.size();
+  std::vector<int8_t> region(n, -1);
+  for (const ElementFrame& f : frames) {
+    if (f.views.empty()) continue;
+    // The patch of each vertex (the first patch listing it: shared boundary vertices belong to either).
+    std::vector<int> vertex_view(f.world_pos.size(), -1);
+    for (size_t v = 0; v < f.views.size(); ++v)
+      for (uint32_t vi : f.grid_patches[size_t(f.views[v].patch)].vertices)
+        if (vi < vertex_view.size() && vertex_view[vi] < 0) vertex_view[vi] = int(v);
+    // The forward direction of each patch's forward volume: the normalised mean of its outgoing ray directions
+    // (pvrr/view_volume.h; a patch rendered with the reversed volume keeps only forward' in its volume).
+    const size_t fit_channel = f.rays.size() / 2;
+    std::vector<Vec3> forward(f.views.size());
+    for (size_t v = 0; v < f.views.size(); ++v) {
+      const ViewVolume& vv = f.views[v].volume;
+      if (!vv.backward || f.rays.empty()) {
+        forward[v] = vv.forward;
+        continue;
+      }
+      Vec3 sum(0);
+      for (uint32_t vi : f.grid_patches[size_t(f.views[v].patch)].vertices)
+        if (vi < f.rays[fit_channel].size() && f.rays[fit_channel][vi].status != VertexStatus::Tir) sum += f.rays[fit_channel][vi].dir;
+      forward[v] = glm::length(sum) > 0 ? glm::normalize(sum) : -vv.forward;
+    }
+    // Specular events of a path that meets this element only: a mirror reflects once, a lens refracts twice.
+    const int own_events = scene && scene->elements[size_t(f.element)].type == ElementType::Lens ? 2 : 1;
+    for (size_t i = 0; i < n; ++i) {
+      if (ref.element[i] != f.element) continue;
+      if (ref.bounces.size() == n && ref.bounces[i] > own_events) {
+        region[i] = 2;
+        continue;
+      }
+      size_t view = 0;
+      if (f.views.size() > 1) {
+        double best = std::numeric_limits<double>::infinity();
+        for (size_t vi = 0; vi < f.world_pos.size(); ++vi) {
+          const Vec3 d = f.world_pos[vi] - ref.element_point[i];
+          const double d2 = glm::dot(d, d);
+          if (d2 < best && vertex_view[vi] >= 0) best = d2, view = size_t(vertex_view[vi]);
+        }
+      }
+      const double depth = glm::dot(ref.seen[i] - f.views[view].fit.eye, forward[view]);
+      if (std::isfinite(depth)) region[i] = depth <= 0 ? 1 : 0;
+    }
+  }
+  return region;
+}
+
+FringeStats fringeStats(const Vec3& eye, const std::vector<Vec3>& element_point, const std::vector<Vec3>& red_seen,
+                        const std::vector<Vec3>& blue_seen, const std::vector<int8_t>& mask, double min_difference_arcmin) {
+  FringeStats s;
+  const size_t n = element_point.size();
+  if (red_seen.size() != n || blue_seen.size() != n || mask.size() != n) return s;
+  std::vector<double> diff;
+  size_t more = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (!mask[i]) continue;
+    const Vec3 p = element_point[i], in = p - eye;
+    const double dev_r = arcminutes(angleBetween(in, red_seen[i] - p)), dev_b = arcminutes(angleBetween(in, blue_seen[i] - p));
+    const double d = dev_b - dev_r;
+    if (!std::isfinite(d) || std::abs(d) < min_difference_arcmin) continue;
+    diff.push_back(d);
+    more += d > 0;
+  }
+  s.pixels = diff.size();
+  if (diff.empty()) return s;
+  s.median_blue_minus_red_arcmin = quantile(diff, 0.5);
+  s.fraction_blue_bends_more = double(more) / double(diff.size());
+  return s;
+}
+
+namespace {
+
+json statsJson(const ErrorStats& s) {
+  return {{"pixels", s.pixels},
+          {"angular_error_arcmin", {{"median", s.median_arcmin}, {"p95", s.p95_arcmin}, {"max", s.max_arcmin}}}};
+}
+
+json fringeJson(const FringeStats& f) {
+  return {{"pixels", f.pixels},
+          {"median_blue_minus_red_deviation_arcmin", f.median_blue_minus_red_arcmin},
+          {"fraction_blue_bends_more", f.fraction_blue_bends_more},
+          {"blue_bends_more", f.pixels > 0 && f.median_blue_minus_red_arcmin > 0}};
+}
+
+// The CPU vertex stages (rays, fit, view volumes) of the given elements from the observer's eye, with the
+// channels the renderer uses (three for a dispersive lens with dispersion on, else one).
+std::vector<ElementFrame> vertexStageFrames(const Scene& scene, const RayScene& rays, const std::vector<int>& which) {
+  const bool disp = scene.render.dispersion != "off";
+  std::vector<ElementFrame> frames;
+  for (int e : which) {
+    VertexStageOptions o;
+    o.channels.clear();
+    if (disp && scene.elements[size_t(e)].type == ElementType::Lens && scene.elements[size_t(e)].dispersion_on)
+      for (double wl : kRgbWavelengths_nm) o.channels.push_back(ChannelSpec{wl});
+    else
+      o.channels.push_back(ChannelSpec{});
+    ElementFrame f = prepareElement(scene, e);
+    traceVertexRays(rays, f, scene.observer.eye, o);
+    fitPatchViews(scene, f, o);
+    frames.push_back(std::move(f));
+  }
+  return frames;
+}
+
+const char* kDefinitions[][2] = {
+    {"angular_error", "per pixel where the reference sees a mirror or lens: the angle, at the reference's surface point, "
+                      "between the directions to the mode's seen point and to the reference's"},
+    {"zooming_region", "pixels whose reference seen point lies behind the fitted virtual viewpoint of the pvrr patch under "
+                       "the pixel (the patch of the nearest element vertex), along the patch's forward direction (the "
+                       "normalised mean of its outgoing rays, the axis of its forward view volume): (seen - viewpoint) . "
+                       "forward <= 0, e.g. objects nearer a concave mirror than the point where its rays converge; "
+                       "outside_zooming: the other element pixels whose path meets only that element; "
+                       "not_classified: pixels whose reference path goes on to another element (or is totally "
+                       "reflected inside a lens), where the seen point is not the element's own hit"},
+    {"channels", "with rgb dispersion: channel c's error compares the reference's channel-c ray (R = C line 656.3 nm, "
+                 "G = d line 587.6 nm, B = F line 486.1 nm) with the mode's channel-c seen point (pvrr: rendered once per "
+                 "channel; other modes have one seen point for all channels)"},
+    {"fringe", "over dispersive lens pixels: the deviation of a channel is the angle between the eye ray and the line from "
+               "the lens point to that channel's seen point; blue bends more than red where deviation(B) > deviation(R); "
+               "pixels where the two differ by less than 0.01 arcmin are left out"}};
+
+}  // namespace
+
 int cmdCompare(const std::vector<std::string>& argv) {
   Args a("compare", argv, {"modes", "size", "frames", "out", "gl", "set"}, {}, {"set"});
   if (a.positional().size() != 1) usageError("compare", "expected one scene file");
@@ -170,7 +332,34 @@ int cmdCompare(const std::vector<std::string>& argv) {
   RenderedFrame ref = renderFrame(ls, "raytrace", gl_name, &none);
   const int w = ref.width, h = ref.height;
   json metrics = {{"scene", scene_path}, {"size", {w, h}}, {"reference", {{"frame_ms", ref.frame_ms}}}};
+  json definitions = json::object();
+  for (const auto& d : kDefinitions) definitions[d[0]] = d[1];
+  metrics["definitions"] = definitions;
   writeLinearPng(*out_dir + "/reference.png", w, h, ref.color);
+
+  // The zooming region (issue 5), from the CPU vertex stages of every element: the same patches, viewpoints
+  // and view volumes as the pvrr mode's.
+  std::vector<int> all_elements;
+  for (size_t e = 0; e < ls.scene.elements.size(); ++e) all_elements.push_back(int(e));
+  std::vector<int8_t> zooming;
+  {
+    RayScene rays(ls.scene);
+    zooming = zoomingRegion(ref, vertexStageFrames(ls.scene, rays, all_elements), &ls.scene);
+  }
+  // Per-channel seen points (issue 6): the reference traces one ray per channel in rgb dispersion mode.
+  const bool per_channel = !ref.channel_seen[0].empty();
+  const char* channel_names[3] = {"R", "G", "B"};
+  std::vector<int8_t> lens_mask(ref.element.size(), 0);
+  for (size_t i = 0; i < ref.element.size(); ++i) {
+    const int e = ref.element[i];
+    lens_mask[i] = e >= 0 && ls.scene.elements[size_t(e)].type == ElementType::Lens && ls.scene.elements[size_t(e)].dispersion_on;
+  }
+  FringeStats ref_fringe;
+  if (per_channel) {
+    ref_fringe = fringeStats(ls.scene.observer.eye, ref.element_point, ref.channel_seen[0], ref.channel_seen[2], lens_mask);
+    metrics["reference"]["fringe"] = fringeJson(ref_fringe);
+  }
+
   json jm = json::object();
   std::string gl_used;
   for (const std::string& m : modes) {
@@ -191,11 +380,14 @@ int cmdCompare(const std::vector<std::string>& argv) {
       per_element.push_back({{"name", ls.scene.elements[e].name}, {"pixels", es.pixels},
                              {"angular_error_arcmin", {{"median", es.median_arcmin}, {"p95", es.p95_arcmin}, {"max", es.max_arcmin}}}});
     }
+    const ErrorStats zs = summarizeErrors(err, &zooming, 1), os = summarizeErrors(err, &zooming, 0),
+                     ns = summarizeErrors(err, &zooming, 2);
     jm[m] = {{"frame_ms", frame_ms},
              {"stages", stages},
              {"speedup_vs_reference", frame_ms > 0 ? ref.frame_ms / frame_ms : 0.0},
              {"pixels", st.pixels},
              {"angular_error_arcmin", {{"median", st.median_arcmin}, {"p95", st.p95_arcmin}, {"max", st.max_arcmin}}},
+             {"regions", {{"zooming", statsJson(zs)}, {"outside_zooming", statsJson(os)}, {"not_classified", statsJson(ns)}}},
              {"heat_map_scale_arcmin", scale},
              {"psnr_db", st.psnr_db},
              {"rmse", st.rmse},
@@ -203,6 +395,44 @@ int cmdCompare(const std::vector<std::string>& argv) {
              {"element_stats", f.elements}};
     std::printf("%-8s %8.2f ms  median %.4f' p95 %.4f' max %.3f'  PSNR %.2f dB  (%zu px)\n", m.c_str(), frame_ms,
                 st.median_arcmin, st.p95_arcmin, st.max_arcmin, st.psnr_db, st.pixels);
+    if (zs.pixels > 0)
+      std::printf("%-8s zooming region: median %.4f' p95 %.4f' (%zu px); outside: median %.4f' (%zu px)\n", m.c_str(),
+                  zs.median_arcmin, zs.p95_arcmin, zs.pixels, os.median_arcmin, os.pixels);
+    if (per_channel) {
+      // pvrr: each channel's own texture coordinates feed the seen point, one render per channel (the timed
+      // frame is the middle channel's). Other modes have one seen point for every channel.
+      std::array<std::vector<Vec3>, 3> seen;
+      const bool own = m == "pvrr";
+      for (int c = 0; c < 3; ++c) {
+        if (!own || c == 1) {
+          seen[size_t(c)] = f.seen;
+          continue;
+        }
+        RenderSession s;
+        s.seen_channel = c;
+        seen[size_t(c)] = renderFrame(ls, m, gl_name, &s).seen;
+      }
+      json ch = json::object();
+      for (int c = 0; c < 3; ++c) {
+        const ErrorStats cs = summarizeErrors(angularErrors(ref, ref.channel_seen[size_t(c)], seen[size_t(c)]));
+        json j = statsJson(cs);
+        j["wavelength_nm"] = kRgbWavelengths_nm[c];
+        ch[channel_names[c]] = j;
+        std::printf("%-8s channel %s: median %.4f' p95 %.4f'\n", m.c_str(), channel_names[c], cs.median_arcmin, cs.p95_arcmin);
+      }
+      jm[m]["channels"] = ch;
+      jm[m]["channel_seen"] = own ? "per channel (one render per channel)" : "one seen point for all channels";
+      if (own) {
+        const FringeStats fs = fringeStats(ls.scene.observer.eye, ref.element_point, seen[0], seen[2], lens_mask);
+        json fj = fringeJson(fs);
+        fj["agrees_with_reference"] = fs.pixels > 0 && ref_fringe.pixels > 0 &&
+                                      (fs.median_blue_minus_red_arcmin > 0) == (ref_fringe.median_blue_minus_red_arcmin > 0);
+        jm[m]["fringe"] = fj;
+        std::printf("%-8s fringe: blue - red deviation median %.4f' (reference %.4f'), blue bends more at %.0f%% of %zu px\n",
+                    m.c_str(), fs.median_blue_minus_red_arcmin, ref_fringe.median_blue_minus_red_arcmin,
+                    100 * fs.fraction_blue_bends_more, fs.pixels);
+      }
+    }
   }
   metrics["gl"] = gl_used;
   metrics["modes"] = jm;
@@ -235,21 +465,7 @@ int cmdVertices(const std::vector<std::string>& argv) {
     throw Error(ls.desc.source + ": the scene has no mirror or lens");
   }
   RayScene rays(scene);
-  VertexStageOptions opt;
-  const bool disp = scene.render.dispersion != "off";
-  std::vector<ElementFrame> frames;
-  for (int e : which) {
-    VertexStageOptions o = opt;
-    o.channels.clear();
-    if (disp && scene.elements[size_t(e)].type == ElementType::Lens && scene.elements[size_t(e)].dispersion_on)
-      for (double wl : kRgbWavelengths_nm) o.channels.push_back(ChannelSpec{wl});
-    else
-      o.channels.push_back(ChannelSpec{});
-    ElementFrame f = prepareElement(scene, e);
-    traceVertexRays(rays, f, scene.observer.eye, o);
-    fitPatchViews(scene, f, o);
-    frames.push_back(std::move(f));
-  }
+  const std::vector<ElementFrame> frames = vertexStageFrames(scene, rays, which);
   if (ext == ".vtp") {
     writeVerticesVtp(*out, scene, frames);
     std::printf("%s\n", out->c_str());

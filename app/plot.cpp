@@ -17,6 +17,11 @@
 #include <vtkPNGWriter.h>
 #include <vtkPen.h>
 #include <vtkPlot.h>
+#include <vtkPlotPoints.h>
+#include <vtkContext2D.h>
+#include <vtkPoints2D.h>
+#include <vtkTransform2D.h>
+#include <vtkRect.h>
 #include <vtkRenderer.h>
 #include <vtkTable.h>
 #include <vtkTextProperty.h>
@@ -26,6 +31,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <unistd.h>
@@ -64,24 +70,98 @@ class ExternalGLRenderWindow : public vtkGenericOpenGLRenderWindow {
 vtkStandardNewMacro(ExternalGLRenderWindow);
 
 const unsigned char kColours[][3] = {{31, 119, 180}, {214, 39, 40}, {44, 160, 44}, {148, 103, 189}, {255, 127, 14}, {23, 190, 207}};
+constexpr int kNumColours = 6;
+const int kMarkers[] = {vtkPlotPoints::CIRCLE, vtkPlotPoints::SQUARE, vtkPlotPoints::DIAMOND, vtkPlotPoints::CROSS,
+                        vtkPlotPoints::PLUS};
+constexpr int kNumMarkers = 5;
 
 std::string seriesName(const SweepRow& r) {
   return r.mode + " map " + std::to_string(r.map_size) + (r.vary.empty() ? "" : " " + r.vary);
 }
 
-// A chart from (x, y) series; log axes as asked. Rendered into a PNG through our EGL context.
-struct Series {
-  std::string name;
-  std::vector<double> x, y;
-  bool line = false;
-  int colour = 0;
+// Point labels drawn at the points themselves (vtkPlot's indexed labels are tooltips only). A label goes to
+// the upper right of its point, or to the first of a few other spots that overlaps no label drawn before
+// it in this chart (`placed`, in screen pixels, shared by the chart's labelled plots) and stays in the scene.
+class LabelledPoints : public vtkPlotPoints {
+ public:
+  static LabelledPoints* New();
+  vtkTypeMacro(LabelledPoints, vtkPlotPoints);
+  std::vector<std::string> labels;
+  std::vector<vtkRectf>* placed = nullptr;
+  bool first = false;  // the chart's first labelled plot: a new paint of the chart starts, forget the old labels
+
+  bool Paint(vtkContext2D* painter) override {
+    if (!this->Superclass::Paint(painter)) return false;
+    if (placed && first) placed->clear();
+    if (!this->Points || labels.empty() || !this->Visible) return true;
+    vtkTransform2D* to_screen = painter->GetTransform();
+    const vtkIdType n = std::min<vtkIdType>(this->Points->GetNumberOfPoints(), vtkIdType(labels.size()));
+    std::vector<float> data(size_t(2 * n)), screen(size_t(2 * n));
+    for (vtkIdType i = 0; i < n; ++i) {
+      double p[2];
+      this->Points->GetPoint(i, p);
+      data[size_t(2 * i)] = float(p[0]);
+      data[size_t(2 * i + 1)] = float(p[1]);
+    }
+    to_screen->TransformPoints(data.data(), screen.data(), int(n));
+    const vtkRecti scene_rect(0, 0, this->GetScene() ? this->GetScene()->GetSceneWidth() : 100000,
+                              this->GetScene() ? this->GetScene()->GetSceneHeight() : 100000);
+    painter->PushMatrix();
+    vtkNew<vtkTransform2D> identity;
+    painter->SetTransform(identity);
+    vtkNew<vtkTextProperty> tp;
+    tp->SetFontSize(11);
+    tp->SetColor(0.15, 0.15, 0.15);
+    tp->SetJustificationToLeft();
+    tp->SetVerticalJustificationToBottom();
+    painter->ApplyTextProp(tp);
+    for (vtkIdType i = 0; i < n; ++i) {
+      const std::string& text = labels[size_t(i)];
+      const float sx = screen[size_t(2 * i)], sy = screen[size_t(2 * i + 1)];
+      if (text.empty() || !std::isfinite(sx) || !std::isfinite(sy)) continue;
+      float b[4];
+      painter->ComputeStringBounds(text, b);
+      const float w = b[2], h = b[3], gap = 5;
+      // Upper right, lower right, upper left, lower left, then further up and down on the right.
+      const float spots[][2] = {{gap, gap},          {gap, -gap - h},           {-gap - w, gap},
+                                {-gap - w, -gap - h}, {gap, gap + 1.2f * h},     {gap, -gap - 2.2f * h},
+                                {gap, gap + 2.4f * h}, {gap, -gap - 3.4f * h}};
+      vtkRectf chosen(sx + spots[0][0], sy + spots[0][1], w, h);
+      for (const auto& d : spots) {
+        const vtkRectf r(sx + d[0], sy + d[1], w, h);
+        const bool inside = r.GetX() >= 0 && r.GetY() >= 0 && r.GetX() + w <= float(scene_rect.GetWidth()) &&
+                            r.GetY() + h <= float(scene_rect.GetHeight());
+        bool overlaps = false;
+        if (placed)
+          for (const vtkRectf& o : *placed)
+            overlaps = overlaps || (r.GetX() < o.GetX() + o.GetWidth() && o.GetX() < r.GetX() + w &&
+                                    r.GetY() < o.GetY() + o.GetHeight() && o.GetY() < r.GetY() + h);
+        if (inside && !overlaps) {
+          chosen = r;
+          break;
+        }
+      }
+      if (placed) placed->push_back(chosen);
+      painter->DrawString(chosen.GetX(), chosen.GetY(), text);
+    }
+    painter->PopMatrix();
+    return true;
+  }
+};
+vtkStandardNewMacro(LabelledPoints);
+
+struct Axes {
+  std::string title, xtitle, ytitle;
+  bool log_x = false, log_y = false;
+  std::pair<double, double> x_range, y_range;
 };
 
-void renderChart(const std::string& path, const std::string& title, const std::string& xtitle, const std::string& ytitle,
-                 bool log_x, bool log_y, const std::vector<Series>& series) {
+// A chart of the series on fixed, padded axes with the legend outside the plot area, rendered into a PNG
+// through our EGL context.
+void renderChart(const std::string& path, const Axes& axes, const std::vector<PlotSeries>& series) {
   auto ctx = gl::GlContext::create(gl::GlBackend::Egl);
   vtkNew<ExternalGLRenderWindow> rw;
-  rw->SetSize(900, 600);
+  rw->SetSize(1000, 640);
   rw->SetOffScreenRendering(1);
   rw->SetIsCurrent(true);
   rw->SetReadyForRendering(true);
@@ -106,14 +186,31 @@ void renderChart(const std::string& path, const std::string& title, const std::s
   view->GetRenderer()->SetBackground(1, 1, 1);
   vtkNew<vtkChartXY> chart;
   view->GetScene()->AddItem(chart);
-  chart->SetTitle(title);
+  chart->SetTitle(axes.title);
   chart->SetShowLegend(true);
-  chart->GetAxis(vtkAxis::BOTTOM)->SetTitle(xtitle);
-  chart->GetAxis(vtkAxis::LEFT)->SetTitle(ytitle);
-  chart->GetAxis(vtkAxis::BOTTOM)->SetLogScale(log_x);
-  chart->GetAxis(vtkAxis::LEFT)->SetLogScale(log_y);
+  // Outside the plot area, on the right: inside, it hides whatever lies in its corner.
+  chart->GetLegend()->SetInline(false);
+  chart->GetLegend()->SetHorizontalAlignment(vtkChartLegend::RIGHT);
+  chart->GetLegend()->SetVerticalAlignment(vtkChartLegend::TOP);
+  chart->GetLegend()->SetDragEnabled(false);
+  struct AxisSpec {
+    int which;
+    const std::string& title;
+    bool log;
+    std::pair<double, double> range;
+  };
+  for (const AxisSpec& a : {AxisSpec{vtkAxis::BOTTOM, axes.xtitle, axes.log_x, axes.x_range},
+                            AxisSpec{vtkAxis::LEFT, axes.ytitle, axes.log_y, axes.y_range}}) {
+    vtkAxis* ax = chart->GetAxis(a.which);
+    ax->SetTitle(a.title);
+    ax->SetLogScale(a.log);
+    ax->SetBehavior(vtkAxis::FIXED);
+    ax->SetUnscaledRange(a.range.first, a.range.second);
+  }
+  std::vector<vtkRectf> placed;
+  bool any_labelled = false;
   std::vector<vtkSmartPointer<vtkTable>> tables;
-  for (const Series& s : series) {
+  for (const PlotSeries& s : series) {
     auto table = vtkSmartPointer<vtkTable>::New();
     vtkNew<vtkDoubleArray> xs, ys;
     xs->SetName("x");
@@ -124,11 +221,29 @@ void renderChart(const std::string& path, const std::string& title, const std::s
     }
     table->AddColumn(xs);
     table->AddColumn(ys);
-    vtkPlot* p = chart->AddPlot(s.line ? vtkChart::LINE : vtkChart::POINTS);
+    vtkPlot* p = nullptr;
+    if (s.line) {
+      p = chart->AddPlot(vtkChart::LINE);
+    } else {
+      vtkNew<LabelledPoints> lp;
+      lp->labels = s.labels;
+      lp->placed = &placed;
+      lp->first = !any_labelled;
+      any_labelled = true;
+      lp->SetMarkerStyle(kMarkers[s.marker % kNumMarkers]);
+      lp->SetMarkerSize(9);
+      chart->AddPlot(lp);
+      p = lp;
+    }
     p->SetInputData(table, 0, 1);
-    const unsigned char* c = kColours[s.colour % 6];
-    p->SetColor(c[0], c[1], c[2], 255);
-    p->SetWidth(s.line ? 2.0f : 4.0f);
+    if (s.colour < 0) {
+      p->SetColor(0, 0, 0, 255);
+    } else {
+      const unsigned char* c = kColours[s.colour % kNumColours];
+      p->SetColor(c[0], c[1], c[2], 255);
+    }
+    p->SetWidth(s.line ? 2.0f : 3.0f);
+    if (s.dashed) p->GetPen()->SetLineType(vtkPen::DASH_LINE);
     tables.push_back(table);
   }
   rw->Render();
@@ -151,19 +266,38 @@ void renderChart(const std::string& path, const std::string& title, const std::s
   }
 }
 
-// The same error-vs-time chart as SVG, every point labelled "N/S" (tessellation / map size).
-std::string svgErrorVsTime(const std::vector<SweepRow>& rows) {
-  const double W = 900, H = 600, L = 90, R = 220, T = 50, B = 70;
-  double x0 = 1e300, x1 = 0, y0 = 1e300, y1 = 0;
-  for (const SweepRow& r : rows) {
-    x0 = std::min({x0, r.frame_ms, r.reference_ms});
-    x1 = std::max({x1, r.frame_ms, r.reference_ms});
-    if (r.median_arcmin > 0) {
-      y0 = std::min(y0, r.median_arcmin);
-      y1 = std::max(y1, r.median_arcmin);
-    }
+// An SVG marker of the chart's marker set at (x, y).
+std::string svgMarker(double x, double y, int marker, const std::string& colour) {
+  std::ostringstream s;
+  const double r = 4.5;
+  switch (marker % kNumMarkers) {
+    case 0: s << "<circle cx='" << x << "' cy='" << y << "' r='" << r << "' fill='" << colour << "'/>"; break;
+    case 1: s << "<rect x='" << x - r << "' y='" << y - r << "' width='" << 2 * r << "' height='" << 2 * r << "' fill='" << colour << "'/>"; break;
+    case 2:
+      s << "<polygon points='" << x << "," << y - r - 1 << " " << x + r + 1 << "," << y << " " << x << "," << y + r + 1 << " "
+        << x - r - 1 << "," << y << "' fill='" << colour << "'/>";
+      break;
+    case 3:
+      s << "<path d='M" << x - r << "," << y - r << "L" << x + r << "," << y + r << "M" << x - r << "," << y + r << "L" << x + r << ","
+        << y - r << "' stroke='" << colour << "' stroke-width='2'/>";
+      break;
+    default:
+      s << "<path d='M" << x - r << "," << y << "L" << x + r << "," << y << "M" << x << "," << y - r << "L" << x << "," << y + r
+        << "' stroke='" << colour << "' stroke-width='2'/>";
   }
-  x0 *= 0.8, x1 *= 1.25, y0 = std::max(y0 * 0.5, 1e-6), y1 *= 2;
+  return s.str();
+}
+
+std::string rgb(int colour) {
+  const unsigned char* c = kColours[colour % kNumColours];
+  return "rgb(" + std::to_string(int(c[0])) + "," + std::to_string(int(c[1])) + "," + std::to_string(int(c[2])) + ")";
+}
+
+// The same error-vs-time chart as SVG, every point labelled "N/S" (tessellation / map size).
+std::string svgErrorVsTime(const std::vector<PlotSeries>& series, double reference_ms, std::pair<double, double> xr,
+                           std::pair<double, double> yr) {
+  const double W = 1000, H = 640, L = 90, R = 240, T = 50, B = 70;
+  const double x0 = xr.first, x1 = xr.second, y0 = yr.first, y1 = yr.second;
   auto X = [&](double v) { return L + (v - x0) / (x1 - x0) * (W - L - R); };
   auto Y = [&](double v) { return H - B - (std::log10(std::max(v, y0)) - std::log10(y0)) / (std::log10(y1) - std::log10(y0)) * (H - T - B); };
   std::ostringstream s;
@@ -184,22 +318,21 @@ std::string svgErrorVsTime(const std::vector<SweepRow>& rows) {
     const double v = x0 + (x1 - x0) * i / 5;
     s << "<text x='" << X(v) << "' y='" << H - B + 18 << "' text-anchor='middle'>" << std::round(v * 10) / 10 << "</text>\n";
   }
-  const double ref = rows.empty() ? 0 : rows.front().reference_ms;
-  s << "<line x1='" << X(ref) << "' y1='" << T << "' x2='" << X(ref) << "' y2='" << H - B
-    << "' stroke='black' stroke-dasharray='6,4'/><text x='" << X(ref) + 4 << "' y='" << T + 12 << "'>reference " << std::round(ref * 10) / 10 << " ms</text>\n";
-  std::map<std::string, int> colour;
-  for (const SweepRow& r : rows) colour.emplace(seriesName(r), int(colour.size()));
-  for (const SweepRow& r : rows) {
-    const unsigned char* c = kColours[colour[seriesName(r)] % 6];
-    s << "<circle cx='" << X(r.frame_ms) << "' cy='" << Y(r.median_arcmin) << "' r='4' fill='rgb(" << int(c[0]) << ","
-      << int(c[1]) << "," << int(c[2]) << ")'/><text x='" << X(r.frame_ms) + 6 << "' y='" << Y(r.median_arcmin) - 4
-      << "' font-size='10'>" << r.tessellation << "/" << r.map_size << "</text>\n";
-  }
+  s << "<line x1='" << X(reference_ms) << "' y1='" << T << "' x2='" << X(reference_ms) << "' y2='" << H - B
+    << "' stroke='black' stroke-dasharray='6,4'/><text x='" << X(reference_ms) + 4 << "' y='" << T + 12 << "'>reference "
+    << std::round(reference_ms * 10) / 10 << " ms</text>\n";
   int k = 0;
-  for (const auto& [name, idx] : colour) {
-    const unsigned char* c = kColours[idx % 6];
-    s << "<circle cx='" << W - R + 20 << "' cy='" << T + 20 * k << "' r='4' fill='rgb(" << int(c[0]) << "," << int(c[1]) << ","
-      << int(c[2]) << ")'/><text x='" << W - R + 30 << "' y='" << T + 4 + 20 * k << "'>" << name << "</text>\n";
+  for (const PlotSeries& ps : series) {
+    if (ps.line) continue;
+    const std::string c = rgb(ps.colour);
+    for (size_t i = 0; i < ps.x.size(); ++i) {
+      s << svgMarker(X(ps.x[i]), Y(ps.y[i]), ps.marker, c);
+      if (i < ps.labels.size())
+        s << "<text x='" << X(ps.x[i]) + 6 << "' y='" << Y(ps.y[i]) - 4 << "' font-size='10'>" << ps.labels[i] << "</text>";
+      s << "\n";
+    }
+    s << svgMarker(W - R + 20, T + 20 * k, ps.marker, c) << "<text x='" << W - R + 30 << "' y='" << T + 4 + 20 * k << "'>" << ps.name
+      << "</text>\n";
     ++k;
   }
   s << "<text x='" << W - R + 20 << "' y='" << T + 20 * k + 10 << "' font-size='10'>labels: tessellation/map size</text>\n";
@@ -256,62 +389,113 @@ std::vector<SweepRow> readSweepCsv(const std::string& path) {
   return rows;
 }
 
-void writeSweepPlots(const std::string& dir, const std::vector<SweepRow>& rows) {
-  std::map<std::string, int> colour;
-  std::map<std::string, Series> by_series, med, p95;
+std::pair<double, double> paddedRange(const std::vector<double>& values, bool log) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (double v : values)
+    if (std::isfinite(v) && (!log || v > 0)) lo = std::min(lo, v), hi = std::max(hi, v);
+  if (!(lo <= hi)) throw Error(std::string("plot: no finite ") + (log ? "positive " : "") + "value to scale an axis to");
+  if (log) return {lo / 1.6, hi * 1.6};
+  const double pad = hi > lo ? 0.08 * (hi - lo) : std::max(0.1 * std::abs(lo), 1e-9);
+  // Start at 0 rather than below it when the lowest value keeps a quarter of the padding (2 % of the span,
+  // ~15 px on the chart) from the border.
+  return {lo - pad < 0 && lo >= 0.25 * pad ? 0.0 : lo - pad, hi + pad};
+}
+
+std::vector<PlotSeries> errorVsTimeSeries(const std::vector<SweepRow>& rows) {
+  std::vector<PlotSeries> out;
+  std::map<std::string, size_t> index;  // series name -> position in `out`
   for (const SweepRow& r : rows) {
     const std::string name = seriesName(r);
-    const int c = colour.emplace(name, int(colour.size())).first->second;
-    Series& s = by_series[name];
-    s.name = name;
-    s.colour = c;
+    auto it = index.find(name);
+    if (it == index.end()) {
+      PlotSeries s;
+      s.name = name;
+      const int k = int(out.size());
+      // Colours cycle first; the marker changes once per round of colours, so (colour, marker) stays unique
+      // for kNumColours * kNumMarkers series.
+      s.colour = k % kNumColours;
+      s.marker = (k / kNumColours) % kNumMarkers;
+      it = index.emplace(name, out.size()).first;
+      out.push_back(s);
+    }
+    PlotSeries& s = out[it->second];
     s.x.push_back(r.frame_ms);
     s.y.push_back(std::max(r.median_arcmin, 1e-6));
-    Series& m = med[r.mode];
-    m.name = r.mode + " median";
-    m.colour = 2 * int(med.size() - 1);
-    m.x.push_back(double(r.vertices));
-    m.y.push_back(std::max(r.median_arcmin, 1e-6));
-    Series& p = p95[r.mode];
-    p.name = r.mode + " p95";
-    p.colour = 2 * int(p95.size() - 1) + 1;
-    p.x.push_back(double(r.vertices));
-    p.y.push_back(std::max(r.p95_arcmin, 1e-6));
+    s.labels.push_back(std::to_string(r.tessellation) + "/" + std::to_string(r.map_size));
   }
-  std::vector<Series> time_series;
-  double lo = 1e300, hi = 0;
-  for (auto& [name, s] : by_series) {
-    time_series.push_back(s);
-    for (double y : s.y) lo = std::min(lo, y), hi = std::max(hi, y);
+  return out;
+}
+
+void writeSweepPlots(const std::string& dir, const std::vector<SweepRow>& rows) {
+  if (rows.empty()) throw Error(dir + ": no sweep rows to plot");
+  // Error against frame time: one labelled point series per (mode, map size, vary) group.
+  std::vector<PlotSeries> time_series = errorVsTimeSeries(rows);
+  std::vector<double> xs = {rows.front().reference_ms}, ys;
+  for (const PlotSeries& s : time_series) {
+    xs.insert(xs.end(), s.x.begin(), s.x.end());
+    ys.insert(ys.end(), s.y.begin(), s.y.end());
   }
-  Series ref;
+  Axes ta;
+  ta.title = "Median angular error against frame time (labels: tessellation/map size)";
+  ta.xtitle = "frame time (ms)";
+  ta.ytitle = "median angular error (arcmin)";
+  ta.log_y = true;
+  ta.x_range = paddedRange(xs, false);
+  ta.y_range = paddedRange(ys, true);
+  PlotSeries ref;
   ref.name = "reference frame time";
   ref.line = true;
-  ref.colour = 5;
+  ref.colour = -1;  // black
   ref.x = {rows.front().reference_ms, rows.front().reference_ms};
-  ref.y = {lo, hi};
-  time_series.push_back(ref);
-  renderChart(dir + "/error_vs_time.png", "Median angular error against frame time (points: tessellation x map size)",
-              "frame time (ms)", "median angular error (arcmin)", false, true, time_series);
-  writeFileAtomic(dir + "/error_vs_time.svg", svgErrorVsTime(rows));
-  std::vector<Series> vert_series;
-  for (auto& [mode, s] : med) {
-    // Sort by vertex count so the lines run left to right.
-    std::vector<size_t> idx(s.x.size());
-    for (size_t i = 0; i < idx.size(); ++i) idx[i] = i;
-    std::sort(idx.begin(), idx.end(), [&](size_t a, size_t b) { return s.x[a] < s.x[b]; });
-    for (Series* ser : {&s, &p95[mode]}) {
-      Series sorted = *ser;
+  ref.y = {ta.y_range.first, ta.y_range.second};
+  std::vector<PlotSeries> with_ref = time_series;
+  with_ref.push_back(ref);
+  renderChart(dir + "/error_vs_time.png", ta, with_ref);
+  writeFileAtomic(dir + "/error_vs_time.svg", svgErrorVsTime(time_series, rows.front().reference_ms, ta.x_range, ta.y_range));
+
+  // Median and p95 against vertex count, one pair of lines per mode (and vary), sorted by vertex count.
+  std::map<std::string, PlotSeries> med, p95;
+  std::vector<std::string> order;
+  for (const SweepRow& r : rows) {
+    const std::string key = r.mode + (r.vary.empty() ? "" : " " + r.vary) + " map " + std::to_string(r.map_size);
+    if (!med.count(key)) {
+      const int k = int(order.size());
+      order.push_back(key);
+      med[key].name = key + " median";
+      p95[key].name = key + " p95";
+      med[key].colour = p95[key].colour = k % kNumColours;
+      med[key].line = p95[key].line = true;
+      p95[key].dashed = true;
+    }
+    med[key].x.push_back(double(r.vertices));
+    med[key].y.push_back(std::max(r.median_arcmin, 1e-6));
+    p95[key].x.push_back(double(r.vertices));
+    p95[key].y.push_back(std::max(r.p95_arcmin, 1e-6));
+  }
+  std::vector<PlotSeries> vert_series;
+  std::vector<double> vx, vy;
+  for (const std::string& key : order)
+    for (PlotSeries* ser : {&med[key], &p95[key]}) {
+      std::vector<size_t> idx(ser->x.size());
+      for (size_t i = 0; i < idx.size(); ++i) idx[i] = i;
+      std::stable_sort(idx.begin(), idx.end(), [&](size_t a, size_t b) { return ser->x[a] < ser->x[b]; });
+      PlotSeries sorted = *ser;
       for (size_t i = 0; i < idx.size(); ++i) {
         sorted.x[i] = ser->x[idx[i]];
         sorted.y[i] = ser->y[idx[i]];
       }
-      sorted.line = true;
+      vx.insert(vx.end(), sorted.x.begin(), sorted.x.end());
+      vy.insert(vy.end(), sorted.y.begin(), sorted.y.end());
       vert_series.push_back(sorted);
     }
-  }
-  renderChart(dir + "/error_vs_vertices.png", "Angular error against vertex count", "vertices (log)",
-              "angular error (arcmin, log)", true, true, vert_series);
+  Axes va;
+  va.title = "Angular error against vertex count (lines: median and p95 per mode and map size)";
+  va.xtitle = "vertices (log)";
+  va.ytitle = "angular error (arcmin, log)";
+  va.log_x = va.log_y = true;
+  va.x_range = paddedRange(vx, true);
+  va.y_range = paddedRange(vy, true);
+  renderChart(dir + "/error_vs_vertices.png", va, vert_series);
 }
 
 }  // namespace pvrr::app

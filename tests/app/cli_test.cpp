@@ -10,36 +10,15 @@
 #include <fstream>
 #include <sstream>
 
+#include "app/run_pvrr.h"
+
 namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int code = -1;
-  std::string out, err;
-};
+using Result = pvrr::test::CliResult;
 
-// Runs build/pvrr with the arguments (a shell fragment) from the source tree, capturing both streams.
-Result pvrr(const std::string& args) {
-  static int counter = 0;
-  const fs::path tmp = fs::temp_directory_path() / ("pvrr-cli-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
-  const std::string cmd = "cd '" PVRR_SOURCE_DIR "' && '" PVRR_BINARY "' " + args + " >'" + tmp.string() + ".out' 2>'" +
-                          tmp.string() + ".err'";
-  Result r;
-  const int status = std::system(cmd.c_str());
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  auto slurp = [](const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-  };
-  r.out = slurp(tmp.string() + ".out");
-  r.err = slurp(tmp.string() + ".err");
-  fs::remove(tmp.string() + ".out");
-  fs::remove(tmp.string() + ".err");
-  return r;
-}
+Result pvrr(const std::string& args) { return pvrr::test::runPvrr(args); }
 
 class Cli : public ::testing::Test {
  protected:

@@ -1,0 +1,51 @@
+// Runs the built pvrr command from the source tree, as a user does, for the tests of tests/app.
+#pragma once
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace pvrr::test {
+
+struct CliResult {
+  int code = -1;
+  std::string out, err;
+};
+
+// Runs build/pvrr with the arguments (a shell fragment) from the source tree, capturing both streams.
+inline CliResult runPvrr(const std::string& args) {
+  namespace fs = std::filesystem;
+  static int counter = 0;
+  const fs::path tmp = fs::temp_directory_path() / ("pvrr-cli-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+  const std::string cmd = "cd '" PVRR_SOURCE_DIR "' && '" PVRR_BINARY "' " + args + " >'" + tmp.string() + ".out' 2>'" +
+                          tmp.string() + ".err'";
+  CliResult r;
+  const int status = std::system(cmd.c_str());
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  auto slurp = [](const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  };
+  r.out = slurp(tmp.string() + ".out");
+  r.err = slurp(tmp.string() + ".err");
+  fs::remove(tmp.string() + ".out");
+  fs::remove(tmp.string() + ".err");
+  return r;
+}
+
+// A fresh temporary folder per test, removed afterwards.
+inline std::filesystem::path freshTestDir(const std::string& name) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("pvrr-app-" + std::to_string(::getpid()) + "-" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+}  // namespace pvrr::test
