@@ -92,12 +92,6 @@ gl::GlBackend backendArg(const Args& a) {
 
 json vec(const Vec3& v) { return json::array({v.x, v.y, v.z}); }
 
-json stagesJson(const FrameStages& s) {
-  json a = json::array();
-  for (const StageTiming& t : s.stages) a.push_back({{"name", t.name}, {"ms", t.ms}, {"ran", t.ran}, {"reason", t.reason}});
-  return a;
-}
-
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
@@ -105,6 +99,17 @@ double median(std::vector<double> v) {
 }
 
 }  // namespace
+
+json stagesJson(const FrameStages& s) {
+  json a = json::array();
+  for (const StageTiming& t : s.stages) {
+    json j = {{"name", t.name}, {"ms", t.ms}, {"ran", t.ran}, {"reason", t.reason}};
+    if (t.count >= 0) j["count"] = t.count;
+    if (!t.note.empty()) j["note"] = t.note;
+    a.push_back(std::move(j));
+  }
+  return a;
+}
 
 json elementsJson(const Scene& scene, const std::vector<ElementFrame>& frames) {
   json out = json::array();
@@ -228,15 +233,7 @@ RenderedFrame renderFrame(LoadedScene& ls, const std::string& mode, const std::s
     gl::RendererOptions ro;
     ro.map_size = scene.render.map_size;
     ro.seen_channel = session->seen_channel;
-    ro.vertex.channels.clear();
-    const bool any_dispersive_lens = std::any_of(scene.elements.begin(), scene.elements.end(), [](const Element& e) {
-      return e.type == ElementType::Lens && e.dispersion_on;
-    });
-    if (disp != DispersionMode::Off && any_dispersive_lens) {
-      for (double wl : kRgbWavelengths_nm) ro.vertex.channels.push_back(ChannelSpec{wl});
-    } else {
-      ro.vertex.channels.push_back(ChannelSpec{});
-    }
+    ro.vertex.channels.clear();  // per element: dispersionChannels(scene, e), rgb or spectral as the scene says
     session->renderer = std::make_unique<gl::Renderer>(scene, *session->rays, ro);
   }
   gl::RasterFrame f = session->renderer->render(rm, &session->cache);

@@ -266,17 +266,12 @@ json fringeJson(const FringeStats& f) {
 }
 
 // The CPU vertex stages (rays, fit, view volumes) of the given elements from the observer's eye, with the
-// channels the renderer uses (three for a dispersive lens with dispersion on, else one).
+// channels the renderer uses (dispersionChannels: R, G, B or the spectral samples for a dispersive lens).
 std::vector<ElementFrame> vertexStageFrames(const Scene& scene, const RayScene& rays, const std::vector<int>& which) {
-  const bool disp = scene.render.dispersion != "off";
   std::vector<ElementFrame> frames;
   for (int e : which) {
     VertexStageOptions o;
-    o.channels.clear();
-    if (disp && scene.elements[size_t(e)].type == ElementType::Lens && scene.elements[size_t(e)].dispersion_on)
-      for (double wl : kRgbWavelengths_nm) o.channels.push_back(ChannelSpec{wl});
-    else
-      o.channels.push_back(ChannelSpec{});
+    o.channels = dispersionChannels(scene, e);
     ElementFrame f = prepareElement(scene, e);
     traceVertexRays(rays, f, scene.observer.eye, o);
     fitPatchViews(scene, f, o);
@@ -371,9 +366,7 @@ int cmdCompare(const std::vector<std::string>& argv) {
     writeLinearPng(*out_dir + "/" + m + ".png", w, h, f.color);
     const double scale = std::max(1.0, st.p95_arcmin * 1.5);
     writeHeatMap(*out_dir + "/" + m + "-error.png", w, h, err, scale);
-    json stages = json::array();
-    for (const StageTiming& t : f.stages.stages)
-      stages.push_back({{"name", t.name}, {"ms", t.ms}, {"ran", t.ran}, {"reason", t.reason}});
+    const json stages = stagesJson(f.stages);
     json per_element = json::array();
     for (size_t e = 0; e < ls.scene.elements.size(); ++e) {
       const ErrorStats es = compareToReference(ref, f, nullptr, int(e));
@@ -484,7 +477,7 @@ int cmdVertices(const std::vector<std::string>& argv) {
     for (const PatchView& pv : f.views) {
       const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
       for (size_t c = 0; c < pv.st.size(); ++c) {
-        const double wl = f.rays.size() > 1 ? kRgbWavelengths_nm[c] : kLineD_nm;
+        const double wl = f.channels[c].wavelength_nm > 0 ? f.channels[c].wavelength_nm : kLineD_nm;
         auto rm = [](const Mat4& m) { auto r = rowMajor16(m); return json(std::vector<double>(r.begin(), r.end())); };
         patches.push_back({{"patch", pv.patch}, {"channel", c}, {"eye", {pv.volume.eye.x, pv.volume.eye.y, pv.volume.eye.z}},
                            {"view_matrix", rm(pv.volume.view)}, {"projection_matrix", rm(pv.volume.projection)},

@@ -42,6 +42,8 @@ RenderedFrame renderFrame(LoadedScene& ls, const std::string& mode, const std::s
 RenderedFrame timedFrame(LoadedScene& ls, const std::string& mode, const std::string& gl_backend_name, int frames,
                          double* median_ms);
 nlohmann::json elementsJson(const Scene& scene, const std::vector<ElementFrame>& frames);
+// The stages of a frame: [{"name", "ms", "ran", "reason"[, "count"][, "note"]}].
+nlohmann::json stagesJson(const FrameStages& s);
 // Per-vertex data as VTK PolyData (.vtp) for ParaView: the grid of each element with point arrays.
 void writeVerticesVtp(const std::string& path, const Scene& scene, const std::vector<ElementFrame>& frames);
 // A tessellation as OBJ (v, vn, f v//vn), PLY or VTP, chosen by extension; atomic.

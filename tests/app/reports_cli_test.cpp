@@ -163,4 +163,57 @@ TEST(Reports, RenderFramesDoesNotGrowResidentMemory) {
   fs::remove_all(dir);
 }
 
+// Spectral dispersion as a user asks for it (--set render.dispersion=spectral): render draws the lens with
+// one channel per spectral sample (stats "colour-channels" count), and vertices writes one row per vertex
+// and sample, each patch/channel in the JSON with its own wavelength and the material's index there.
+TEST(Reports, SpectralDispersionRendersAndExportsEverySample) {
+  constexpr int kSamples = 7;
+  const fs::path dir = pvrr::test::freshTestDir("spectral");
+  const std::string sets = " --set render.dispersion=spectral --set render.spectral_samples=" + std::to_string(kSamples);
+  const auto r = runPvrr("render models/reading-lens.json --size 32x24 --gl osmesa" + sets + " --out '" +
+                         (dir / "f.png").string() + "' --stats '" + (dir / "s.json").string() + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto s = readJson(dir / "s.json");
+  bool found = false;
+  for (const auto& st : s["stages"])
+    if (st["name"] == "colour-channels") {
+      found = true;
+      EXPECT_TRUE(st["ran"].get<bool>());
+      EXPECT_EQ(st["count"].get<int>(), kSamples) << st.dump();
+    }
+  EXPECT_TRUE(found) << s["stages"].dump();
+
+  const auto v = runPvrr("vertices models/reading-lens.json" + sets + " --out '" + (dir / "v.csv").string() + "'");
+  ASSERT_EQ(v.code, 0) << v.err;
+  const auto cams = readJson(dir / "v.json");
+  std::set<double> wavelengths;
+  double last_n = 1e9;
+  for (const auto& p : cams["elements"][0]["patches"]) {
+    const double wl = p["wavelength_nm"].get<double>();
+    if (p["patch"].get<int>() == 0) {
+      // Normal dispersion: the index falls as the wavelength grows (samples in increasing wavelength).
+      if (!wavelengths.empty()) {
+        EXPECT_GT(wl, *wavelengths.rbegin());
+      }
+      EXPECT_LT(p["n"].get<double>(), last_n);
+      last_n = p["n"].get<double>();
+    }
+    wavelengths.insert(wl);
+  }
+  EXPECT_EQ(wavelengths.size(), size_t(kSamples));
+  EXPECT_GT(*wavelengths.begin(), 380.0);
+  EXPECT_LT(*wavelengths.rbegin(), 780.0);
+  std::ifstream csv(dir / "v.csv");
+  std::string line;
+  std::set<int> channels;
+  std::getline(csv, line);
+  while (std::getline(csv, line)) {
+    size_t c = 0;
+    for (int k = 0; k < 3; ++k) c = line.find(',', c) + 1;
+    channels.insert(std::stoi(line.substr(c)));
+  }
+  EXPECT_EQ(channels.size(), size_t(kSamples));
+  fs::remove_all(dir);
+}
+
 }  // namespace
