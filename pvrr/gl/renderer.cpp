@@ -167,9 +167,15 @@ Program makeProgram(const std::string& vert, const std::string& frag, const std:
 const std::vector<int> kElementLayout = {3, 3, 3, 3, 3, 3, 3, 3, 3};
 constexpr size_t kElementFloats = 27;
 
-// At most this many first passes per frame (top-level and nested): each holds a map_size^2 colour, seen-point
+// At most this many first passes per frame (top-level and nested): each holds a size^2 colour, seen-point
 // and depth target. Elements that would need more are drawn dark in their map, and the stats say so.
 constexpr size_t kMaxFirstPasses = 16;
+
+// The map size of an element seen in a map of size `parent`: half of it, at least 128 texels. A nested
+// element covers part of its parent's map, which covers part of the image, so half the parent's texels
+// still exceed the pixels it covers in the shipped scenes; full-size nested maps (28 MB each at 1024^2: RGBA16F
+// colour, RGBA32F seen points, 32-bit depth) took the mirror pair's render at 1280 x 720 to 460 MB.
+int nestedMapSize(int parent) { return parent <= 128 ? parent : std::max(128, parent / 2); }
 
 // A camera of one pass (the second pass, or a first pass from a virtual viewpoint): positions are relative
 // to `origin`.
@@ -379,10 +385,10 @@ struct Renderer::Impl {
     uploadMesh(mb, data, kElementLayout, idx);
   }
 
-  Framebuffer& mapTarget(size_t i) {
+  Framebuffer& mapTarget(size_t i, int size) {
     if (maps.size() <= i) maps.resize(i + 1);
-    if (!maps[i] || maps[i]->width() != options.map_size) {
-      maps[i] = std::make_unique<Framebuffer>(options.map_size, options.map_size,
+    if (!maps[i] || maps[i]->width() != size) {
+      maps[i] = std::make_unique<Framebuffer>(size, size,
                                               std::vector<ColorFormat>{ColorFormat::RGBA16F, ColorFormat::RGBA32F},
                                               DepthFormat::Depth32F);
       // Colour and seen points filter linearly: seen points are exact within a surface and blend only across
@@ -412,6 +418,7 @@ struct Renderer::Impl {
     int depth = 0;     // the tracer's depth (events before) of what this map shows: 1 behind a mirror seen
                        // from the eye, 2 behind a lens (two interfaces)
     size_t slot = 0;   // index into `maps`
+    int size = 0;      // the map's width and height (nestedMapSize for nested maps)
     bool visible = true;  // false: a top-level element the observer cannot see; its map is left as it is
     std::vector<NestedDraw> nested;
   };
@@ -484,7 +491,7 @@ struct Renderer::Impl {
     size_t slot = 0;
     for (const ElementFrame& f : frames)
       for (size_t v = 0; v < f.views.size(); ++v)
-        passes.push_back({&f, v, interfaces(scene.elements[size_t(f.element)]), slot++, true, {}});
+        passes.push_back({&f, v, interfaces(scene.elements[size_t(f.element)]), slot++, options.map_size, true, {}});
     const size_t top = passes.size();
     // A top-level element outside the observer's view needs no map (its second-pass triangles are clipped).
     const Observer& ob = scene.observer;
@@ -525,8 +532,9 @@ struct Renderer::Impl {
           continue;
         }
         const size_t first = slot;
+        const int size = nestedMapSize(passes[i].size);
         for (size_t v = 0; v < nf->views.size(); ++v)
-          passes.push_back({nf.get(), v, depth + interfaces(el), slot++, true, {}});
+          passes.push_back({nf.get(), v, depth + interfaces(el), slot++, size, true, {}});
         passes[i].nested.push_back({int(b), nf.get(), first});
         nested_frames.push_back(std::move(nf));
       }
@@ -606,7 +614,7 @@ struct Renderer::Impl {
     for (size_t i = passes.size(); i-- > 0;) {
       const MapPass& mp = passes[i];
       const PatchView& pv = mp.owner->views[mp.view];
-      const Framebuffer& t = mapTarget(mp.slot);
+      const Framebuffer& t = mapTarget(mp.slot, mp.size);
       if (!mp.visible) continue;
       t.bind();
       t.clear({0, 0, 0, 0}, pv.volume.backward ? 0.0f : 1.0f);
