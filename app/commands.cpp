@@ -228,7 +228,11 @@ RenderedFrame renderFrame(LoadedScene& ls, const std::string& mode, const std::s
   const gl::RasterMode rm = gl::parseRasterMode(mode);
   if (!session->context) session->context = gl::GlContext::create(gl::parseGlBackend(gl_backend_name));
   session->context->makeCurrent();
-  if (!session->rays) session->rays = std::make_unique<RayScene>(scene);
+  if (!session->rays) {
+    RaySceneOptions o;
+    o.moving_elements = session->moving_elements;
+    session->rays = std::make_unique<RayScene>(scene, o);
+  }
   if (!session->renderer) {
     gl::RendererOptions ro;
     ro.map_size = scene.render.map_size;
@@ -267,6 +271,7 @@ int cmdRender(const std::vector<std::string>& argv) {
   const Vec3 eye0 = ls.scene.observer.eye, target0 = ls.scene.observer.target;
   const bool any_attached = std::any_of(ls.scene.elements.begin(), ls.scene.elements.end(),
                                         [](const Element& e) { return e.attached_to_observer; });
+  session.moving_elements = frames > 1 && orbit_deg != 0 && any_attached;
   // Memory soak (issue 7): resident memory after the baseline frame and at the end; a long run must not grow.
   const int rss_frame = rssBaselineFrame(frames);
   double rss_baseline_mb = 0;

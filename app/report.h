@@ -34,6 +34,7 @@ struct RenderSession {
   std::unique_ptr<gl::Renderer> renderer;
   gl::FrameCache cache;
   int seen_channel = -1;  // gl::RendererOptions::seen_channel of the renderer this session creates
+  bool moving_elements = false;  // RaySceneOptions::moving_elements: the head turns between frames
 };
 
 RenderedFrame renderFrame(LoadedScene& ls, const std::string& mode, const std::string& gl_backend_name,

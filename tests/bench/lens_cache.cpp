@@ -38,7 +38,9 @@ void BM_LensFrame(benchmark::State& state, Variant variant) {
   SceneDesc desc = loadScene(std::string(PVRR_SOURCE_DIR) + "/models/spectacle-lens.json",
                              {"observer.image_size=[1280,720]", "render.dispersion=rgb"});
   Scene s = buildScene(desc);
-  RayScene rays(s);
+  RaySceneOptions ro;
+  ro.moving_elements = variant == Variant::CachedOrbit;  // as pvrr render --orbit does
+  RayScene rays(s, ro);
   gl::RendererOptions opt;
   opt.read_back = false;
   opt.vertex.channels.clear();  // each element's own: dispersionChannels() gives the lens R, G and B
