@@ -1,6 +1,7 @@
 // Reference-tracer ray throughput (issue 4): exact RayScene::intersect() queries per second, incoherent and
 // secondary rays on one thread and on all threads (TBB), primary rays as single rays and as 4 x 4 packets,
-// and the reference frame at 1280 x 720 for the car mirror and the spectacle lens, packets on and off.
+// and the reference frame at 1280 x 720 for every default scene (car mirror and spectacle lens also without
+// primary packets).
 // Incoherent and secondary rays are also measured as incoherent 16-ray packets (what Embree's packet
 // kernels give without the coherent flag; the tracer itself traces secondary rays one by one).
 // Goal: >= 20 M incoherent rays/s on 2 cores. The figure of interest is items_per_second (rays/s, or
@@ -210,6 +211,13 @@ BENCHMARK_CAPTURE(BM_ReferenceFrame, car_mirror, "car-mirror")
     ->Arg(0)->Arg(1)->ArgName("packets")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK_CAPTURE(BM_ReferenceFrame, spectacle_lens, "spectacle-lens")
     ->Arg(0)->Arg(1)->ArgName("packets")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+// The other default scenes, with primary packets (the tracer's default).
+BENCHMARK_CAPTURE(BM_ReferenceFrame, plane_mirror, "plane-mirror")->Arg(1)->ArgName("packets")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK_CAPTURE(BM_ReferenceFrame, concave_mirror, "concave-mirror")->Arg(1)->ArgName("packets")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK_CAPTURE(BM_ReferenceFrame, saddle_mirror, "saddle-mirror")->Arg(1)->ArgName("packets")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK_CAPTURE(BM_ReferenceFrame, mirror_pair, "mirror-pair")->Arg(1)->ArgName("packets")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK_CAPTURE(BM_ReferenceFrame, reading_lens, "reading-lens")->Arg(1)->ArgName("packets")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK_CAPTURE(BM_ReferenceFrame, progressive_lens, "progressive-lens")->Arg(1)->ArgName("packets")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 
 }  // namespace
 
