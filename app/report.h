@@ -35,6 +35,7 @@ struct RenderSession {
   gl::FrameCache cache;
   int seen_channel = -1;  // gl::RendererOptions::seen_channel of the renderer this session creates
   bool moving_elements = false;  // RaySceneOptions::moving_elements: the head turns between frames
+  bool seen_points = true;       // gl::RendererOptions::seen_points: off when only the picture is wanted
 };
 
 RenderedFrame renderFrame(LoadedScene& ls, const std::string& mode, const std::string& gl_backend_name,

@@ -8,6 +8,7 @@
 //   MODE_PLAIN   a plain grey shaded surface (raster mode); u_dark: black, an element met at the depth limit
 //                inside another element's map (the tracer absorbs there)
 //   LENS         the element is a lens (transmission) rather than a mirror (reflection)
+//   NO_SEEN_POINTS  colour only: the seen-point maps are not read (RendererOptions::seen_points off)
 in vec3 v_pos;
 in vec3 v_normal;
 in vec3 v_st0;
@@ -77,7 +78,11 @@ void main() {
 #if CHANNELS == 3
   c += v_w1 * texture(u_map, v_st1.xy / v_st1.z).rgb + v_w2 * texture(u_map, v_st2.xy / v_st2.z).rgb;
 #endif
+#if defined(NO_SEEN_POINTS)
+  vec4 seen = vec4(0.0);
+#else
   vec4 seen = texture(u_seen_map, v_st_seen.xy / v_st_seen.z);
+#endif
 #else
 #if defined(LENS)
   vec3 dir = normalize(v_st0);  // the exact exit direction at the vertices, interpolated
@@ -86,7 +91,11 @@ void main() {
   vec3 dir = reflect(view, n);
 #endif
   vec3 c = texture(u_cube, dir).rgb;
+#if defined(NO_SEEN_POINTS)
+  vec4 seen = vec4(0.0);
+#else
   vec4 seen = texture(u_seen_cube, dir);
+#endif
 #endif
   o_color = vec4(weight * c, 1.0);
   o_seen = vec4(seen.xyz + u_seen_offset, seen.w);

@@ -215,15 +215,20 @@ struct Renderer::Impl {
   const Scene& scene;
   const RayScene& rays;
   RendererOptions options;
+  // The element programs' defines, plus NO_SEEN_POINTS when RendererOptions::seen_points is off.
+  std::vector<std::string> defines(std::vector<std::string> d) const {
+    if (!options.seen_points) d.push_back("#define NO_SEEN_POINTS");
+    return d;
+  }
   Program env_program = makeProgram("env.vert", "env.frag");
   Program sky_program = makeProgram("sky.vert", "sky.frag");
-  Program plain_program = makeProgram("element.vert", "element.frag", {"#define MODE_PLAIN"});
-  Program envmap_program = makeProgram("element.vert", "element.frag", {"#define MODE_ENVMAP"});
-  Program lens_envmap_program = makeProgram("element.vert", "element.frag", {"#define MODE_ENVMAP", "#define LENS"});
-  Program pvrr_program = makeProgram("element.vert", "element.frag", {"#define MODE_PVRR", "#define CHANNELS 1"});
-  Program pvrr3_program = makeProgram("element.vert", "element.frag", {"#define MODE_PVRR", "#define CHANNELS 3"});
-  Program lens_program = makeProgram("element.vert", "element.frag", {"#define MODE_PVRR", "#define CHANNELS 1", "#define LENS"});
-  Program lens3_program = makeProgram("element.vert", "element.frag", {"#define MODE_PVRR", "#define CHANNELS 3", "#define LENS"});
+  Program plain_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_PLAIN"}));
+  Program envmap_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_ENVMAP"}));
+  Program lens_envmap_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_ENVMAP", "#define LENS"}));
+  Program pvrr_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_PVRR", "#define CHANNELS 1"}));
+  Program pvrr3_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_PVRR", "#define CHANNELS 3"}));
+  Program lens_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_PVRR", "#define CHANNELS 1", "#define LENS"}));
+  Program lens3_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_PVRR", "#define CHANNELS 3", "#define LENS"}));
   GLuint empty_vao = 0;
   std::vector<MeshBuffers> env_meshes;
   std::vector<Texture> textures;  // environment textures, in Scene::textures order
@@ -389,11 +394,13 @@ struct Renderer::Impl {
     if (maps.size() <= i) maps.resize(i + 1);
     if (!maps[i] || maps[i]->width() != size) {
       maps[i] = std::make_unique<Framebuffer>(size, size,
-                                              std::vector<ColorFormat>{ColorFormat::RGBA16F, ColorFormat::RGBA32F},
+                                              options.seen_points
+                                                  ? std::vector<ColorFormat>{ColorFormat::RGBA16F, ColorFormat::RGBA32F}
+                                                  : std::vector<ColorFormat>{ColorFormat::RGBA16F},
                                               DepthFormat::Depth32F);
       // Colour and seen points filter linearly: seen points are exact within a surface and blend only across
       // depth edges (nearest filtering would quantise every seen point by up to half a texel).
-      for (int a = 0; a < 2; ++a) {
+      for (int a = 0; a < (options.seen_points ? 2 : 1); ++a) {
         glBindTexture(GL_TEXTURE_2D, maps[i]->colorTexture(a));
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
@@ -567,7 +574,7 @@ struct Renderer::Impl {
       glActiveTexture(GL_TEXTURE0);
       glBindTexture(GL_TEXTURE_2D, map.colorTexture(0));
       glActiveTexture(GL_TEXTURE1);
-      glBindTexture(GL_TEXTURE_2D, map.colorTexture(1));
+      if (options.seen_points) glBindTexture(GL_TEXTURE_2D, map.colorTexture(1));
       p.set("u_seen_offset", glm::vec3(pv.volume.eye - cam.origin));
       for (size_t set = 0; set < sets; ++set) {
         MeshBuffers& mb = meshSlot();
@@ -798,7 +805,10 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     while (cubes.size() < n_el) cubes.push_back(std::make_unique<CubeTarget>());
     for (size_t e = 0; e < n_el; ++e) {
       CubeTarget& c = *cubes[e];
-      if (c.size != options.map_size) c.create(options.map_size, {GL_RGBA16F, GL_RGBA32F});
+      if (c.size != options.map_size) {
+        if (options.seen_points) c.create(options.map_size, {GL_RGBA16F, GL_RGBA32F});
+        else c.create(options.map_size, {GL_RGBA16F});
+      }
       const Vec3 centre = Vec3(scene.elements[e].local_to_world[3]);
       const double near_m = 1e-3, far_m = 2.0 * (scene.boundsRadius() + glm::length(centre - scene.bounds_min)) + 1.0;
       const Mat4 proj = glm::perspective(kPi / 2, 1.0, near_m, far_m);
@@ -819,7 +829,10 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   t0 = Clock::now();
   if (!frame_target || frame_target->width() != ob.width || frame_target->height() != ob.height)
     frame_target = std::make_unique<Framebuffer>(
-        ob.width, ob.height, std::vector<ColorFormat>{ColorFormat::RGBA32F, ColorFormat::RGBA32F, ColorFormat::RGBA32F},
+        ob.width, ob.height,
+        options.seen_points
+            ? std::vector<ColorFormat>{ColorFormat::RGBA32F, ColorFormat::RGBA32F, ColorFormat::RGBA32F}
+            : std::vector<ColorFormat>{ColorFormat::RGBA32F},
         DepthFormat::Depth32F);
   frame_target->bind();
   frame_target->clear({0, 0, 0, 0});
@@ -853,7 +866,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
         glActiveTexture(GL_TEXTURE0);
         glBindTexture(GL_TEXTURE_CUBE_MAP, cubes[e]->colors[0]);
         glActiveTexture(GL_TEXTURE1);
-        glBindTexture(GL_TEXTURE_CUBE_MAP, cubes[e]->colors[1]);
+        if (options.seen_points) glBindTexture(GL_TEXTURE_CUBE_MAP, cubes[e]->colors[1]);
         glActiveTexture(GL_TEXTURE0);
         p.set("u_cube", 0);
         p.set("u_seen_cube", 1);
@@ -867,9 +880,17 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   glFinish();
   checkGlError("rendering a frame");
   out.stages.ran("second-pass", msSince(t0));
+  if (options.seen_points)
+    out.stages.ran("seen-points", 0, -1, "world-position attachments in every pass (for accuracy reports)");
+  else
+    out.stages.skipped("seen-points", "not requested: colour only (no seen-point attachments)");
   out.elements = std::move(frames);
 
-  if (options.read_back) {
+  if (options.read_back && !options.seen_points) {
+    const std::vector<float> color = frame_target->readFloat4(0);  // rows top-down
+    out.color.resize(size_t(ob.width) * size_t(ob.height));
+    for (size_t i = 0; i < out.color.size(); ++i) out.color[i] = Vec3(color[4 * i], color[4 * i + 1], color[4 * i + 2]);
+  } else if (options.read_back) {
     const std::vector<float> color = frame_target->readFloat4(0), seen = frame_target->readFloat4(1),
                              surf = frame_target->readFloat4(2);  // rows top-down
     const size_t n = size_t(ob.width) * size_t(ob.height);

@@ -42,6 +42,10 @@ struct RendererOptions {
   // (the scene's render.dispersion and spectral_samples); otherwise every element gets these channels.
   VertexStageOptions vertex;
   bool read_back = true;            // false: leave the frame on the GPU (benchmarks of the draw alone)
+  // false: colour only, for viewing (pvrr render): no seen-point and surface attachments in any pass and
+  // RasterFrame::seen / element / element_point left empty; the accuracy reports need them on. Stage
+  // "seen-points" reports which.
+  bool seen_points = true;
   // Which colour channel's texture coordinates feed the per-pixel seen point (RasterFrame::seen) in pvrr
   // mode: -1 the fit channel (the middle one with dispersion, else the only one); c >= 0 channel c (clamped
   // to the last channel), e.g. 0 and 2 give red's and blue's seen points on a dispersive lens.

@@ -1,0 +1,59 @@
+// RendererOptions::seen_points off (pvrr render: the picture only): every mode draws the same colours as with
+// the seen-point attachments on, leaves the seen points out, and says so in its stages. OSMesa and EGL.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "pvrr/gl/context.h"
+#include "pvrr/gl/renderer.h"
+#include "pvrr/scene_build.h"
+#include "pvrr/scene_json.h"
+
+namespace pvrr {
+namespace {
+
+// The same shaders and inputs, minus outputs that are not written: the colours should agree to float
+// rounding; 1e-6 in linear units is far below one 8-bit step (~4e-3).
+constexpr double kColourTol = 1e-6;
+
+class ColourOnlyTest : public ::testing::TestWithParam<gl::GlBackend> {};
+
+TEST_P(ColourOnlyTest, SameColoursWithoutSeenPoints) {
+  std::unique_ptr<gl::GlContext> ctx;
+  try {
+    ctx = gl::GlContext::create(GetParam());
+  } catch (const std::exception& e) {
+    FAIL() << "no GL context: " << e.what();
+  }
+  for (const char* scene : {"car-mirror", "reading-lens", "mirror-pair"}) {
+    Scene s = buildScene(loadScene(std::string(PVRR_SOURCE_DIR) + "/models/" + scene + ".json",
+                                   {"observer.image_size=[96,72]", "render.map_size=256"}));
+    RayScene rays(s);
+    gl::RendererOptions with, without;
+    with.vertex.channels.clear();
+    without.vertex.channels.clear();
+    without.seen_points = false;
+    gl::Renderer a(s, rays, with), b(s, rays, without);
+    for (gl::RasterMode mode : {gl::RasterMode::Pvrr, gl::RasterMode::Envmap, gl::RasterMode::Raster}) {
+      const gl::RasterFrame fa = a.render(mode), fb = b.render(mode);
+      ASSERT_EQ(fa.color.size(), fb.color.size()) << scene;
+      EXPECT_EQ(fa.seen.size(), fa.color.size());
+      EXPECT_TRUE(fb.seen.empty() && fb.element.empty() && fb.element_point.empty()) << scene;
+      double worst = 0;
+      for (size_t i = 0; i < fa.color.size(); ++i) worst = std::max(worst, glm::length(fa.color[i] - fb.color[i]));
+      EXPECT_LE(worst, kColourTol) << scene << " mode " << int(mode);
+      const StageTiming* on = fa.stages.find("seen-points");
+      const StageTiming* off = fb.stages.find("seen-points");
+      ASSERT_TRUE(on && off) << scene;
+      EXPECT_TRUE(on->ran);
+      EXPECT_FALSE(off->ran);
+      EXPECT_NE(off->reason.find("not requested"), std::string::npos) << off->reason;
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, ColourOnlyTest, ::testing::Values(gl::GlBackend::OsMesa, gl::GlBackend::Egl),
+                         [](const auto& info) { return info.param == gl::GlBackend::OsMesa ? "OsMesa" : "Egl"; });
+
+}  // namespace
+}  // namespace pvrr
