@@ -51,6 +51,10 @@ struct MaterialDesc {
   Vec2 texture_scale_m{1.0};
 };
 
+// The most directional lights, and the most point lights, a scene may hold (the raster shaders' uniform
+// arrays; ambient lights are summed and unlimited).
+constexpr size_t kMaxLightsPerKind = 32;
+
 struct LightDesc {
   enum class Type { Directional, Point, Ambient };
   Type type = Type::Ambient;

@@ -933,6 +933,16 @@ SceneDesc readScene(Ctx& c, const json& doc) {
 
   if (const json* lights = arrayAt(c, top.get("lights"), "lights", "an array of lights")) {
     for (size_t i = 0; i < lights->size(); ++i) s.lights.push_back(readLight(c, &(*lights)[i], indexPath("lights", i)));
+    // The raster shaders hold each kind in a uniform array (shaders/shading.glsl).
+    size_t dir = 0, point = 0;
+    for (const LightDesc& l : s.lights) {
+      dir += l.type == LightDesc::Type::Directional;
+      point += l.type == LightDesc::Type::Point;
+    }
+    if (dir > kMaxLightsPerKind || point > kMaxLightsPerKind)
+      c.fail("lights", "expected at most " + std::to_string(kMaxLightsPerKind) + " directional and " +
+                           std::to_string(kMaxLightsPerKind) + " point lights, got " + std::to_string(dir) +
+                           " directional and " + std::to_string(point) + " point");
   } else {
     s.lights.push_back(LightDesc{});  // no "lights": ambient white, intensity 1 (albedo shown as is)
   }

@@ -1,24 +1,37 @@
 // The environment shading model; keep in step with pvrr/shading.cpp (the reference tracer's copy).
 //   colour = albedo(uv) * (sum ambient + sum_dir max(0, n.(-dir)) L + sum_point max(0, n.l) L / d^2)
 // Positions are relative to the camera origin of the current pass (camera-relative rendering).
-#define MAX_LIGHTS 8
-uniform int u_num_lights;
-uniform int u_light_type[MAX_LIGHTS];       // 0 ambient, 1 directional, 2 point
-uniform vec3 u_light_vec[MAX_LIGHTS];       // directional: travel direction; point: position (relative)
-uniform vec3 u_light_radiance[MAX_LIGHTS];
+// Specialised to the scene's lights when the program is built (pvrr/gl/renderer.cpp prepends
+// NUM_DIR_LIGHTS and NUM_POINT_LIGHTS): constant loop bounds and no per-light branches, the ambient lights
+// summed into one colour. A loop over a uniform light count with a type switch per light cost llvmpipe
+// more than half of a 1280 x 720 raster frame.
+#ifndef NUM_DIR_LIGHTS
+#define NUM_DIR_LIGHTS 0
+#endif
+#ifndef NUM_POINT_LIGHTS
+#define NUM_POINT_LIGHTS 0
+#endif
+uniform vec3 u_ambient;                                   // the sum of the ambient lights
+#if NUM_DIR_LIGHTS > 0
+uniform vec3 u_dir_light_dir[NUM_DIR_LIGHTS];             // the direction the light travels
+uniform vec3 u_dir_light_radiance[NUM_DIR_LIGHTS];
+#endif
+#if NUM_POINT_LIGHTS > 0
+uniform vec3 u_point_light_pos[NUM_POINT_LIGHTS];         // relative to the camera origin
+uniform vec3 u_point_light_radiance[NUM_POINT_LIGHTS];
+#endif
 
 vec3 shadeDiffuse(vec3 albedo, vec3 p, vec3 n) {
-  vec3 light = vec3(0.0);
-  for (int i = 0; i < u_num_lights; ++i) {
-    if (u_light_type[i] == 0) {
-      light += u_light_radiance[i];
-    } else if (u_light_type[i] == 1) {
-      light += max(0.0, -dot(n, u_light_vec[i])) * u_light_radiance[i];
-    } else {
-      vec3 to = u_light_vec[i] - p;
-      float d2 = dot(to, to);
-      if (d2 > 0.0) light += max(0.0, dot(n, to) * inversesqrt(d2)) / d2 * u_light_radiance[i];
-    }
+  vec3 light = u_ambient;
+#if NUM_DIR_LIGHTS > 0
+  for (int i = 0; i < NUM_DIR_LIGHTS; ++i) light += max(0.0, -dot(n, u_dir_light_dir[i])) * u_dir_light_radiance[i];
+#endif
+#if NUM_POINT_LIGHTS > 0
+  for (int i = 0; i < NUM_POINT_LIGHTS; ++i) {
+    vec3 to = u_point_light_pos[i] - p;
+    float d2 = dot(to, to);
+    if (d2 > 0.0) light += max(0.0, dot(n, to) * inversesqrt(d2)) / d2 * u_point_light_radiance[i];
   }
+#endif
   return albedo * light;
 }

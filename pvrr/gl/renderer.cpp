@@ -215,12 +215,20 @@ struct Renderer::Impl {
   const Scene& scene;
   const RayScene& rays;
   RendererOptions options;
-  // The element programs' defines, plus NO_SEEN_POINTS when RendererOptions::seen_points is off.
+  // A program's defines, plus the scene's light counts (shaders/shading.glsl) and NO_SEEN_POINTS when
+  // RendererOptions::seen_points is off.
   std::vector<std::string> defines(std::vector<std::string> d) const {
+    int dir = 0, point = 0;
+    for (const Light& l : scene.lights) {
+      dir += l.type == Light::Type::Directional;
+      point += l.type == Light::Type::Point;
+    }
+    d.push_back("#define NUM_DIR_LIGHTS " + std::to_string(dir));
+    d.push_back("#define NUM_POINT_LIGHTS " + std::to_string(point));
     if (!options.seen_points) d.push_back("#define NO_SEEN_POINTS");
     return d;
   }
-  Program env_program = makeProgram("env.vert", "env.frag");
+  Program env_program = makeProgram("env.vert", "env.frag", defines({}));
   Program sky_program = makeProgram("sky.vert", "sky.frag");
   Program plain_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_PLAIN"}));
   Program envmap_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_ENVMAP"}));
@@ -275,24 +283,27 @@ struct Renderer::Impl {
     if (empty_vao) glDeleteVertexArrays(1, &empty_vao);
   }
 
+  // The uniforms of shaders/shading.glsl, for a pass whose camera origin is `origin`.
   void setLights(const Program& p, const Vec3& origin) const {
-    int types[8] = {};
-    float vecs[24] = {}, rad[24] = {};
-    int n = 0;
+    Vec3 ambient(0.0);
+    std::vector<float> dir_vec, dir_rad, point_pos, point_rad;
+    auto push = [](std::vector<float>& to, const Vec3& v) { to.insert(to.end(), {float(v.x), float(v.y), float(v.z)}); };
     for (const Light& l : scene.lights) {
-      if (n == 8) break;
-      types[n] = l.type == Light::Type::Ambient ? 0 : l.type == Light::Type::Directional ? 1 : 2;
-      Vec3 v = l.type == Light::Type::Point ? l.position - origin : l.direction;
-      for (int c = 0; c < 3; ++c) {
-        vecs[3 * n + c] = float(v[c]);
-        rad[3 * n + c] = float(l.radiance[c]);
+      switch (l.type) {
+        case Light::Type::Ambient: ambient += l.radiance; break;
+        case Light::Type::Directional: push(dir_vec, l.direction), push(dir_rad, l.radiance); break;
+        case Light::Type::Point: push(point_pos, l.position - origin), push(point_rad, l.radiance); break;
       }
-      ++n;
     }
-    p.set("u_num_lights", n);
-    glUniform1iv(p.uniformLocation("u_light_type"), 8, types);
-    p.setVec3("u_light_vec", vecs, 8);
-    p.setVec3("u_light_radiance", rad, 8);
+    p.set("u_ambient", glm::vec3(ambient));
+    if (!dir_vec.empty()) {
+      p.setVec3("u_dir_light_dir", dir_vec.data(), int(dir_vec.size() / 3));
+      p.setVec3("u_dir_light_radiance", dir_rad.data(), int(dir_rad.size() / 3));
+    }
+    if (!point_pos.empty()) {
+      p.setVec3("u_point_light_pos", point_pos.data(), int(point_pos.size() / 3));
+      p.setVec3("u_point_light_radiance", point_rad.data(), int(point_rad.size() / 3));
+    }
   }
 
   // Sky and environment from a camera at `origin`; `view_origin` is where the viewing rays start (for the

@@ -180,6 +180,22 @@ void expectContains(const std::string& message, const std::string& part) {
   EXPECT_NE(message.find(part), std::string::npos) << "message: " << message << "\nexpected to contain: " << part;
 }
 
+// The raster shaders hold at most kMaxLightsPerKind lights of each kind: one more is refused, naming the
+// counts, rather than dropped in GL while the tracer keeps it.
+TEST(SceneJson, TooManyLightsOfOneKindAreRejected) {
+  auto withLights = [](size_t dir, size_t point) {
+    std::string lights = "\"lights\": [{\"type\": \"ambient\"}";
+    for (size_t i = 0; i < dir; ++i) lights += ", {\"type\": \"directional\", \"direction\": [0, -1, 0]}";
+    for (size_t i = 0; i < point; ++i) lights += ", {\"type\": \"point\", \"position\": [0, 2, 0]}";
+    return edited("\"environment\": [", lights + "],\n  \"environment\": [");
+  };
+  EXPECT_EQ(parse(withLights(kMaxLightsPerKind, kMaxLightsPerKind)).lights.size(), 2 * kMaxLightsPerKind + 1);
+  EXPECT_EQ(errorOf(withLights(kMaxLightsPerKind + 1, 0)),
+            kName + ": lights: expected at most 32 directional and 32 point lights, got 33 directional and 0 point");
+  EXPECT_EQ(errorOf(withLights(0, kMaxLightsPerKind + 1)),
+            kName + ": lights: expected at most 32 directional and 32 point lights, got 0 directional and 33 point");
+}
+
 TEST(SceneJson, SyntaxErrorGivesLineAndColumn) {
   // The stray '}' is on line 3, column 15.
   const std::string text = "{\n  \"version\": 1,\n  \"observer\": }\n";
