@@ -310,17 +310,25 @@ struct Renderer::Impl {
   // two-sided normal), relative to `origin`.
   // reversed_depth: the zooming-region pass (view_volume.h): the fragment farthest from the camera wins.
   // rays_from: where the viewing rays start (two-sided normals face it); the camera unless given.
+  // Forward passes (not reversed_depth) draw the sky last, where the depth buffer is still clear, so that
+  // no pixel is shaded twice for it; what was drawn into the target before (the elements of the second
+  // pass, drawn first so that the environment behind them fails the early depth test) stays.
   void drawEnvironment(const Mat4& view, const Mat4& proj, const Vec3& origin, bool reversed_depth = false,
                        const Vec3* rays_from = nullptr) const {
     const Mat4 vp = relativeViewProj(proj, view, origin);
-    glDisable(GL_DEPTH_TEST);
-    glDepthMask(GL_FALSE);
-    sky_program.use();
-    sky_program.set("u_inv_view_proj", toFloat(glm::inverse(vp)));
-    sky_program.set("u_background", glm::vec3(scene.render.background));
-    sky_program.set("u_far", float(scene.render.far_distance_m));
-    glBindVertexArray(empty_vao);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
+    auto drawSky = [&] {
+      sky_program.use();
+      sky_program.set("u_inv_view_proj", toFloat(glm::inverse(vp)));
+      sky_program.set("u_background", glm::vec3(scene.render.background));
+      sky_program.set("u_far", float(scene.render.far_distance_m));
+      glBindVertexArray(empty_vao);
+      glDrawArrays(GL_TRIANGLES, 0, 3);
+    };
+    if (reversed_depth) {  // depth cleared to 0: the sky first, without depth
+      glDisable(GL_DEPTH_TEST);
+      glDepthMask(GL_FALSE);
+      drawSky();
+    }
     glEnable(GL_DEPTH_TEST);
     glDepthMask(GL_TRUE);
     glDepthFunc(reversed_depth ? GL_GREATER : GL_LESS);
@@ -338,6 +346,13 @@ struct Renderer::Impl {
       env_program.set("u_has_texture", mat.texture >= 0 ? 1 : 0);
       if (mat.texture >= 0) glBindTexture(GL_TEXTURE_2D, textures[size_t(mat.texture)].name());
       draw(env_meshes[m]);
+    }
+    if (!reversed_depth) {  // the sky triangle lies at depth 1: it passes only where nothing was drawn
+      glDepthFunc(GL_LEQUAL);
+      glDepthMask(GL_FALSE);
+      drawSky();
+      glDepthMask(GL_TRUE);
+      glDepthFunc(GL_LESS);
     }
   }
 
@@ -850,7 +865,6 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   const double near_m = 1e-3;
   const double far_m = 4.0 * (scene.boundsRadius() + glm::length(ob.eye - 0.5 * (scene.bounds_min + scene.bounds_max))) + 1.0;
   const Mat4 view = ob.view(), proj = ob.projection(near_m, far_m);
-  drawEnvironment(view, proj, ob.eye);
   const Mat4 vp = relativeViewProj(proj, view, ob.eye);
   PassCamera eye_cam;
   eye_cam.origin = ob.eye;
@@ -888,6 +902,9 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       draw(mb);
     }
   }
+  // The environment after the elements: behind a lens or mirror it fails the early depth test, unshaded.
+  frame_target->bind();
+  drawEnvironment(view, proj, ob.eye);
   glFinish();
   checkGlError("rendering a frame");
   out.stages.ran("second-pass", msSince(t0));
