@@ -75,7 +75,7 @@ struct NurbsGraph {
   Vec2 uv_axis{0};
   // Affine guess (u, v) ~ A (x, y) + b, least squares over the table.
   double a[2][3] = {{0, 0, 0}, {0, 0, 0}};
-  std::vector<Vec2> table_uv, table_xy;
+  std::vector<Vec2> table_uv, table_xy;  // regular samples only (see singular())
   double min_nz = 0;    // cos(max slope)
 
   Vec2 clampUv(Vec2 uv) const {
@@ -136,6 +136,13 @@ struct NurbsGraph {
   // Graph z(x, y) = z of the surface and its derivatives, from the derivatives at the (u, v) over (x, y):
   // with J = d(x, y)/d(u, v) and a_i = J^-1 e_i, z_i = grad z . a_i and, differentiating F(u(x)) = x twice,
   // z_ij = Q_z(a_i, a_j) - grad z . J^-1 Q_xy(a_i, a_j), Q(a, b) = P_uu a0 b0 + P_uv (a0 b1 + a1 b0) + P_vv a1 b1.
+  // Whether d(x, y)/d(u, v) is singular at d: a collapsed edge or a pole of the parametrisation (the apex
+  // of a spherical cap built from arcs, say), where the graph is smooth but graph() would divide by zero.
+  static bool singular(const SurfaceDerivs& d) {
+    const double det = d.du.x * d.dv.y - d.dv.x * d.du.y;
+    return !(std::abs(det) > 1e-9 * glm::length(Vec2(d.du)) * glm::length(Vec2(d.dv)));
+  }
+
   static SagDerivs graph(const SurfaceDerivs& d) {
     const double det = d.du.x * d.dv.y - d.dv.x * d.du.y;
     const Vec2 a1(d.dv.y / det, -d.du.y / det), a2(-d.dv.x / det, d.du.x / det);
@@ -178,7 +185,7 @@ class NurbsSag final : public SagSurface {
     Vec2 uv;
     SurfaceDerivs d;
     const bool over = g_->invert(x, y, uv, d);
-    SagDerivs z = NurbsGraph::graph(d);
+    SagDerivs z = NurbsGraph::singular(d) ? nearSingular(x, y, d) : NurbsGraph::graph(d);
     if (!over) {
       const double dx = x - d.p.x, dy = y - d.p.y;
       z.z += z.zx * dx + z.zy * dy + 0.5 * (z.zxx * dx * dx + 2 * z.zxy * dx * dy + z.zyy * dy * dy);
@@ -191,6 +198,35 @@ class NurbsSag final : public SagSurface {
   std::shared_ptr<const SagSurface> withVertex(double z_vertex) const override {
     return std::make_shared<NurbsSag>(g_, outline(), z_vertex);
   }
+
+ private:
+  // The graph's derivatives at a singular point of the parametrisation, whose z is d.p.z: the mean of the
+  // derivatives at the four points h away along x and y, which is the value at the centre to O(h^2)
+  // (h = 1e-6 of the surface's extent: ~1e-12 relative for a smooth surface). Throws when those are
+  // singular too (a degenerate line, not a point).
+  SagDerivs nearSingular(double x, double y, const SurfaceDerivs& d) const {
+    const double h = 1e-6 * std::max(g_->scale, 1e-9);
+    SagDerivs m{};
+    const double offsets[4][2] = {{h, 0}, {-h, 0}, {0, h}, {0, -h}};
+    for (const auto& o : offsets) {
+      Vec2 uv;
+      SurfaceDerivs dn;
+      g_->invert(x + o[0], y + o[1], uv, dn);
+      if (NurbsGraph::singular(dn))
+        throw Error(g_->what + ": the surface's parametrisation is degenerate along a line through (" + num(x) +
+                    ", " + num(y) + ") m: no slope there");
+      const SagDerivs gn = NurbsGraph::graph(dn);
+      m.zx += 0.25 * (gn.zx - gn.zxx * o[0] - gn.zxy * o[1]);
+      m.zy += 0.25 * (gn.zy - gn.zxy * o[0] - gn.zyy * o[1]);
+      m.zxx += 0.25 * gn.zxx;
+      m.zxy += 0.25 * gn.zxy;
+      m.zyy += 0.25 * gn.zyy;
+    }
+    m.z = d.p.z;
+    return m;
+  }
+
+ public:
 
   std::string describe() const override {
     const Vec3 lo = g_->surface->evaluate(g_->dom.u0, g_->dom.v0).p, hi = g_->surface->evaluate(g_->dom.u1, g_->dom.v1).p;
@@ -223,8 +259,11 @@ SagSurfacePtr makeNurbsSag(std::shared_ptr<const NurbsSurface> surface, const Ou
     for (int j = 0; j < kGraphTable; ++j) {
       const Vec2 uv(g->dom.u0 + (g->dom.u1 - g->dom.u0) * i / (kGraphTable - 1),
                     g->dom.v0 + (g->dom.v1 - g->dom.v0) * j / (kGraphTable - 1));
-      const Vec3 p = g->surface->evaluate(uv.x, uv.y).p;
+      const SurfaceDerivs sd = g->surface->evaluate(uv.x, uv.y);
+      const Vec3 p = sd.p;
       if (!isFinite(p)) throw Error(what + ": the surface is not finite at (u, v) = (" + num(uv.x) + ", " + num(uv.y) + ")");
+      // Newton cannot start at a singular point of (u, v) -> (x, y) (a pole of the parametrisation).
+      if (NurbsGraph::singular(sd)) continue;
       g->table_uv.push_back(uv);
       g->table_xy.emplace_back(p.x, p.y);
       scale = std::max({scale, std::abs(p.x), std::abs(p.y)});

@@ -143,6 +143,28 @@ TEST(NurbsSag, RationalCylinderMatchesTheAnalyticSag) {
   EXPECT_EQ(moved->evaluate(0.01, 0.002).p.z, graph->evaluate(0.01, 0.002).p.z - 0.003);
 }
 
+// A spherical cap built from rational arcs (makeSphereCap) has a pole of its parametrisation at its apex,
+// the lens axis: there d(x, y)/d(u, v) is singular, and the slope and curvature come from the points around
+// it. The graph still matches the analytic sphere, at the apex and next to it.
+TEST(NurbsSag, SphereCapWithItsPoleOnTheAxisMatchesTheSphere) {
+  const double r = 0.2;
+  const Outline disc = Outline::circle(0.06);
+  auto cap = std::make_shared<NurbsSurface>(makeSphereCap(Vec3(0, 0, -r), r, 0.3));
+  const SagSurfacePtr graph = makeNurbsSag(cap, disc, std::nullopt, 0, "sphere cap", 0.0);
+  const SagSurfacePtr exact = makeSphere(r, disc);
+  for (const Vec2 p : {Vec2(0, 0), Vec2(1e-9, 0), Vec2(0, -1e-7), Vec2(1e-5, 2e-5), Vec2(0.01, -0.02), Vec2(-0.025, 0.015)}) {
+    ASSERT_TRUE(graph->defined(p.x, p.y)) << p.x << ", " << p.y;
+    const SagDerivs a = graph->sag(p.x, p.y), b = exact->sag(p.x, p.y);
+    EXPECT_NEAR(a.z, b.z, 1e-15) << p.x << ", " << p.y;
+    EXPECT_NEAR(a.zx, b.zx, 1e-10) << p.x << ", " << p.y;
+    EXPECT_NEAR(a.zy, b.zy, 1e-10) << p.x << ", " << p.y;
+    EXPECT_NEAR(a.zxx, b.zxx, 1e-7 / r) << p.x << ", " << p.y;
+    EXPECT_NEAR(a.zxy, b.zxy, 1e-7 / r) << p.x << ", " << p.y;
+    EXPECT_NEAR(a.zyy, b.zyy, 1e-7 / r) << p.x << ", " << p.y;
+    EXPECT_LT(angleBetween(graph->normal(p.x, p.y), exact->normal(p.x, p.y)), 1e-10);
+  }
+}
+
 TEST(NurbsSag, ContinuesBeyondTheSurfaceWithContinuousSlope) {
   // The patch spans x in [-r/sqrt(2), r/sqrt(2)] and y in [-h/2, h/2]; outside, the Taylor continuation.
   const double r = 0.1, h = 0.06, edge = r * std::sqrt(0.5);
