@@ -460,6 +460,11 @@ struct Renderer::Impl {
   size_t next_mesh = 0;
 
   static int interfaces(const Element& el) { return el.type == ElementType::Lens ? 2 : 1; }
+  // A top-level element whose interfaces reach render.max_depth (a lens with max_depth 1): the tracer
+  // absorbs at its back surface, so it is drawn dark and needs no map.
+  bool beyondDepth(const ElementFrame& f) const {
+    return interfaces(scene.elements[size_t(f.element)]) > scene.render.max_depth;
+  }
 
   VertexStageOptions optionsFor(size_t e) const {
     VertexStageOptions o = options.vertex;
@@ -529,7 +534,8 @@ struct Renderer::Impl {
     // A top-level element outside the observer's view needs no map (its second-pass triangles are clipped).
     const Observer& ob = scene.observer;
     const Mat4 eye_clip = ob.projection(1e-3, 1e6) * ob.view();
-    for (MapPass& mp : passes) mp.visible = mayBeInVolume(mp.owner->world_pos, eye_clip);
+    for (MapPass& mp : passes)
+      mp.visible = mayBeInVolume(mp.owner->world_pos, eye_clip) && !beyondDepth(*mp.owner);
     const int max_depth = scene.render.max_depth;
     for (size_t i = 0; i < passes.size(); ++i) {
       if (!passes[i].visible) continue;
@@ -540,8 +546,11 @@ struct Renderer::Impl {
         if (int(b) == owner.element || !mayBeInVolume(frames[b].world_pos, pv.volume.projection * pv.volume.view)) continue;
         const Element& el = scene.elements[b];
         const size_t views_needed = size_t(std::max(1, el.patches_u * el.patches_v));
-        if (depth >= max_depth || passes.size() + views_needed > kMaxFirstPasses) {
-          *budget_hit = *budget_hit || depth < max_depth;
+        // The tracer absorbs at an element event with depth >= max_depth; a lens's back surface is the
+        // event after its front, so the element is dark unless all its interfaces come before the limit.
+        const bool too_deep = depth + interfaces(el) > max_depth;
+        if (too_deep || passes.size() + views_needed > kMaxFirstPasses) {
+          *budget_hit = *budget_hit || !too_deep;
           ++*dark;
           passes[i].nested.push_back({int(b), nullptr, 0});
           continue;
@@ -862,6 +871,10 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
         DepthFormat::Depth32F);
   frame_target->bind();
   frame_target->clear({0, 0, 0, 0});
+  // The elements come first: the depth state must not depend on what an earlier pass (or none) left.
+  glEnable(GL_DEPTH_TEST);
+  glDepthMask(GL_TRUE);
+  glDepthFunc(GL_LESS);
   const double near_m = 1e-3;
   const double far_m = 4.0 * (scene.boundsRadius() + glm::length(ob.eye - 0.5 * (scene.bounds_min + scene.bounds_max))) + 1.0;
   const Mat4 view = ob.view(), proj = ob.projection(near_m, far_m);
@@ -875,7 +888,8 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     const bool lens = el.type == ElementType::Lens;
     frame_target->bind();
     if (mode == RasterMode::Pvrr) {
-      drawPvrrElement(frames[e], top_slot[e], eye_cam, options.seen_channel);
+      if (beyondDepth(frames[e])) drawDarkElement(frames[e], eye_cam);
+      else drawPvrrElement(frames[e], top_slot[e], eye_cam, options.seen_channel);
     } else {
       ElementFrame f = prepareElement(scene, int(e));
       if (lens && mode == RasterMode::Envmap) traceVertexRays(rays, f, ob.eye, VertexStageOptions{});

@@ -52,6 +52,34 @@ TEST_P(ColourOnlyTest, SameColoursWithoutSeenPoints) {
   }
 }
 
+// The first frame of a fresh renderer in each mode (no earlier pass has set any GL state) shows the
+// elements where a later frame does: the same element pixels, the same colours.
+TEST_P(ColourOnlyTest, FirstFrameOfEachModeEqualsALaterOne) {
+  std::unique_ptr<gl::GlContext> ctx;
+  try {
+    ctx = gl::GlContext::create(GetParam());
+  } catch (const std::exception& e) {
+    FAIL() << "no GL context: " << e.what();
+  }
+  Scene s = buildScene(loadScene(std::string(PVRR_SOURCE_DIR) + "/models/car-mirror.json",
+                                 {"observer.image_size=[96,72]", "render.map_size=256"}));
+  RayScene rays(s);
+  for (gl::RasterMode mode : {gl::RasterMode::Raster, gl::RasterMode::Envmap, gl::RasterMode::Pvrr}) {
+    gl::Renderer r(s, rays, gl::RendererOptions{});
+    const gl::RasterFrame first = r.render(mode), second = r.render(mode);
+    size_t element_pixels = 0, same = 0;
+    double worst = 0;
+    for (size_t i = 0; i < first.color.size(); ++i) {
+      element_pixels += second.element[i] >= 0;
+      same += first.element[i] == second.element[i];
+      worst = std::max(worst, glm::length(first.color[i] - second.color[i]));
+    }
+    EXPECT_GT(element_pixels, 200u) << "mode " << int(mode);
+    EXPECT_EQ(same, first.color.size()) << "mode " << int(mode);
+    EXPECT_LE(worst, kColourTol) << "mode " << int(mode);
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, ColourOnlyTest, ::testing::Values(gl::GlBackend::OsMesa, gl::GlBackend::Egl),
                          [](const auto& info) { return info.param == gl::GlBackend::OsMesa ? "OsMesa" : "Egl"; });
 

@@ -100,6 +100,38 @@ TEST_P(LensTypesTest, InvertingPlusLensAndMinusLensMatchTheReference) {
   }
 }
 
+// render.max_depth = 1: the tracer absorbs at the lens's back surface (its second event), so the lens is
+// black in the reference; pvrr draws it dark too, without a first pass for it.
+TEST_P(LensTypesTest, LensBeyondTheDepthLimitIsDarkLikeTheReference) {
+  std::unique_ptr<gl::GlContext> ctx;
+  try {
+    ctx = gl::GlContext::create(GetParam());
+  } catch (const std::exception& e) {
+    FAIL() << "no GL context: " << e.what();
+  }
+  Scene s = lensScene({"plus 10 D", 0.1, -0.1, 0.005, true});
+  s.render.max_depth = 1;
+  RayScene rays(s);
+  TraceOptions to;
+  to.max_depth = 1;
+  const TracedFrame ref = Tracer(rays, to).render();
+  gl::Renderer r(s, rays, gl::RendererOptions{});
+  const gl::RasterFrame f = r.render(gl::RasterMode::Pvrr);
+  size_t lens = 0, dark_ref = 0, dark_pvrr = 0;
+  for (size_t i = 0; i < ref.color.size(); ++i) {
+    if (ref.element[i] < 0) continue;
+    ++lens;
+    dark_ref += glm::length(ref.color[i]) == 0.0;
+    dark_pvrr += glm::length(f.color[i]) < 1e-6;
+  }
+  ASSERT_GT(lens, 2000u);
+  EXPECT_EQ(dark_ref, lens);
+  EXPECT_GE(double(dark_pvrr), 0.99 * double(lens));  // the tessellated rim may differ by a pixel ring
+  const StageTiming* fp = f.stages.find("first-pass");
+  ASSERT_NE(fp, nullptr);
+  EXPECT_EQ(fp->count, 0) << fp->note;  // no map rendered for a lens drawn dark
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, LensTypesTest, ::testing::Values(gl::GlBackend::OsMesa, gl::GlBackend::Egl),
                          [](const auto& info) { return info.param == gl::GlBackend::OsMesa ? "OsMesa" : "Egl"; });
 
