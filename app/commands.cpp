@@ -183,14 +183,17 @@ RenderedFrame timedFrame(LoadedScene& ls, const std::string& mode, const std::st
   // Timed as pvrr render draws for viewing (colour only, no seen-point attachments): one warm-up frame
   // (shader compilation, first uploads), then the median of N with the cache cleared, so every measured
   // frame does all of its stages. The pixels and seen points come from one more frame with seen points on.
-  RenderSession timing;
-  timing.seen_points = false;
   std::vector<double> times;
   RenderedFrame timed;
-  for (int i = 0; i <= frames; ++i) {
-    timing.cache = gl::FrameCache{};
-    timed = renderFrame(ls, mode, gl_backend_name, &timing);
-    if (i > 0) times.push_back(timed.frame_ms);
+  {
+    // Its own scope: its renderer is released while its context is current, before the next one exists.
+    RenderSession timing;
+    timing.seen_points = false;
+    for (int i = 0; i <= frames; ++i) {
+      timing.cache = gl::FrameCache{};
+      timed = renderFrame(ls, mode, gl_backend_name, &timing);
+      if (i > 0) times.push_back(timed.frame_ms);
+    }
   }
   std::sort(times.begin(), times.end());
   *median_ms = times[times.size() / 2];

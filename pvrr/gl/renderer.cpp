@@ -460,6 +460,13 @@ struct Renderer::Impl {
   size_t next_mesh = 0;
 
   static int interfaces(const Element& el) { return el.type == ElementType::Lens ? 2 : 1; }
+  // Whether cached rays were traced for these channels (wavelengths and weights, not just their count).
+  static bool sameChannels(const std::vector<ChannelSpec>& a, const std::vector<ChannelSpec>& b) {
+    if (a.size() != b.size()) return false;
+    for (size_t c = 0; c < a.size(); ++c)
+      if (a[c].wavelength_nm != b[c].wavelength_nm || channelWeight(a, c) != channelWeight(b, c)) return false;
+    return true;
+  }
   // A top-level element whose interfaces reach render.max_depth (a lens with max_depth 1): the tracer
   // absorbs at its back surface, so it is drawn dark and needs no map.
   bool beyondDepth(const ElementFrame& f) const {
@@ -601,7 +608,19 @@ struct Renderer::Impl {
     p.set("u_seen_map", 1);
     setLights(p, cam.origin);
     setElementMaterial(p, el, f.element);
-    const size_t seen_c = seen_channel < 0 ? channels / 2 : std::min(size_t(seen_channel), channels - 1);
+    // The seen point's channel: the one nearest the d line unless asked (the tracer's seen point is the d
+    // line's ray; with RGB channels that is G exactly, with N spectral samples the nearest bin midpoint).
+    size_t seen_c = channels / 2;
+    if (seen_channel >= 0) {
+      seen_c = std::min(size_t(seen_channel), channels - 1);
+    } else if (f.channels.size() == channels) {
+      auto off = [&](size_t c) {
+        const double wl = f.channels[c].wavelength_nm > 0 ? f.channels[c].wavelength_nm : kLineD_nm;
+        return std::abs(wl - kLineD_nm);
+      };
+      for (size_t c = 0; c < channels; ++c)
+        if (off(c) < off(seen_c)) seen_c = c;
+    }
     const size_t sets = channels > 1 ? (channels + 2) / 3 : 1;
     for (size_t v = 0; v < f.views.size(); ++v) {
       const PatchView& pv = f.views[v];
@@ -718,7 +737,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     std::vector<bool> reuse(n_el, false);
     for (size_t e = 0; e < n_el; ++e)
       reuse[e] = cache && cache->valid && cache->elements.size() == n_el &&
-                 cache->elements[e].rays.size() == opts[e].channels.size() &&
+                 sameChannels(cache->elements[e].channels, opts[e].channels) &&
                  same(cache->element_to_eye[e], view * scene.elements[e].local_to_world);
     const bool all_reused = std::all_of(reuse.begin(), reuse.end(), [](bool b) { return b; });
     const bool nothing_moved = all_reused && same(motion, Mat4(1.0)) && !cache->environment_changed;
