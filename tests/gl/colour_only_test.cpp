@@ -8,6 +8,7 @@
 #include "pvrr/gl/renderer.h"
 #include "pvrr/scene_build.h"
 #include "pvrr/scene_json.h"
+#include "support/gl_backends.h"
 
 namespace pvrr {
 namespace {
@@ -19,12 +20,8 @@ constexpr double kColourTol = 1e-6;
 class ColourOnlyTest : public ::testing::TestWithParam<gl::GlBackend> {};
 
 TEST_P(ColourOnlyTest, SameColoursWithoutSeenPoints) {
-  std::unique_ptr<gl::GlContext> ctx;
-  try {
-    ctx = gl::GlContext::create(GetParam());
-  } catch (const std::exception& e) {
-    FAIL() << "no GL context: " << e.what();
-  }
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
   for (const char* scene : {"car-mirror", "reading-lens", "mirror-pair"}) {
     Scene s = buildScene(loadScene(std::string(PVRR_SOURCE_DIR) + "/models/" + scene + ".json",
                                    {"observer.image_size=[96,72]", "render.map_size=256"}));
@@ -55,12 +52,8 @@ TEST_P(ColourOnlyTest, SameColoursWithoutSeenPoints) {
 // The first frame of a fresh renderer in each mode (no earlier pass has set any GL state) shows the
 // elements where a later frame does: the same element pixels, the same colours.
 TEST_P(ColourOnlyTest, FirstFrameOfEachModeEqualsALaterOne) {
-  std::unique_ptr<gl::GlContext> ctx;
-  try {
-    ctx = gl::GlContext::create(GetParam());
-  } catch (const std::exception& e) {
-    FAIL() << "no GL context: " << e.what();
-  }
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
   Scene s = buildScene(loadScene(std::string(PVRR_SOURCE_DIR) + "/models/car-mirror.json",
                                  {"observer.image_size=[96,72]", "render.map_size=256"}));
   RayScene rays(s);
@@ -80,8 +73,7 @@ TEST_P(ColourOnlyTest, FirstFrameOfEachModeEqualsALaterOne) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, ColourOnlyTest, ::testing::Values(gl::GlBackend::OsMesa, gl::GlBackend::Egl),
-                         [](const auto& info) { return info.param == gl::GlBackend::OsMesa ? "OsMesa" : "Egl"; });
+PVRR_GL_BACKENDS(ColourOnlyTest);
 
 }  // namespace
 }  // namespace pvrr

@@ -11,6 +11,7 @@
 #include "pvrr/scene_build.h"
 #include "pvrr/scene_json.h"
 #include "pvrr/tracer.h"
+#include "support/gl_backends.h"
 
 namespace pvrr {
 namespace {
@@ -53,12 +54,8 @@ Errors errors(const TracedFrame& ref, const gl::RasterFrame& f, int y0, int y1) 
 class FreeformLensTest : public ::testing::TestWithParam<gl::GlBackend> {};
 
 TEST_P(FreeformLensTest, ProgressiveLensMatchesTheReference) {
-  std::unique_ptr<gl::GlContext> ctx;
-  try {
-    ctx = gl::GlContext::create(GetParam());
-  } catch (const std::exception& e) {
-    FAIL() << "no GL context: " << e.what();
-  }
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
   Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/progressive-lens.json", {"observer.image_size=[160,120]"}));
   RayScene rays(s);
   const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
@@ -84,8 +81,7 @@ TEST_P(FreeformLensTest, ProgressiveLensMatchesTheReference) {
   for (const VertexRay& v : f.elements[0].rays.at(0)) EXPECT_NE(v.status, VertexStatus::Tir);
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, FreeformLensTest, ::testing::Values(gl::GlBackend::OsMesa, gl::GlBackend::Egl),
-                         [](const auto& info) { return info.param == gl::GlBackend::OsMesa ? "OsMesa" : "Egl"; });
+PVRR_GL_BACKENDS(FreeformLensTest);
 
 }  // namespace
 }  // namespace pvrr

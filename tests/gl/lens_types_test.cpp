@@ -18,6 +18,7 @@
 #include "pvrr/gl/renderer.h"
 #include "pvrr/tracer.h"
 #include "support/test_scenes.h"
+#include "support/gl_backends.h"
 
 namespace pvrr {
 namespace {
@@ -57,12 +58,8 @@ Scene lensScene(const LensCase& c) {
 class LensTypesTest : public ::testing::TestWithParam<gl::GlBackend> {};
 
 TEST_P(LensTypesTest, InvertingPlusLensAndMinusLensMatchTheReference) {
-  std::unique_ptr<gl::GlContext> ctx;
-  try {
-    ctx = gl::GlContext::create(GetParam());
-  } catch (const std::exception& e) {
-    FAIL() << "no GL context: " << e.what();
-  }
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
   for (const LensCase& c : {LensCase{"plus 10 D", 0.1, -0.1, 0.005, true}, LensCase{"minus 10 D", -0.1, 0.1, 0.0015, false}}) {
     Scene s = lensScene(c);
     RayScene rays(s);
@@ -103,12 +100,8 @@ TEST_P(LensTypesTest, InvertingPlusLensAndMinusLensMatchTheReference) {
 // render.max_depth = 1: the tracer absorbs at the lens's back surface (its second event), so the lens is
 // black in the reference; pvrr draws it dark too, without a first pass for it.
 TEST_P(LensTypesTest, LensBeyondTheDepthLimitIsDarkLikeTheReference) {
-  std::unique_ptr<gl::GlContext> ctx;
-  try {
-    ctx = gl::GlContext::create(GetParam());
-  } catch (const std::exception& e) {
-    FAIL() << "no GL context: " << e.what();
-  }
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
   Scene s = lensScene({"plus 10 D", 0.1, -0.1, 0.005, true});
   s.render.max_depth = 1;
   RayScene rays(s);
@@ -132,8 +125,7 @@ TEST_P(LensTypesTest, LensBeyondTheDepthLimitIsDarkLikeTheReference) {
   EXPECT_EQ(fp->count, 0) << fp->note;  // no map rendered for a lens drawn dark
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, LensTypesTest, ::testing::Values(gl::GlBackend::OsMesa, gl::GlBackend::Egl),
-                         [](const auto& info) { return info.param == gl::GlBackend::OsMesa ? "OsMesa" : "Egl"; });
+PVRR_GL_BACKENDS(LensTypesTest);
 
 }  // namespace
 }  // namespace pvrr

@@ -15,6 +15,7 @@
 #include "pvrr/spectrum.h"
 #include "pvrr/tracer.h"
 #include "support/test_scenes.h"
+#include "support/gl_backends.h"
 
 namespace pvrr {
 namespace {
@@ -27,15 +28,6 @@ constexpr double kSeenPointTol_m = 1e-4;
 // Colour: identical shading model; llvmpipe filters sRGB textures in 8 bits and the colour buffer is float.
 // Mean over pixels away from edges, in linear units.
 constexpr double kMeanColourTol = 2e-3;
-
-std::unique_ptr<gl::GlContext> makeContext(gl::GlBackend b) {
-  try {
-    return gl::GlContext::create(b);
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "no GL context: " << e.what();
-    return nullptr;
-  }
-}
 
 // Pixels whose reference seen point is close to all of its 8 neighbours' (no depth edge nearby).
 std::vector<bool> awayFromDepthEdges(const TracedFrame& ref, const Vec3& eye) {
@@ -71,7 +63,7 @@ double medianArcmin(const TracedFrame& ref, const gl::RasterFrame& f) {
 class RendererTest : public ::testing::TestWithParam<gl::GlBackend> {};
 
 TEST_P(RendererTest, RasterEnvironmentMatchesTheTracer) {
-  auto ctx = makeContext(GetParam());
+  auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
   Scene s = test::roomScene(Vec3(0.3, 0.2, 2.0), Vec3(0, -0.2, 0));
   RayScene rays(s);
@@ -93,7 +85,7 @@ TEST_P(RendererTest, RasterEnvironmentMatchesTheTracer) {
 }
 
 TEST_P(RendererTest, PlaneMirrorPvrrIsExactAwayFromDepthEdges) {
-  auto ctx = makeContext(GetParam());
+  auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
   Scene s = test::roomScene(Vec3(0.3, 0.2, 2.0), Vec3(0, 0, 0));
   const cad::Outline outline = cad::Outline::rectangle(1.2, 0.9, 0.1);
@@ -125,7 +117,7 @@ TEST_P(RendererTest, PlaneMirrorPvrrIsExactAwayFromDepthEdges) {
 }
 
 TEST_P(RendererTest, ConvexMirrorPvrrBeatsTheCubeMap) {
-  auto ctx = makeContext(GetParam());
+  auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
   Scene s = test::roomScene(Vec3(0.3, 0.2, 1.2), Vec3(0, 0, 0), 120, 90);
   const cad::Outline outline = cad::Outline::rectangle(0.5, 0.4, 0.05);
@@ -146,7 +138,7 @@ TEST_P(RendererTest, ConvexMirrorPvrrBeatsTheCubeMap) {
 // The car mirror (issue 5): median error <= 1 arcmin at the scene's default tessellation, at least 10x below
 // the cube map's, and falling about quadratically with vertex spacing (log-log slope <= -1.7, 7x7 to 33x33).
 TEST_P(RendererTest, CarMirrorAccuracyAndConvergence) {
-  auto ctx = makeContext(GetParam());
+  auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
   auto load = [](int tess) {
     std::vector<std::string> sets = {"observer.image_size=[320,240]"};
@@ -172,7 +164,7 @@ TEST_P(RendererTest, CarMirrorAccuracyAndConvergence) {
 // The concave make-up mirror: the viewpoint lies in front of the mirror and every hit lies in the zooming
 // region, rendered backwards with a reversed depth test. No holes, no NaN, sub-arcminute median error.
 TEST_P(RendererTest, ConcaveMirrorZoomingRegion) {
-  auto ctx = makeContext(GetParam());
+  auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
   Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/concave-mirror.json", {"observer.image_size=[240,180]"}));
   RayScene rays(s);
@@ -200,7 +192,7 @@ TEST_P(RendererTest, ConcaveMirrorZoomingRegion) {
 // move the viewpoint slightly, by 0.13 mm here, because the angular objective depends on the hit points;
 // every vertex stays exact either way.)
 TEST_P(RendererTest, EyeFixedCacheMatchesAFreshFrame) {
-  auto ctx = makeContext(GetParam());
+  auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
   SceneDesc desc = loadScene(PVRR_SOURCE_DIR "/models/spectacle-lens.json", {"observer.image_size=[160,120]"});
   Scene s = buildScene(desc);
@@ -231,7 +223,7 @@ TEST_P(RendererTest, EyeFixedCacheMatchesAFreshFrame) {
 // The spectacle lens (issue 6): median angular error over lens pixels <= 1 arcmin at the default
 // tessellation; the reading lens with RGB dispersion renders three channels from one shared first pass.
 TEST_P(RendererTest, LensAccuracyAndDispersion) {
-  auto ctx = makeContext(GetParam());
+  auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
   {
     Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/spectacle-lens.json", {"observer.image_size=[200,150]"}));
@@ -262,7 +254,7 @@ TEST_P(RendererTest, LensAccuracyAndDispersion) {
 // Patches (paper 4.1): the car mirror split 2 x 2 (each patch its own viewpoint and map) covers every mirror
 // pixel the single patch covers and is as accurate; the automatic split honours its field-of-view bound.
 TEST_P(RendererTest, PatchesCoverTheMirrorAndKeepTheAccuracy) {
-  auto ctx = makeContext(GetParam());
+  auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
   auto run = [&](const std::string& set, gl::RasterFrame* frame, TracedFrame* reference) {
     Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/car-mirror.json", {"observer.image_size=[240,180]", set}));
@@ -305,7 +297,7 @@ const StageTiming& stage(const gl::RasterFrame& f, const std::string& name) {
 // blue (F line) deviates more than red (C line), in the same direction, by the fraction of the deviation
 // that the Abbe number predicts for a thin lens: (n_F - n_C) / (n_d - 1) = 1 / V_d.
 TEST_P(RendererTest, SeenChannelGivesEachChannelsSeenPoint) {
-  auto ctx = makeContext(GetParam());
+  auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
   Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/reading-lens.json", {"observer.image_size=[160,120]"}));
   RayScene rays(s);
@@ -355,7 +347,7 @@ TEST_P(RendererTest, MirrorSeenInAMirror) {
   // outer mirror's ray origins (rayOrigins in pvrr/gl/renderer.cpp); starting them at the outer virtual
   // viewpoint instead, as the paper does, gave 6.4'.
   constexpr double kNestedMedianArcmin = 2.0;
-  auto ctx = makeContext(GetParam());
+  auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
   Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/mirror-pair.json", {"observer.image_size=[160,120]"}));
   RayScene rays(s);
@@ -413,7 +405,7 @@ TEST_P(RendererTest, MirrorSeenInAMirror) {
 
 // A scene with one mirror says why nothing was nested.
 TEST_P(RendererTest, OneMirrorHasNoNesting) {
-  auto ctx = makeContext(GetParam());
+  auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
   Scene s = test::roomScene(Vec3(0.3, 0.2, 2.0), Vec3(0, 0, 0), 32, 24);
   const cad::Outline outline = cad::Outline::rectangle(1.2, 0.9, 0.1);
@@ -431,7 +423,7 @@ TEST_P(RendererTest, OneMirrorHasNoNesting) {
 // pass per patch, summed with the spectral mode's colour weights in ceil(N / 3) additive draws; its colour
 // matches the tracer's spectral mode over the lens, and more closely than the RGB mode does.
 TEST_P(RendererTest, SpectralPvrrMatchesTheSpectralTracer) {
-  auto ctx = makeContext(GetParam());
+  auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
   Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/reading-lens.json",
                                  {"observer.image_size=[160,120]", "render.dispersion=spectral", "render.spectral_samples=16"}));
@@ -605,8 +597,7 @@ TEST(PatchSeam, CarMirrorSeamIsBelowOneTexel) {
   EXPECT_LE(jumps.back(), kMaxSeamTexels);
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, RendererTest, ::testing::Values(gl::GlBackend::OsMesa, gl::GlBackend::Egl),
-                         [](const auto& info) { return info.param == gl::GlBackend::OsMesa ? "OsMesa" : "Egl"; });
+PVRR_GL_BACKENDS(RendererTest);
 
 }  // namespace
 }  // namespace pvrr
