@@ -25,6 +25,7 @@ uniform vec3 u_reflectance;
 uniform vec3 u_metal_n;
 uniform vec3 u_metal_k;
 uniform vec3 u_seen_offset;      // (the map's camera origin) - (this pass's camera origin)
+uniform bool u_additive;         // the second or later of the additive draws of more than three channels
 #if defined(MODE_PVRR)
 uniform sampler2D u_map;         // first pass colour (linear)
 uniform sampler2D u_seen_map;    // first pass seen points, relative to the map's camera origin (LINEAR)
@@ -63,8 +64,8 @@ void main() {
 #else
   vec3 weight = vec3(1.0);
 #if !defined(LENS)
-  if (cos_i <= 0.0) {  // the mirror's back: dark (tracer: kMirrorBackAlbedo)
-    o_color = vec4(0.05 * shadeDiffuse(vec3(1.0), v_pos, -n), 1.0);
+  if (cos_i <= 0.0) {  // the mirror's back: dark (tracer: kMirrorBackAlbedo), once, not in each additive draw
+    o_color = u_additive ? vec4(0.0) : vec4(0.05 * shadeDiffuse(vec3(1.0), v_pos, -n), 1.0);
     o_seen = vec4(v_pos, 1.0);
     return;
   }

@@ -633,6 +633,7 @@ struct Renderer::Impl {
       for (size_t set = 0; set < sets; ++set) {
         MeshBuffers& mb = meshSlot();
         uploadPatch(mb, f, pv, anchor, set, seen_c);
+        p.set("u_additive", set > 0 ? 1 : 0);
         if (set == 1) {
           glEnablei(GL_BLEND, 0);
           glBlendFunc(GL_ONE, GL_ONE);
