@@ -225,6 +225,9 @@ void fitOnePatch(const Scene& scene, const ElementFrame& f, size_t patch_index, 
 
 }  // namespace
 
+// The automatic split stops where a patch would have fewer quads a side than this.
+constexpr int kMinPatchQuads = 4;
+
 void fitPatchViews(const Scene& scene, ElementFrame& f, const VertexStageOptions& opt) {
   auto t0 = std::chrono::steady_clock::now();
   const Element& el = scene.elements[size_t(f.element)];
@@ -243,8 +246,12 @@ void fitPatchViews(const Scene& scene, ElementFrame& f, const VertexStageOptions
       worst_y = std::max(worst_y, v.volume.fov_y_rad);
     }
     if (std::max(worst_x, worst_y) <= max_fov) break;
-    // Split along the grid direction whose patches still have room, both when both exceed.
-    const int next_u = std::min(pu * 2, f.grid.grid_u - 1), next_v = std::min(pv * 2, f.grid.grid_v - 1);
+    // Split along the grid directions whose patches still have room: every patch keeps at least
+    // kMinPatchQuads quads a side (a patch of one or two quads fits its viewpoint to a handful of rays and
+    // costs a first pass of its own).
+    const int max_u = std::max(pu, (f.grid.grid_u - 1) / kMinPatchQuads),
+              max_v = std::max(pv, (f.grid.grid_v - 1) / kMinPatchQuads);
+    const int next_u = std::min(pu * 2, max_u), next_v = std::min(pv * 2, max_v);
     if (next_u == pu && next_v == pv) {
       f.split_note = "patch field of view still above the threshold at the finest split the grid allows";
       break;

@@ -5,6 +5,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <functional>
+#include <map>
 
 #include "cad/error.h"
 #include "pvrr/gl/gl.h"
@@ -176,6 +179,16 @@ constexpr size_t kMaxFirstPasses = 16;
 // still exceed the pixels it covers in the shipped scenes; full-size nested maps (28 MB each at 1024^2: RGBA16F
 // colour, RGBA32F seen points, 32-bit depth) took the mirror pair's render at 1280 x 720 to 460 MB.
 int nestedMapSize(int parent) { return parent <= 128 ? parent : std::max(128, parent / 2); }
+
+// The map size of each of an element's `patches` top-level patches: render.map_size up to four patches,
+// beyond that shrunk so that all of them together hold about as many texels as four full maps (each patch's
+// view volume is narrower, so its texels cover a smaller angle). At least 128. An automatic split into
+// 16 x 16 patches at full size took 3.3 GB and 14 s a frame.
+int patchMapSize(int map_size, size_t patches) {
+  if (patches <= 4 || map_size <= 128) return map_size;
+  const double shrink = std::ceil(std::sqrt(double(patches) / 4.0));
+  return std::max(128, int(double(map_size) / shrink));
+}
 
 // A camera of one pass (the second pass, or a first pass from a virtual viewpoint): positions are relative
 // to `origin`.
@@ -536,7 +549,8 @@ struct Renderer::Impl {
     size_t slot = 0;
     for (const ElementFrame& f : frames)
       for (size_t v = 0; v < f.views.size(); ++v)
-        passes.push_back({&f, v, interfaces(scene.elements[size_t(f.element)]), slot++, options.map_size, true, {}});
+        passes.push_back({&f, v, interfaces(scene.elements[size_t(f.element)]), slot++,
+                          patchMapSize(options.map_size, f.views.size()), true, {}});
     const size_t top = passes.size();
     // A top-level element outside the observer's view needs no map (its second-pass triangles are clipped).
     const Observer& ob = scene.observer;
@@ -838,10 +852,17 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     const auto t1 = Clock::now();
     renderPasses(frames);
     glFinish();
-    out.stages.ran("first-pass", msSince(t1), rendered,
-                   rendered == int(passes.size()) ? ""
-                                                  : std::to_string(passes.size() - size_t(rendered)) +
-                                                        " map(s) of elements outside the observer's view not rendered");
+    // The note: how many maps of which size, and what was not rendered.
+    std::map<int, int, std::greater<int>> sizes;
+    for (const MapPass& mp : passes)
+      if (mp.visible) ++sizes[mp.size];
+    std::string note;
+    for (const auto& [size, n] : sizes)
+      note += (note.empty() ? "" : ", ") + std::to_string(n) + " x " + std::to_string(size) + "^2";
+    if (rendered != int(passes.size()))
+      note += (note.empty() ? "" : "; ") + std::to_string(passes.size() - size_t(rendered)) +
+              " map(s) of elements outside the observer's view or beyond the depth limit not rendered";
+    out.stages.ran("first-pass", msSince(t1), rendered, note);
     const std::string dark_note =
         dark == 0 ? "" : std::to_string(dark) + " element(s) in a map drawn dark (" +
                              (budget_hit ? "the budget of " + std::to_string(kMaxFirstPasses) + " first passes"

@@ -285,6 +285,28 @@ TEST_P(RendererTest, PatchesCoverTheMirrorAndKeepTheAccuracy) {
   EXPECT_LE(medianArcmin(ref, automatic), 1.0);
 }
 
+// An unreachable field-of-view bound (0.5 deg on a 15 x 15 car mirror): the automatic split stops where a
+// patch would have fewer than 4 quads a side (3 x 3 patches of 14 quads), says so, and the patches' maps
+// shrink so that together they hold about four full maps (1024 / ceil(sqrt(9 / 4)) = 512).
+TEST_P(RendererTest, AutomaticSplitStopsAtFourQuadsAPatchAndShrinksTheMaps) {
+  auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/car-mirror.json",
+                                 {"observer.image_size=[120,90]", "elements[0].max_patch_fov_deg=0.5"}));
+  ASSERT_EQ(s.elements[0].tess_u, 15);
+  RayScene rays(s);
+  gl::Renderer r(s, rays, gl::RendererOptions{});
+  const gl::RasterFrame f = r.render(gl::RasterMode::Pvrr);
+  const ElementFrame& e = f.elements[0];
+  EXPECT_EQ(e.patches_u, 3);
+  EXPECT_EQ(e.patches_v, 3);
+  EXPECT_NE(e.split_note.find("finest split"), std::string::npos) << e.split_note;
+  const StageTiming* fp = f.stages.find("first-pass");
+  ASSERT_NE(fp, nullptr);
+  EXPECT_EQ(fp->count, 9);
+  EXPECT_EQ(fp->note, "9 x 512^2");
+}
+
 const StageTiming& stage(const gl::RasterFrame& f, const std::string& name) {
   static const StageTiming none{};
   const StageTiming* t = f.stages.find(name);
