@@ -170,24 +170,26 @@ Partial evaluateRange(const Data& D, const Vector3d& e, double b, bool derivativ
 // bit-identical whatever the number of threads. Below two blocks the loop runs serially.
 constexpr size_t kEvalBlock = 512;
 
+// range(begin, end) -> T over [0, n) in kEvalBlock blocks, summed with T::add in the fixed tree.
+template <class T, class RangeFn>
+T reduceBlocks(size_t n, const RangeFn& range) {
+  if (n < 2 * kEvalBlock) return range(size_t(0), n);
+  return tbb::parallel_deterministic_reduce(
+      tbb::blocked_range<size_t>(0, n, kEvalBlock), T{},
+      [&](const tbb::blocked_range<size_t>& r, T acc) {
+        acc.add(range(r.begin(), r.end()));
+        return acc;
+      },
+      [](T a, const T& c) {
+        a.add(c);
+        return a;
+      },
+      tbb::simple_partitioner());
+}
+
 Eval evaluate(const Data& D, const Vector3d& e, double b, const Prior& prior, bool derivatives) {
-  const size_t n = D.size();
-  Partial P;
-  if (n < 2 * kEvalBlock) {
-    P = evaluateRange(D, e, b, derivatives, 0, n);
-  } else {
-    P = tbb::parallel_deterministic_reduce(
-        tbb::blocked_range<size_t>(0, n, kEvalBlock), Partial{},
-        [&](const tbb::blocked_range<size_t>& r, Partial acc) {
-          acc.add(evaluateRange(D, e, b, derivatives, r.begin(), r.end()));
-          return acc;
-        },
-        [](Partial a, const Partial& c) {
-          a.add(c);
-          return a;
-        },
-        tbb::simple_partitioner());
-  }
+  const Partial P = reduceBlocks<Partial>(
+      D.size(), [&](size_t begin, size_t end) { return evaluateRange(D, e, b, derivatives, begin, end); });
   Eval E;
   E.F = 0.5 * P.sum;
   if (prior.active) E.F += 0.5 * prior.k * prior.k * (e - prior.nominal).squaredNorm();
@@ -200,6 +202,39 @@ Eval evaluate(const Data& D, const Vector3d& e, double b, const Prior& prior, bo
     }
   }
   return E;
+}
+
+// The fit's metrics at the final eye over one block of rays, and the data-only Gauss-Newton partial sums.
+struct Metrics {
+  Partial gn;
+  double sum_dist2 = 0, sum_ang2 = 0, max_ang = 0;
+  int behind = 0;
+  void add(const Metrics& o) {
+    gn.add(o.gn);
+    sum_dist2 += o.sum_dist2, sum_ang2 += o.sum_ang2, max_ang = std::max(max_ang, o.max_ang), behind += o.behind;
+  }
+};
+
+Metrics metricsRange(const Data& D, const Vector3d& e, size_t begin, size_t end) {
+  Metrics m;
+  m.gn = evaluateRange(D, e, 0.0, true, begin, end);
+  for (size_t i = begin; i < end; ++i) {
+    const Vector3d w = e - D.o[i];
+    m.sum_dist2 += (w - w.dot(D.d[i]) * D.d[i]).squaredNorm();
+    const Vector3d v = D.h[i] - e;
+    const double len = v.norm();
+    if (v.dot(D.d[i]) < 0) ++m.behind;
+    if (!(len > 0)) continue;
+    const double du = v.dot(D.d[i]) / len;
+    const double sin_a = (v / len - du * D.d[i]).norm();
+    // theta = atan2(sin, |cos|); below 1e-3 rad the series theta = sin (1 + sin^2/6) is exact to 1e-13
+    // relative and spares the atan2 (a third of this loop's time).
+    const double ang = sin_a < 1e-3 && du > 0 ? sin_a * (1.0 + sin_a * sin_a / 6.0)
+                                              : std::atan2(sin_a, std::abs(du));
+    m.sum_ang2 += ang * ang;
+    m.max_ang = std::max(m.max_ang, ang);
+  }
+  return m;
 }
 
 double objective(const Data& D, const Vector3d& e, double b, const Prior& prior) {
@@ -222,11 +257,12 @@ struct Refined {
 
 // Levenberg-damped Newton-type iteration on the 3x3 system of evaluate(). Monotone: a step is taken only
 // when F does not increase. One pass over the rays per trial step (F, H and g together).
-Refined gaussNewton(const Data& D, const Vector3d& e0, double b, const Prior& prior, const ViewpointOptions& opt,
-                    double length_scale_m) {
+// `start`: evaluate(D, e0, b, prior, true), which the caller has (its F is the start cost).
+Refined gaussNewton(const Data& D, const Vector3d& e0, const Eval& start, double b, const Prior& prior,
+                    const ViewpointOptions& opt, double length_scale_m) {
   Refined R;
   R.e = e0;
-  Eval cur = evaluate(D, R.e, b, prior, true);
+  Eval cur = start;
   const double F0 = cur.F;
   double mu = 1e-8;  // damping relative to trace(H)/3
   std::string why = "max_iterations";
@@ -467,7 +503,10 @@ ViewpointFit fitViewpoint(const std::vector<ViewpointRay>& rays, const Viewpoint
     b = scale * scale;
   }
   fit.robust_scale_rad = std::sqrt(b);
-  const double F0 = objective(D, e0, b, prior);
+  // The start: F0, and for Gauss-Newton its derivatives too (one pass over the rays for both).
+  const bool newton = opt.solver != ViewpointSolver::kClosedForm && opt.solver != ViewpointSolver::kCeres;
+  const Eval start = evaluate(D, e0, b, prior, newton);
+  const double F0 = start.F;
   fit.cost_initial = F0;
 
   // 2./4. Refinement and acceptance. A refinement is usable when finite, converged and not worse than e0.
@@ -488,7 +527,7 @@ ViewpointFit fitViewpoint(const std::vector<ViewpointRay>& rays, const Viewpoint
     std::vector<Refined> tried;
     bool found = false;
     if (opt.solver != ViewpointSolver::kCeres) {
-      tried.push_back(gaussNewton(D, e0, b, prior, opt, length_scale));
+      tried.push_back(gaussNewton(D, e0, start, b, prior, opt, length_scale));
       found = usable(tried.back());
     }
     if (!found && opt.solver != ViewpointSolver::kGaussNewton) {
@@ -528,28 +567,15 @@ ViewpointFit fitViewpoint(const std::vector<ViewpointRay>& rays, const Viewpoint
   fit.solver_report = report + (b > 0 ? "; Cauchy scale " + fmt("%.3g", arcminutes(std::sqrt(b))) + " arcmin"
                                        : std::string("; no robust loss"));
   fit.accepted = accepted;
-  double sum_dist2 = 0, sum_ang2 = 0, max_ang = 0;
-  for (size_t i = 0; i < n; ++i) {
-    const Vector3d w = e - D.o[i];
-    sum_dist2 += (w - w.dot(D.d[i]) * D.d[i]).squaredNorm();
-    const Vector3d v = D.h[i] - e;
-    const double len = v.norm();
-    if (v.dot(D.d[i]) < 0) ++fit.hits_behind_eye;
-    if (!(len > 0)) continue;
-    const double du = v.dot(D.d[i]) / len;
-    const double sin_a = (v / len - du * D.d[i]).norm();
-    // theta = atan2(sin, |cos|); below 1e-3 rad the series theta = sin (1 + sin^2/6) is exact to 1e-13
-    // relative and spares the atan2 (a third of this loop's time).
-    const double ang = sin_a < 1e-3 && du > 0 ? sin_a * (1.0 + sin_a * sin_a / 6.0)
-                                              : std::atan2(sin_a, std::abs(du));
-    sum_ang2 += ang * ang;
-    max_ang = std::max(max_ang, ang);
-  }
-  fit.rms_line_distance_m = std::sqrt(sum_dist2 / double(n));
-  fit.rms_angle_rad = std::sqrt(sum_ang2 / double(n));
-  fit.max_angle_rad = max_ang;
-  // Data-only Gauss-Newton matrix: no robust weights, no prior (b = 0, inactive prior).
-  fit.condition_number_solution = conditionOf(evaluate(D, e, 0.0, Prior{}, true).H);
+  // With the data-only Gauss-Newton matrix (no robust weights, no prior: b = 0) in the same blocks.
+  const Metrics M = reduceBlocks<Metrics>(n, [&](size_t begin, size_t end) { return metricsRange(D, e, begin, end); });
+  fit.hits_behind_eye = M.behind;
+  fit.rms_line_distance_m = std::sqrt(M.sum_dist2 / double(n));
+  fit.rms_angle_rad = std::sqrt(M.sum_ang2 / double(n));
+  fit.max_angle_rad = M.max_ang;
+  Matrix3d H;
+  H << M.gn.hxx, M.gn.hxy, M.gn.hxz, M.gn.hxy, M.gn.hyy, M.gn.hyz, M.gn.hxz, M.gn.hyz, M.gn.hzz;
+  fit.condition_number_solution = conditionOf(H);
   return fit;
 }
 
