@@ -1,0 +1,115 @@
+// Huge coordinates (a design placed in site or map coordinates, millions of metres from the origin): the
+// whole scene translated by such an offset renders as it does at the origin, in the reference and in every
+// raster mode, because the CPU works in doubles and the GPU in coordinates relative to each pass's camera.
+// OSMesa and EGL.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <iostream>
+#include <vector>
+
+#include "pvrr/gl/renderer.h"
+#include "pvrr/tracer.h"
+#include "support/gl_backends.h"
+#include "support/test_scenes.h"
+
+namespace pvrr {
+namespace {
+
+// Every world position of the scene moved by `offset` (directions unchanged).
+void translate(Scene& s, const Vec3& offset) {
+  s.observer.eye += offset;
+  s.observer.target += offset;
+  for (EnvMesh& m : s.meshes) m.anchor += offset;
+  for (Light& l : s.lights) l.position += offset;
+  for (Element& e : s.elements) {
+    e.local_to_world[3] += Vec4(offset, 0.0);
+    e.world_to_local = glm::inverse(e.local_to_world);
+  }
+  s.updateBounds();
+}
+
+Scene mirrorInARoom(const Vec3& offset) {
+  Scene s = test::roomScene(Vec3(0.3, 0.2, 1.2), Vec3(0, 0, 0), 120, 90);
+  const cad::Outline outline = cad::Outline::rectangle(0.5, 0.4, 0.05);
+  test::addMirror(s, cad::makeSphere(1.0, outline), outline, test::pose(Vec3(0, 0, -0.3), Vec3(0, 0, 1)), 25, 0.9);
+  Light point;
+  point.type = Light::Type::Point;
+  point.position = Vec3(0.5, 2.0, 0.5);
+  point.radiance = Vec3(0.5);
+  s.lights.push_back(point);
+  s.updateBounds();
+  translate(s, offset);
+  return s;
+}
+
+struct Result {
+  std::vector<Vec3> color, seen_rel;  // seen points relative to the eye
+  std::vector<int> element;
+  double median_arcmin = 0;
+};
+
+Result run(const Vec3& offset, gl::RasterMode mode) {
+  Scene s = mirrorInARoom(offset);
+  RayScene rays(s);
+  const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
+  gl::RendererOptions opt;
+  opt.map_size = 512;
+  gl::Renderer r(s, rays, opt);
+  const gl::RasterFrame f = r.render(mode);
+  Result out;
+  out.color = f.color;
+  out.element = f.element;
+  std::vector<double> err;
+  for (size_t i = 0; i < f.seen.size(); ++i) {
+    out.seen_rel.push_back(f.seen[i] - s.observer.eye);
+    if (ref.element[i] >= 0)
+      err.push_back(arcminutes(angleBetween(ref.seen[i] - ref.element_point[i], f.seen[i] - ref.element_point[i])));
+  }
+  std::sort(err.begin(), err.end());
+  out.median_arcmin = err.empty() ? 1e9 : err[err.size() / 2];
+  return out;
+}
+
+class LargeCoordinatesTest : public ::testing::TestWithParam<gl::GlBackend> {};
+
+TEST_P(LargeCoordinatesTest, SceneMillionsOfMetresAwayRendersAsAtTheOrigin) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  const Vec3 far_away(3.2e6, 1.5e3, -5.4e6);  // UTM-like easting/northing, metres
+  for (gl::RasterMode mode : {gl::RasterMode::Pvrr, gl::RasterMode::Envmap, gl::RasterMode::Raster}) {
+    const Result near = run(Vec3(0.0), mode), far = run(far_away, mode);
+    ASSERT_EQ(near.color.size(), far.color.size());
+    size_t differ = 0, pixels = 0;
+    double worst_seen = 0;
+    for (size_t i = 0; i < near.color.size(); ++i) {
+      ASSERT_TRUE(isFinite(far.color[i]) && isFinite(far.seen_rel[i])) << "pixel " << i;
+      if (near.element[i] != far.element[i]) {
+        ++differ;
+        continue;
+      }
+      ++pixels;
+      // Colours: the same shading of the same relative geometry; float rounding of the camera-relative
+      // positions (~1e-7 relative) moves an edge by a pixel at most, so compare the bulk.
+      if (glm::length(near.color[i] - far.color[i]) > 1e-3) ++differ;
+      // Seen points relative to the eye: exact to float rounding of metre-scale coordinates, not of 5e6 m
+      // ones (which would be ~0.5 m).
+      if (near.element[i] >= 0) worst_seen = std::max(worst_seen, glm::length(near.seen_rel[i] - far.seen_rel[i]));
+    }
+    std::cout << "[ measured ] mode " << int(mode) << ": " << differ << " of " << near.color.size()
+              << " pixels differ, seen points within " << worst_seen << " m, median " << near.median_arcmin << "' at the origin, "
+              << far.median_arcmin << "' far away\n";
+    EXPECT_LE(differ, near.color.size() / 100) << "mode " << int(mode);
+    EXPECT_LT(worst_seen, 1e-3) << "mode " << int(mode);
+    if (mode == gl::RasterMode::Pvrr) {
+      EXPECT_LT(far.median_arcmin, 1.0);
+      EXPECT_NEAR(far.median_arcmin, near.median_arcmin, 0.01 + 0.05 * near.median_arcmin);
+    }
+    EXPECT_GT(pixels, 0u);
+  }
+}
+
+PVRR_GL_BACKENDS(LargeCoordinatesTest);
+
+}  // namespace
+}  // namespace pvrr
