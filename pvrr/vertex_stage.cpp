@@ -167,21 +167,24 @@ namespace {
 // The patch's rays for the fit and the view volume: flagged rays (TIR, or out through the lens's edge
 // band) say nothing about where the scene is seen from and are left out, unless too few remain.
 std::vector<ViewpointRay> patchRays(const ElementFrame& f, const cad::GridPatch& gp, int* excluded) {
-  const size_t fit_channel = f.rays.size() / 2;  // the middle (green) channel, or the only one
-  std::vector<ViewpointRay> all, kept;
-  for (uint32_t vi : gp.vertices) {
-    const VertexRay& r = f.rays[fit_channel][vi];
-    all.push_back(ViewpointRay{r.origin, r.dir, r.hit});
-    if (r.status != VertexStatus::Tir) kept.push_back(all.back());
-  }
-  if (excluded) *excluded = int(all.size() - kept.size());
-  return kept.size() < 3 ? all : kept;
+  const std::vector<VertexRay>& rs = f.rays[f.rays.size() / 2];  // the middle (green) channel, or the only one
+  std::vector<ViewpointRay> kept;
+  kept.reserve(gp.vertices.size());
+  for (uint32_t vi : gp.vertices)
+    if (rs[vi].status != VertexStatus::Tir) kept.push_back(ViewpointRay{rs[vi].origin, rs[vi].dir, rs[vi].hit});
+  if (excluded) *excluded = int(gp.vertices.size() - kept.size());
+  if (kept.size() >= 3) return kept;
+  std::vector<ViewpointRay> all;
+  all.reserve(gp.vertices.size());
+  for (uint32_t vi : gp.vertices) all.push_back(ViewpointRay{rs[vi].origin, rs[vi].dir, rs[vi].hit});
+  return all;
 }
 
 // View volume, projective weights and texture coordinates of a patch whose viewpoint is fitted.
-void buildPatchMap(const Scene& scene, const ElementFrame& f, const Element& el, PatchView& pv) {
+// `rays`: the patch's patchRays() (fitOnePatch has them already).
+void buildPatchMap(const Scene& scene, const ElementFrame& f, const Element& el, PatchView& pv,
+                   const std::vector<ViewpointRay>& rays) {
   const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
-  const std::vector<ViewpointRay> rays = patchRays(f, gp, nullptr);
   ViewVolumeOptions vo;
   vo.scene_radius_m = scene.boundsRadius();
   vo.scene_center = 0.5 * (scene.bounds_min + scene.bounds_max);
@@ -219,8 +222,9 @@ void buildPatchMap(const Scene& scene, const ElementFrame& f, const Element& el,
 void fitOnePatch(const Scene& scene, const ElementFrame& f, size_t patch_index, const Element& el, PatchView& pv,
                  const ViewpointOptions& vopt) {
   pv.patch = int(patch_index);
-  pv.fit = fitViewpoint(patchRays(f, f.grid_patches[patch_index], &pv.rays_excluded), vopt);
-  buildPatchMap(scene, f, el, pv);
+  const std::vector<ViewpointRay> rays = patchRays(f, f.grid_patches[patch_index], &pv.rays_excluded);
+  pv.fit = fitViewpoint(rays, vopt);
+  buildPatchMap(scene, f, el, pv, rays);
 }
 
 }  // namespace
@@ -307,7 +311,7 @@ void updateTextureCoordinates(const RayScene& rays, ElementFrame& f) {
       r.hit = h.hit() ? h.point : r.origin + far * r.dir;
     });
   const Element& el = scene.elements[size_t(f.element)];
-  for (PatchView& pv : f.views) buildPatchMap(scene, f, el, pv);
+  for (PatchView& pv : f.views) buildPatchMap(scene, f, el, pv, patchRays(f, f.grid_patches[size_t(pv.patch)], nullptr));
   f.rays_ms = msSince(t0);
 }
 
