@@ -2,6 +2,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <chrono>
 
 #include "cad/error.h"
@@ -166,22 +167,32 @@ namespace {
 
 // The patch's rays for the fit and the view volume: flagged rays (TIR, or out through the lens's edge
 // band) say nothing about where the scene is seen from and are left out, unless too few remain.
-std::vector<ViewpointRay> patchRays(const ElementFrame& f, const cad::GridPatch& gp, int* excluded) {
+// only_in_view: only the rays of vertices in view (ElementFrame::in_view), unless fewer than 3 of the
+// patch's are (`*out_of_view` counts what was left out; 0 when all were taken).
+std::vector<ViewpointRay> patchRays(const ElementFrame& f, const cad::GridPatch& gp, int* excluded,
+                                    bool only_in_view = false, int* out_of_view = nullptr) {
   const std::vector<VertexRay>& rs = f.rays[f.rays.size() / 2];  // the middle (green) channel, or the only one
+  std::vector<uint32_t> verts;
+  verts.reserve(gp.vertices.size());
+  if (only_in_view && !f.in_view.empty())
+    for (uint32_t vi : gp.vertices)
+      if (f.in_view[vi]) verts.push_back(vi);
+  if (verts.size() < 3) verts = gp.vertices;
+  if (out_of_view) *out_of_view = int(gp.vertices.size() - verts.size());
   std::vector<ViewpointRay> kept;
-  kept.reserve(gp.vertices.size());
-  for (uint32_t vi : gp.vertices)
+  kept.reserve(verts.size());
+  for (uint32_t vi : verts)
     if (rs[vi].status != VertexStatus::Tir) kept.push_back(ViewpointRay{rs[vi].origin, rs[vi].dir, rs[vi].hit});
-  if (excluded) *excluded = int(gp.vertices.size() - kept.size());
+  if (excluded) *excluded = int(verts.size() - kept.size());
   if (kept.size() >= 3) return kept;
   std::vector<ViewpointRay> all;
-  all.reserve(gp.vertices.size());
-  for (uint32_t vi : gp.vertices) all.push_back(ViewpointRay{rs[vi].origin, rs[vi].dir, rs[vi].hit});
+  all.reserve(verts.size());
+  for (uint32_t vi : verts) all.push_back(ViewpointRay{rs[vi].origin, rs[vi].dir, rs[vi].hit});
   return all;
 }
 
 // View volume, projective weights and texture coordinates of a patch whose viewpoint is fitted.
-// `rays`: the patch's patchRays() (fitOnePatch has them already).
+// `rays`: the patch's patchRays(..., only_in_view = true): the view volume holds what the viewer sees.
 void buildPatchMap(const Scene& scene, const ElementFrame& f, const Element& el, PatchView& pv,
                    const std::vector<ViewpointRay>& rays) {
   const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
@@ -205,26 +216,46 @@ void buildPatchMap(const Scene& scene, const ElementFrame& f, const Element& el,
       pv.volume.note += (pv.volume.note.empty() ? "" : "; ") + std::to_string(rays.size() - zooming) +
                         " hit(s) beyond the viewpoint are not in this reversed map";
   }
+  // Vertices out of view (their triangles are clipped away by the viewer) take no part in the choice of
+  // projective weights and get finite placeholders where their projection is not.
+  auto counts = [&](uint32_t vi) { return f.in_view.empty() || !pv.in_view || f.in_view[vi]; };
   pv.q.assign(gp.vertices.size(), 1.0);
   bool all_in_front = true;
   for (size_t k = 0; k < gp.vertices.size(); ++k) {
     const Vec4 clip = pv.volume.projection * pv.volume.view * Vec4(f.world_pos[gp.vertices[k]], 1.0);
     pv.q[k] = clip.w;
-    all_in_front = all_in_front && clip.w > 0;
+    if (counts(gp.vertices[k])) all_in_front = all_in_front && clip.w > 0;
+    else if (!(clip.w > 0)) pv.q[k] = 1.0;
   }
   if (!all_in_front) pv.q.assign(gp.vertices.size(), 1.0);
   const size_t channels = f.rays.size();
   pv.st.assign(channels, std::vector<Vec2>(gp.vertices.size()));
   for (size_t c = 0; c < channels; ++c)
-    for (size_t k = 0; k < gp.vertices.size(); ++k) pv.st[c][k] = projectToTexture(pv.volume, f.rays[c][gp.vertices[k]].hit);
+    for (size_t k = 0; k < gp.vertices.size(); ++k) {
+      Vec2 st = projectToTexture(pv.volume, f.rays[c][gp.vertices[k]].hit);
+      if (!counts(gp.vertices[k]) && !(std::isfinite(st.x) && std::isfinite(st.y))) st = Vec2(0.5);
+      pv.st[c][k] = st;
+    }
 }
 
 void fitOnePatch(const Scene& scene, const ElementFrame& f, size_t patch_index, const Element& el, PatchView& pv,
                  const ViewpointOptions& vopt) {
   pv.patch = int(patch_index);
-  const std::vector<ViewpointRay> rays = patchRays(f, f.grid_patches[patch_index], &pv.rays_excluded);
-  pv.fit = fitViewpoint(rays, vopt);
-  buildPatchMap(scene, f, el, pv, rays);
+  // The viewpoint is fitted to all the patch's rays, the view volume to those the viewer sees. (Fitting the
+  // viewpoint to the seen rays alone fits them better, but interpolates worse between the vertices: on the
+  // spectacle lens at 640 x 480, 1.02' median against 0.68'.)
+  const cad::GridPatch& patch = f.grid_patches[patch_index];
+  const std::vector<ViewpointRay> all_rays = patchRays(f, patch, &pv.rays_excluded);
+  const std::vector<ViewpointRay> seen_rays =
+      f.in_view.empty() ? all_rays : patchRays(f, patch, nullptr, true, &pv.rays_out_of_view);
+  // Seen when one of its triangles has all three vertices in view (conservative: those vertices may owe it
+  // to neighbouring triangles).
+  const cad::GridPatch& gp = f.grid_patches[patch_index];
+  pv.in_view = f.in_view.empty() || std::any_of(gp.triangles.begin(), gp.triangles.end(), [&](const cad::Triangle& t) {
+                 return f.in_view[gp.vertices[t.x]] && f.in_view[gp.vertices[t.y]] && f.in_view[gp.vertices[t.z]];
+               });
+  pv.fit = fitViewpoint(all_rays, vopt);
+  buildPatchMap(scene, f, el, pv, seen_rays);
 }
 
 }  // namespace
@@ -232,8 +263,28 @@ void fitOnePatch(const Scene& scene, const ElementFrame& f, size_t patch_index, 
 // The automatic split stops where a patch would have fewer quads a side than this.
 constexpr int kMinPatchQuads = 4;
 
+// ElementFrame::in_view for a viewer with world -> clip matrix `clip`: the vertices of every grid triangle
+// not entirely outside one clip plane (homogeneous outcodes, as GL clips). All 1 when every triangle is.
+std::vector<char> verticesInView(const ElementFrame& f, const Mat4& clip) {
+  std::vector<unsigned> code(f.world_pos.size());
+  for (size_t i = 0; i < f.world_pos.size(); ++i) {
+    const Vec4 c = clip * Vec4(f.world_pos[i], 1.0);
+    code[i] = (c.x < -c.w) | (c.x > c.w) << 1 | (c.y < -c.w) << 2 | (c.y > c.w) << 3 | (c.z < -c.w) << 4 |
+              (c.z > c.w) << 5;
+  }
+  std::vector<char> in(f.world_pos.size(), 0);
+  for (const cad::Triangle& t : f.grid.triangles)
+    if ((code[t.x] & code[t.y] & code[t.z]) == 0) in[t.x] = in[t.y] = in[t.z] = 1;
+  return in;
+}
+
 void fitPatchViews(const Scene& scene, ElementFrame& f, const VertexStageOptions& opt) {
   auto t0 = std::chrono::steady_clock::now();
+  f.in_view.clear();
+  if (opt.viewer_clip) {
+    f.in_view = verticesInView(f, *opt.viewer_clip);
+    if (std::all_of(f.in_view.begin(), f.in_view.end(), [](char c) { return c != 0; })) f.in_view.clear();
+  }
   const Element& el = scene.elements[size_t(f.element)];
   const double max_fov = opt.max_patch_fov_rad > 0 ? opt.max_patch_fov_rad : el.max_patch_fov_rad;
   int pu = el.patches_u, pv = el.patches_v;
@@ -246,6 +297,7 @@ void fitPatchViews(const Scene& scene, ElementFrame& f, const VertexStageOptions
     if (max_fov <= 0 || round >= opt.max_patch_splits) break;
     double worst_x = 0, worst_y = 0;
     for (const PatchView& v : f.views) {
+      if (!v.in_view) continue;  // not drawn: its field of view does not matter
       worst_x = std::max(worst_x, v.volume.fov_x_rad);
       worst_y = std::max(worst_y, v.volume.fov_y_rad);
     }
@@ -311,7 +363,8 @@ void updateTextureCoordinates(const RayScene& rays, ElementFrame& f) {
       r.hit = h.hit() ? h.point : r.origin + far * r.dir;
     });
   const Element& el = scene.elements[size_t(f.element)];
-  for (PatchView& pv : f.views) buildPatchMap(scene, f, el, pv, patchRays(f, f.grid_patches[size_t(pv.patch)], nullptr));
+  for (PatchView& pv : f.views)
+    buildPatchMap(scene, f, el, pv, patchRays(f, f.grid_patches[size_t(pv.patch)], nullptr, true));
   f.rays_ms = msSince(t0);
 }
 

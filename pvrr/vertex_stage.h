@@ -41,6 +41,8 @@ struct PatchView {
   // (plain affine interpolation, as in the paper) when some vertex lies behind the viewpoint.
   std::vector<double> q;
   int rays_excluded = 0;  // flagged (tir / edge) rays left out of the fit
+  int rays_out_of_view = 0;  // rays of vertices the viewer cannot see, left out of the view volume
+  bool in_view = true;    // false: the viewer sees none of the patch (its map need not be rendered)
 };
 
 // One colour channel (wavelength sample) of the vertex stages. The second pass sums the channels' warped
@@ -83,6 +85,12 @@ struct VertexStageOptions {
   }();
   double max_patch_fov_rad = 0;  // overrides the element's when > 0
   int max_patch_splits = 4;      // doublings per direction for the automatic split
+  // World -> clip of the camera that draws the element (the observer's, or the map camera of the element
+  // that shows it). When set, each patch's view volume holds only the rays of the vertices of the triangles
+  // that camera can see (ElementFrame::in_view), so the map spends its texels on what is seen: a spectacle
+  // lens 12 mm from the eye spans ~150 deg, of which a 50 deg view sees a tenth. The viewpoint is still
+  // fitted to all the patch's rays. Unset: all.
+  std::optional<Mat4> viewer_clip;
 };
 
 struct ElementFrame {
@@ -97,6 +105,10 @@ struct ElementFrame {
   double rays_ms = 0, fit_ms = 0;
   int patches_u = 1, patches_v = 1;
   std::string split_note;                    // why patches were split, if they were
+  // Per vertex: 1 when a triangle holding it can be seen by VertexStageOptions::viewer_clip (empty: all
+  // vertices, no viewer given). Vertices of triangles the viewer cannot see get texture coordinates too,
+  // but they shape no pixel.
+  std::vector<char> in_view;
 };
 
 // Tessellates the element (its tess_u x tess_v grid) in local and world coordinates.

@@ -556,7 +556,8 @@ struct Renderer::Impl {
     const Observer& ob = scene.observer;
     const Mat4 eye_clip = ob.projection(1e-3, 1e6) * ob.view();
     for (MapPass& mp : passes)
-      mp.visible = mayBeInVolume(mp.owner->world_pos, eye_clip) && !beyondDepth(*mp.owner);
+      mp.visible = mp.owner->views[mp.view].in_view && mayBeInVolume(mp.owner->world_pos, eye_clip) &&
+                   !beyondDepth(*mp.owner);
     const int max_depth = scene.render.max_depth;
     for (size_t i = 0; i < passes.size(); ++i) {
       if (!passes[i].visible) continue;
@@ -586,8 +587,10 @@ struct Renderer::Impl {
         nf->world_normal = frames[b].world_normal;
         nf->patches_u = el.patches_u;
         nf->patches_v = el.patches_v;
-        traceVertexRays(rays, *nf, pv.volume.eye, rayOrigins(owner, pv, nf->world_pos), opts[b]);
-        fitPatchViews(scene, *nf, opts[b]);
+        VertexStageOptions nested_opt = opts[b];
+        nested_opt.viewer_clip = pv.volume.projection * pv.volume.view;  // seen by the owner's map camera
+        traceVertexRays(rays, *nf, pv.volume.eye, rayOrigins(owner, pv, nf->world_pos), nested_opt);
+        fitPatchViews(scene, *nf, nested_opt);
         if (passes.size() + nf->views.size() > kMaxFirstPasses) {  // an automatic split needed more maps
           *budget_hit = true;
           ++*dark;
@@ -738,7 +741,12 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   bool skip_first_pass = false;
   if (mode == RasterMode::Pvrr && n_el > 0) {
     frames.resize(n_el);
-    for (size_t e = 0; e < n_el; ++e) opts.push_back(optionsFor(e));
+    // Each element's views are fitted to what the observer sees of it.
+    const Mat4 observer_clip = ob.projection(1e-3, 1e6) * ob.view();
+    for (size_t e = 0; e < n_el; ++e) {
+      opts.push_back(optionsFor(e));
+      opts.back().viewer_clip = observer_clip;
+    }
     // Eye-fixed caching (paper 5): an element whose pose relative to the eye is unchanged keeps its rays
     // (in the eye's frame) and its fitted viewpoints; only the scene intersections and texture coordinates
     // are redone, after moving the cached frame rigidly with the eye.

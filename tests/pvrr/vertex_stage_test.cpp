@@ -1,7 +1,11 @@
 // The CPU stages of PVRR: per-vertex rays, viewpoint, view volume and texture coordinates.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "pvrr/optics.h"
+#include "pvrr/scene_build.h"
+#include "pvrr/scene_json.h"
 #include "pvrr/vertex_stage.h"
 #include "support/test_scenes.h"
 
@@ -104,6 +108,39 @@ TEST(VertexStage, LensRaysObeySnellAtBothSurfaces) {
   const Vec3 d0 = glm::normalize(f.world_pos[corner] - s.observer.eye);
   const double dev_r = angleBetween(f.rays[0][corner].dir, d0), dev_b = angleBetween(f.rays[2][corner].dir, d0);
   EXPECT_GT(dev_b, dev_r);
+}
+
+// A spectacle lens 12 mm from the eye spans ~150 deg; a 50 deg view sees a small part of it. With the
+// observer as the viewer, the view volume holds only the rays of the vertices it sees: a much narrower
+// frustum (more texels where they are looked at), every seen vertex's hit inside the map, and the same
+// fitted viewpoint (fitted to all the rays either way).
+TEST(VertexStage, ViewVolumeHoldsWhatTheViewerSees) {
+  Scene s = buildScene(loadScene(std::string(PVRR_SOURCE_DIR) + "/models/spectacle-lens.json", {"observer.image_size=[320,240]"}));
+  RayScene rays(s);
+  ElementFrame all = prepareElement(s, 0);
+  VertexStageOptions opt;
+  traceVertexRays(rays, all, s.observer.eye, opt);
+  ElementFrame seen = all;
+  fitPatchViews(s, all, opt);
+  opt.viewer_clip = s.observer.projection(1e-3, 1e6) * s.observer.view();
+  fitPatchViews(s, seen, opt);
+  ASSERT_EQ(all.views.size(), 1u);
+  ASSERT_EQ(seen.views.size(), 1u);
+  EXPECT_TRUE(all.in_view.empty());
+  ASSERT_EQ(seen.in_view.size(), seen.world_pos.size());
+  const size_t in = size_t(std::count(seen.in_view.begin(), seen.in_view.end(), 1));
+  EXPECT_GT(in, 20u);
+  EXPECT_LT(in, seen.world_pos.size() / 2);  // most of the lens is outside a 50 deg view
+  EXPECT_EQ(seen.views[0].rays_out_of_view, int(seen.world_pos.size() - in));
+  EXPECT_EQ(seen.views[0].fit.eye, all.views[0].fit.eye);
+  EXPECT_GT(all.views[0].volume.fov_y_rad, radians(120.0));
+  EXPECT_LT(seen.views[0].volume.fov_y_rad, 0.6 * all.views[0].volume.fov_y_rad);
+  const cad::GridPatch& gp = seen.grid_patches[0];
+  for (size_t k = 0; k < gp.vertices.size(); ++k) {
+    if (!seen.in_view[gp.vertices[k]]) continue;
+    const Vec2 st = seen.views[0].st[0][k];
+    EXPECT_TRUE(st.x >= -1e-9 && st.x <= 1 + 1e-9 && st.y >= -1e-9 && st.y <= 1 + 1e-9) << "vertex " << gp.vertices[k];
+  }
 }
 
 }  // namespace
