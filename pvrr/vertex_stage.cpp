@@ -217,7 +217,7 @@ void buildPatchMap(const Scene& scene, const ElementFrame& f, const Element& el,
                         " hit(s) beyond the viewpoint are not in this reversed map";
   }
   // Vertices out of view (their triangles are clipped away by the viewer) take no part in the choice of
-  // projective weights and get finite placeholders where their projection is not.
+  // projective weights.
   auto counts = [&](uint32_t vi) { return f.in_view.empty() || !pv.in_view || f.in_view[vi]; };
   pv.q.assign(gp.vertices.size(), 1.0);
   bool all_in_front = true;
@@ -232,8 +232,10 @@ void buildPatchMap(const Scene& scene, const ElementFrame& f, const Element& el,
   pv.st.assign(channels, std::vector<Vec2>(gp.vertices.size()));
   for (size_t c = 0; c < channels; ++c)
     for (size_t k = 0; k < gp.vertices.size(); ++k) {
+      // Finite always: a vertex out of view, or with a flagged ray (TIR: dark, transmittance 0) whose far
+      // point lies behind the map camera, gets the map centre rather than NaN.
       Vec2 st = projectToTexture(pv.volume, f.rays[c][gp.vertices[k]].hit);
-      if (!counts(gp.vertices[k]) && !(std::isfinite(st.x) && std::isfinite(st.y))) st = Vec2(0.5);
+      if (!(std::isfinite(st.x) && std::isfinite(st.y))) st = Vec2(0.5);
       pv.st[c][k] = st;
     }
 }

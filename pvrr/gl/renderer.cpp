@@ -473,6 +473,14 @@ struct Renderer::Impl {
   size_t next_mesh = 0;
 
   static int interfaces(const Element& el) { return el.type == ElementType::Lens ? 2 : 1; }
+  // Patch views a viewer can see (the others render no map).
+  static size_t inView(const ElementFrame& f) {
+    return size_t(std::count_if(f.views.begin(), f.views.end(), [](const PatchView& v) { return v.in_view; }));
+  }
+  // Planned first passes that render a map (the budget counts these).
+  size_t visiblePasses() const {
+    return size_t(std::count_if(passes.begin(), passes.end(), [](const MapPass& m) { return m.visible; }));
+  }
   // Whether cached rays were traced for these channels (wavelengths and weights, not just their count).
   static bool sameChannels(const std::vector<ChannelSpec>& a, const std::vector<ChannelSpec>& b) {
     if (a.size() != b.size()) return false;
@@ -508,12 +516,19 @@ struct Renderer::Impl {
     const size_t fc = owner.rays.size() / 2;
     const std::vector<Vec2>& st = pv.st[fc];
     std::vector<Vec3> out(points.size(), pv.volume.eye);
+    // A vertex out of the viewer's view or with a flagged ray (TIR, edge band) has placeholder texture
+    // coordinates: its triangles say nothing about where the map shows a point.
+    const auto usable = [&](uint32_t k) {
+      const uint32_t vi = gp.vertices[k];
+      return (owner.in_view.empty() || owner.in_view[vi]) && owner.rays[fc][vi].status != VertexStatus::Tir;
+    };
     for (size_t i = 0; i < points.size(); ++i) {
       const Vec2 p = projectToTexture(pv.volume, points[i]);
       if (!std::isfinite(p.x) || !std::isfinite(p.y)) continue;
       double best = -kInf, l[3] = {0, 0, 0};
       const cad::Triangle* best_tri = nullptr;
       for (const cad::Triangle& t : gp.triangles) {
+        if (!usable(t.x) || !usable(t.y) || !usable(t.z)) continue;
         const Vec2 a = st[t.x], e1 = st[t.y] - a, e2 = st[t.z] - a, r = p - a;
         const double den = e1.x * e2.y - e2.x * e1.y;
         if (!(std::abs(den) > 0)) continue;
@@ -550,7 +565,7 @@ struct Renderer::Impl {
     for (const ElementFrame& f : frames)
       for (size_t v = 0; v < f.views.size(); ++v)
         passes.push_back({&f, v, interfaces(scene.elements[size_t(f.element)]), slot++,
-                          patchMapSize(options.map_size, f.views.size()), true, {}});
+                          patchMapSize(options.map_size, std::max<size_t>(1, inView(f))), true, {}});
     const size_t top = passes.size();
     // A top-level element outside the observer's view needs no map (its second-pass triangles are clipped).
     const Observer& ob = scene.observer;
@@ -571,7 +586,7 @@ struct Renderer::Impl {
         // The tracer absorbs at an element event with depth >= max_depth; a lens's back surface is the
         // event after its front, so the element is dark unless all its interfaces come before the limit.
         const bool too_deep = depth + interfaces(el) > max_depth;
-        if (too_deep || passes.size() + views_needed > kMaxFirstPasses) {
+        if (too_deep || visiblePasses() + views_needed > kMaxFirstPasses) {
           *budget_hit = *budget_hit || !too_deep;
           ++*dark;
           passes[i].nested.push_back({int(b), nullptr, 0});
@@ -591,7 +606,7 @@ struct Renderer::Impl {
         nested_opt.viewer_clip = pv.volume.projection * pv.volume.view;  // seen by the owner's map camera
         traceVertexRays(rays, *nf, pv.volume.eye, rayOrigins(owner, pv, nf->world_pos), nested_opt);
         fitPatchViews(scene, *nf, nested_opt);
-        if (passes.size() + nf->views.size() > kMaxFirstPasses) {  // an automatic split needed more maps
+        if (visiblePasses() + inView(*nf) > kMaxFirstPasses) {  // an automatic split needed more maps
           *budget_hit = true;
           ++*dark;
           passes[i].nested.push_back({int(b), nullptr, 0});
@@ -599,8 +614,8 @@ struct Renderer::Impl {
         }
         const size_t first = slot;
         const int size = nestedMapSize(passes[i].size);
-        for (size_t v = 0; v < nf->views.size(); ++v)
-          passes.push_back({nf.get(), v, depth + interfaces(el), slot++, size, true, {}});
+        for (size_t v = 0; v < nf->views.size(); ++v)  // a patch the owner's map camera cannot see: no map
+          passes.push_back({nf.get(), v, depth + interfaces(el), slot++, size, nf->views[v].in_view, {}});
         passes[i].nested.push_back({int(b), nf.get(), first});
         nested_frames.push_back(std::move(nf));
       }
@@ -758,8 +773,10 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       return d < 1e-12;  // a rigid pose re-composed in double differs by a few ulps, never more
     };
     std::vector<bool> reuse(n_el, false);
+    const Mat4 observer_projection = ob.projection(1e-3, 1e6);
+    const bool same_projection = cache && same(cache->projection, observer_projection);
     for (size_t e = 0; e < n_el; ++e)
-      reuse[e] = cache && cache->valid && cache->elements.size() == n_el &&
+      reuse[e] = cache && cache->valid && same_projection && cache->elements.size() == n_el &&
                  sameChannels(cache->elements[e].channels, opts[e].channels) &&
                  same(cache->element_to_eye[e], view * scene.elements[e].local_to_world);
     const bool all_reused = std::all_of(reuse.begin(), reuse.end(), [](bool b) { return b; });
@@ -820,6 +837,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       cache->element_to_eye.resize(n_el);
       for (size_t e = 0; e < n_el; ++e) cache->element_to_eye[e] = view * scene.elements[e].local_to_world;
       cache->view = view;
+      cache->projection = observer_projection;
       cache->elements = frames;
       cache->valid = true;
     }

@@ -59,6 +59,7 @@ struct FrameCache {
   bool valid = false;
   std::vector<Mat4> element_to_eye;  // per element, the element pose relative to the eye of the last frame
   Mat4 view{1.0};                    // the observer's view matrix of the cached frame
+  Mat4 projection{1.0};              // and its projection: what it sees of each element (ElementFrame::in_view)
   std::vector<ElementFrame> elements;
   bool environment_changed = true;
 };

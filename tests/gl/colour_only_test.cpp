@@ -52,12 +52,13 @@ TEST_P(ColourOnlyTest, SameColoursWithoutSeenPoints) {
 // The first frame of a fresh renderer in each mode (no earlier pass has set any GL state) shows the
 // elements where a later frame does: the same element pixels, the same colours.
 TEST_P(ColourOnlyTest, FirstFrameOfEachModeEqualsALaterOne) {
-  const auto ctx = test::glContextOrFail(GetParam());
-  if (!ctx) return;
   Scene s = buildScene(loadScene(std::string(PVRR_SOURCE_DIR) + "/models/car-mirror.json",
                                  {"observer.image_size=[96,72]", "render.map_size=256"}));
   RayScene rays(s);
   for (gl::RasterMode mode : {gl::RasterMode::Raster, gl::RasterMode::Envmap, gl::RasterMode::Pvrr}) {
+    // A fresh context per mode: GL state belongs to the context, so no earlier renderer's frames set it.
+    const auto ctx = test::glContextOrFail(GetParam());
+    if (!ctx) return;
     gl::Renderer r(s, rays, gl::RendererOptions{});
     const gl::RasterFrame first = r.render(mode), second = r.render(mode);
     size_t element_pixels = 0, same = 0;
