@@ -272,7 +272,7 @@ std::vector<ElementFrame> vertexStageFrames(const Scene& scene, const RayScene& 
   for (int e : which) {
     VertexStageOptions o;
     o.channels = dispersionChannels(scene, e);
-    o.viewer_clip = scene.observer.projection(1e-3, 1e6) * scene.observer.view();  // as the renderer fits
+    o.viewer_clip = scene.observer.visibilityProjection() * scene.observer.view();  // as the renderer fits
     ElementFrame f = prepareElement(scene, e);
     traceVertexRays(rays, f, scene.observer.eye, o);
     fitPatchViews(scene, f, o);

@@ -141,10 +141,10 @@ RayScene::RayScene(const Scene& scene, RaySceneOptions options) : scene_(scene),
   rtcSetSceneBuildQuality(im.scene, RTC_BUILD_QUALITY_HIGH);
   // RaySceneOptions::moving_elements: a dynamic scene, which Embree builds in two levels, so that a pose
   // update refits the moved elements' BVHs and rebuilds the top level, not the environment's.
-  const bool any_attached = options.moving_elements &&
+  const bool moving = options.moving_elements &&
                             std::any_of(scene.elements.begin(), scene.elements.end(),
                                         [](const Element& e) { return e.attached_to_observer; });
-  if (any_attached) {
+  if (moving) {
     rtcSetSceneFlags(im.scene, RTC_SCENE_FLAG_DYNAMIC);
     rtcSetSceneBuildQuality(im.scene, RTC_BUILD_QUALITY_LOW);
   }
@@ -183,7 +183,7 @@ RayScene::RayScene(const Scene& scene, RaySceneOptions options) : scene_(scene),
       std::vector<glm::vec3> verts(tess.positions.size());
       for (size_t i = 0; i < verts.size(); ++i) verts[i] = glm::vec3(el.toWorldPoint(tess.positions[i]) - im.anchor);
       unsigned id = addTriangles(im.device, im.scene, verts, tess.triangles);
-      if (any_attached) {
+      if (moving) {
         // Moved rigidly by updateElementPoses: the topology stays, so the BVH is refitted, not rebuilt.
         RTCGeometry g = rtcGetGeometry(im.scene, id);
         rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_REFIT);
@@ -194,8 +194,8 @@ RayScene::RayScene(const Scene& scene, RaySceneOptions options) : scene_(scene),
       im.element_geoms[e][size_t(s)] = int(id);
       RTCScene own = rtcNewScene(im.device);
       im.element_scenes[e][size_t(s)] = own;
-      rtcSetSceneBuildQuality(own, any_attached ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_HIGH);
-      if (any_attached) rtcSetSceneFlags(own, RTC_SCENE_FLAG_DYNAMIC);
+      rtcSetSceneBuildQuality(own, moving ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_HIGH);
+      if (moving) rtcSetSceneFlags(own, RTC_SCENE_FLAG_DYNAMIC);
       rtcAttachGeometryByID(own, rtcGetGeometry(im.scene, id), 0);
       rtcCommitScene(own);
     }

@@ -52,6 +52,9 @@ struct Observer {
   int width = 640, height = 480;
   Mat4 view() const;                                   // world -> camera (OpenGL conventions)
   Mat4 projection(double near_m, double far_m) const;  // OpenGL clip, symmetric
+  // The projection the renderer and the reports use to decide what the observer sees (near 1 mm, far
+  // 1000 km): visibilityProjection() * view() is the observer's world -> clip for visibility tests.
+  Mat4 visibilityProjection() const { return projection(1e-3, 1e6); }
   // The world-space ray through pixel (x, y) with pixel centres at +0.5 and the origin at the top-left.
   Vec3 pixelDirection(double px, double py) const;
 };

@@ -246,13 +246,12 @@ void fitOnePatch(const Scene& scene, const ElementFrame& f, size_t patch_index, 
   // The viewpoint is fitted to all the patch's rays, the view volume to those the viewer sees. (Fitting the
   // viewpoint to the seen rays alone fits them better, but interpolates worse between the vertices: on the
   // spectacle lens at 640 x 480, 1.02' median against 0.68'.)
-  const cad::GridPatch& patch = f.grid_patches[patch_index];
-  const std::vector<ViewpointRay> all_rays = patchRays(f, patch, &pv.rays_excluded);
+  const cad::GridPatch& gp = f.grid_patches[patch_index];
+  const std::vector<ViewpointRay> all_rays = patchRays(f, gp, &pv.rays_excluded);
   const std::vector<ViewpointRay> seen_rays =
-      f.in_view.empty() ? all_rays : patchRays(f, patch, nullptr, true, &pv.rays_out_of_view);
+      f.in_view.empty() ? all_rays : patchRays(f, gp, nullptr, true, &pv.rays_out_of_view);
   // Seen when one of its triangles has all three vertices in view (conservative: those vertices may owe it
   // to neighbouring triangles).
-  const cad::GridPatch& gp = f.grid_patches[patch_index];
   pv.in_view = f.in_view.empty() || std::any_of(gp.triangles.begin(), gp.triangles.end(), [&](const cad::Triangle& t) {
                  return f.in_view[gp.vertices[t.x]] && f.in_view[gp.vertices[t.y]] && f.in_view[gp.vertices[t.z]];
                });
@@ -260,25 +259,21 @@ void fitOnePatch(const Scene& scene, const ElementFrame& f, size_t patch_index, 
   buildPatchMap(scene, f, el, pv, seen_rays);
 }
 
-}  // namespace
-
 // The automatic split stops where a patch would have fewer quads a side than this.
 constexpr int kMinPatchQuads = 4;
 
 // ElementFrame::in_view for a viewer with world -> clip matrix `clip`: the vertices of every grid triangle
-// not entirely outside one clip plane (homogeneous outcodes, as GL clips). All 1 when every triangle is.
+// not entirely outside one clip plane (clipOutcode). All 1 when every triangle is.
 std::vector<char> verticesInView(const ElementFrame& f, const Mat4& clip) {
   std::vector<unsigned> code(f.world_pos.size());
-  for (size_t i = 0; i < f.world_pos.size(); ++i) {
-    const Vec4 c = clip * Vec4(f.world_pos[i], 1.0);
-    code[i] = (c.x < -c.w) | (c.x > c.w) << 1 | (c.y < -c.w) << 2 | (c.y > c.w) << 3 | (c.z < -c.w) << 4 |
-              (c.z > c.w) << 5;
-  }
+  for (size_t i = 0; i < f.world_pos.size(); ++i) code[i] = clipOutcode(clip * Vec4(f.world_pos[i], 1.0));
   std::vector<char> in(f.world_pos.size(), 0);
   for (const cad::Triangle& t : f.grid.triangles)
     if ((code[t.x] & code[t.y] & code[t.z]) == 0) in[t.x] = in[t.y] = in[t.z] = 1;
   return in;
 }
+
+}  // namespace
 
 void fitPatchViews(const Scene& scene, ElementFrame& f, const VertexStageOptions& opt) {
   auto t0 = std::chrono::steady_clock::now();

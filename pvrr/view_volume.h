@@ -60,6 +60,14 @@
 
 namespace pvrr {
 
+// The clip planes a clip-space point lies outside of, one bit each (x < -w, x > w, y < -w, y > w, z < -w,
+// z > w), as GL clips: a convex hull of points lies entirely outside the volume only when the AND of their
+// outcodes is not zero.
+inline unsigned clipOutcode(const Vec4& c) {
+  return unsigned(c.x < -c.w) | unsigned(c.x > c.w) << 1 | unsigned(c.y < -c.w) << 2 | unsigned(c.y > c.w) << 3 |
+         unsigned(c.z < -c.w) << 4 | unsigned(c.z > c.w) << 5;
+}
+
 struct ViewVolume {
   Vec3 eye{0}, forward{0, 0, -1}, up{0, 1, 0}, right{1, 0, 0};  // orthonormal, right = forward x up
   double near_m = 0, far_m = 0;  // depths along forward, 0 < near_m < far_m

@@ -204,15 +204,7 @@ struct PassCamera {
 bool mayBeInVolume(const std::vector<Vec3>& points, const Mat4& m) {
   unsigned all = 0x3f;
   for (const Vec3& p : points) {
-    const Vec4 c = m * Vec4(p, 1.0);
-    unsigned code = 0;
-    if (c.x < -c.w) code |= 1;
-    if (c.x > c.w) code |= 2;
-    if (c.y < -c.w) code |= 4;
-    if (c.y > c.w) code |= 8;
-    if (c.z < -c.w) code |= 16;
-    if (c.z > c.w) code |= 32;
-    all &= code;
+    all &= clipOutcode(m * Vec4(p, 1.0));
     if (!all) return true;
   }
   return all == 0;
@@ -569,7 +561,7 @@ struct Renderer::Impl {
     const size_t top = passes.size();
     // A top-level element outside the observer's view needs no map (its second-pass triangles are clipped).
     const Observer& ob = scene.observer;
-    const Mat4 eye_clip = ob.projection(1e-3, 1e6) * ob.view();
+    const Mat4 eye_clip = ob.visibilityProjection() * ob.view();
     for (MapPass& mp : passes)
       mp.visible = mp.owner->views[mp.view].in_view && mayBeInVolume(mp.owner->world_pos, eye_clip) &&
                    !beyondDepth(*mp.owner);
@@ -757,7 +749,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   if (mode == RasterMode::Pvrr && n_el > 0) {
     frames.resize(n_el);
     // Each element's views are fitted to what the observer sees of it.
-    const Mat4 observer_clip = ob.projection(1e-3, 1e6) * ob.view();
+    const Mat4 observer_projection = ob.visibilityProjection(), observer_clip = observer_projection * ob.view();
     for (size_t e = 0; e < n_el; ++e) {
       opts.push_back(optionsFor(e));
       opts.back().viewer_clip = observer_clip;
@@ -773,7 +765,6 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       return d < 1e-12;  // a rigid pose re-composed in double differs by a few ulps, never more
     };
     std::vector<bool> reuse(n_el, false);
-    const Mat4 observer_projection = ob.projection(1e-3, 1e6);
     const bool same_projection = cache && same(cache->projection, observer_projection);
     for (size_t e = 0; e < n_el; ++e)
       reuse[e] = cache && cache->valid && same_projection && cache->elements.size() == n_el &&
