@@ -479,14 +479,16 @@ int cmdVertices(const std::vector<std::string>& argv) {
   for (const ElementFrame& f : frames) {
     const Element& el = scene.elements[size_t(f.element)];
     json patches = json::array();
+    const size_t in_view = size_t(std::count_if(f.views.begin(), f.views.end(), [](const PatchView& v) { return v.in_view; }));
     for (const PatchView& pv : f.views) {
       const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
+      const std::array<int, 2> texels = mapTexels(pv.volume, gl::patchMapSize(scene.render.map_size, std::max<size_t>(1, in_view)));
       for (size_t c = 0; c < pv.st.size(); ++c) {
         const double wl = f.channels[c].wavelength_nm > 0 ? f.channels[c].wavelength_nm : kLineD_nm;
         auto rm = [](const Mat4& m) { auto r = rowMajor16(m); return json(std::vector<double>(r.begin(), r.end())); };
         patches.push_back({{"patch", pv.patch}, {"channel", c}, {"eye", {pv.volume.eye.x, pv.volume.eye.y, pv.volume.eye.z}},
                            {"view_matrix", rm(pv.volume.view)}, {"projection_matrix", rm(pv.volume.projection)},
-                           {"map_size", {scene.render.map_size, scene.render.map_size}},
+                           {"map_size", {texels[0], texels[1]}},
                            {"wavelength_nm", wl},
                            {"n", el.type == ElementType::Lens ? el.dispersion.index(wl) : 1.0}});
         for (size_t k = 0; k < gp.vertices.size(); ++k) {

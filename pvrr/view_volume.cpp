@@ -292,6 +292,14 @@ Vec2 projectToTexel(const ViewVolume& vv, const Vec3& p, int width, int height) 
   return {st.x * width, st.y * height};
 }
 
+std::array<int, 2> mapTexels(const ViewVolume& vv, int longest_side) {
+  const double w = vv.right_ - vv.left, h = vv.top - vv.bottom;
+  if (!(w > 0) || !(h > 0) || !std::isfinite(w / h)) return {longest_side, longest_side};
+  const int shortest = std::min(longest_side, 16);
+  auto share = [&](double ratio) { return std::clamp(int(std::ceil(longest_side * ratio - 1e-9)), shortest, longest_side); };
+  return w >= h ? std::array<int, 2>{longest_side, share(h / w)} : std::array<int, 2>{share(w / h), longest_side};
+}
+
 std::array<double, 16> rowMajor16(const Mat4& m) {
   std::array<double, 16> out{};
   for (int r = 0; r < 4; ++r)

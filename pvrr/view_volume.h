@@ -119,6 +119,13 @@ Vec2 projectToTexture(const ViewVolume& vv, const Vec3& world_point);
 // its centre is (i + 0.5, j + 0.5); row j = 0 is the bottom row.
 Vec2 projectToTexel(const ViewVolume& vv, const Vec3& world_point, int width, int height);
 
+// The texels a map of this volume needs so that its texels are square on the near plane (the same angle
+// across and up the map at its centre): the longer side gets `longest_side` texels, the shorter side its
+// proportional share, rounded up and at least min(longest_side, 16). A square map of an oblong frustum spends
+// texels on the narrow axis that no screen pixel resolves (the spectacle lens's 108 x 79 degree frustum at
+// 1280 x 720: 41 % of a square map's texels). {w, h}.
+std::array<int, 2> mapTexels(const ViewVolume& vv, int longest_side);
+
 // m as 16 doubles, row-major (out[4 * row + col]), e.g. for printing or row-major APIs; glm is column-major.
 std::array<double, 16> rowMajor16(const Mat4& m);
 

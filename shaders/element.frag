@@ -29,6 +29,10 @@ uniform bool u_additive;         // the second or later of the additive draws of
 #if defined(MODE_PVRR)
 uniform sampler2D u_map;         // first pass colour (linear)
 uniform sampler2D u_seen_map;    // first pass seen points, relative to the map's camera origin (LINEAR)
+uniform vec2 u_st_scale;         // the map fills the lower-left (texels / texture size) of its texture
+uniform vec2 u_st_max;           // half a texel inside that region's far edges
+// A projective texture coordinate (s q, t q, q) of the volume's [0, 1]^2 to the map's region of its texture.
+vec2 mapST(vec3 stq) { return min(stq.xy / stq.z * u_st_scale, u_st_max); }
 #elif defined(MODE_ENVMAP)
 uniform samplerCube u_cube;
 uniform samplerCube u_seen_cube;
@@ -75,14 +79,14 @@ void main() {
                   fresnelConductor(cos_i, u_metal_n.b, u_metal_k.b));
 #endif
 #if defined(MODE_PVRR)
-  vec3 c = v_w0 * texture(u_map, v_st0.xy / v_st0.z).rgb;
+  vec3 c = v_w0 * texture(u_map, mapST(v_st0)).rgb;
 #if CHANNELS == 3
-  c += v_w1 * texture(u_map, v_st1.xy / v_st1.z).rgb + v_w2 * texture(u_map, v_st2.xy / v_st2.z).rgb;
+  c += v_w1 * texture(u_map, mapST(v_st1)).rgb + v_w2 * texture(u_map, mapST(v_st2)).rgb;
 #endif
 #if defined(NO_SEEN_POINTS)
   vec4 seen = vec4(0.0);
 #else
-  vec4 seen = texture(u_seen_map, v_st_seen.xy / v_st_seen.z);
+  vec4 seen = texture(u_seen_map, mapST(v_st_seen));
 #endif
 #else
 #if defined(LENS)

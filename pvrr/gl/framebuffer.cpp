@@ -14,6 +14,7 @@ namespace {
 const char* formatName(ColorFormat f) {
   switch (f) {
     case ColorFormat::RGBA8: return "RGBA8";
+    case ColorFormat::SRGB8A8: return "SRGB8_ALPHA8";
     case ColorFormat::RGBA16F: return "RGBA16F";
     case ColorFormat::RGBA32F: return "RGBA32F";
   }
@@ -23,6 +24,7 @@ const char* formatName(ColorFormat f) {
 GLenum internalFormat(ColorFormat f) {
   switch (f) {
     case ColorFormat::RGBA8: return GL_RGBA8;
+    case ColorFormat::SRGB8A8: return GL_SRGB8_ALPHA8;
     case ColorFormat::RGBA16F: return GL_RGBA16F;
     case ColorFormat::RGBA32F: return GL_RGBA32F;
   }
@@ -180,7 +182,7 @@ Framebuffer::Framebuffer(int width, int height, const std::vector<ColorFormat>& 
   for (std::size_t i = 0; i < colors.size(); ++i) {
     glBindTexture(GL_TEXTURE_2D, color_textures_[i]);
     // No data is uploaded, so format/type only need to be a valid pair for the internal format.
-    const GLenum type = colors[i] == ColorFormat::RGBA8 ? GL_UNSIGNED_BYTE : GL_FLOAT;
+    const GLenum type = colors[i] == ColorFormat::RGBA8 || colors[i] == ColorFormat::SRGB8A8 ? GL_UNSIGNED_BYTE : GL_FLOAT;
     glTexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(internalFormat(colors[i])), width, height, 0, GL_RGBA, type,
                  nullptr);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
@@ -283,6 +285,19 @@ void Framebuffer::clear(const std::array<float, 4>& rgba, float depth) const {
   bind();
   for (std::size_t i = 0; i < colors_.size(); ++i) glClearBufferfv(GL_COLOR, static_cast<GLint>(i), rgba.data());
   if (depth_texture_ != 0) glClearBufferfv(GL_DEPTH, 0, &depth);
+}
+
+void Framebuffer::clearDepth(float depth) const {
+  bind();
+  if (depth_texture_ != 0) glClearBufferfv(GL_DEPTH, 0, &depth);
+}
+
+void Framebuffer::bindRegion(int width, int height) const {
+  if (width <= 0 || height <= 0 || width > width_ || height > height_)
+    throw Error("Framebuffer::bindRegion: region " + std::to_string(width) + "x" + std::to_string(height) +
+                " outside the framebuffer's " + std::to_string(width_) + "x" + std::to_string(height_));
+  bind();
+  glViewport(0, 0, width, height);
 }
 
 ColorFormat Framebuffer::colorFormat(int attachment) const {

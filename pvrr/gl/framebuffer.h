@@ -12,7 +12,7 @@ namespace pvrr::gl {
 
 class GlContext;
 
-enum class ColorFormat { RGBA8, RGBA16F, RGBA32F };
+enum class ColorFormat { RGBA8, SRGB8A8, RGBA16F, RGBA32F };
 enum class DepthFormat { None, Depth24, Depth32F };
 
 // How texture data from 8-bit images is interpreted when sampled: Srgb stores GL_SRGB8 (sampling returns linear
@@ -75,6 +75,12 @@ class Framebuffer {
   void bind() const;
   // Clears every colour attachment to `rgba` and the depth attachment to `depth`. Binds the framebuffer.
   void clear(const std::array<float, 4>& rgba, float depth = 1.0f) const;
+  // Clears only the depth attachment (a pass that writes every pixel, e.g. one ending with a full-screen sky,
+  // needs no colour clear: a 1280 x 720 RGBA32F colour clear costs llvmpipe about 2 ms). Binds the framebuffer.
+  void clearDepth(float depth = 1.0f) const;
+  // Binds like bind(), with the viewport on the lower-left width x height pixels only (a map rendered into part
+  // of its texture). Throws pvrr::Error when the region does not fit.
+  void bindRegion(int width, int height) const;
 
   int width() const { return width_; }
   int height() const { return height_; }

@@ -64,6 +64,11 @@ struct FrameCache {
   bool environment_changed = true;
 };
 
+// The map size (longer side, texels) of each of an element's top-level patches when `patches_in_view` of them
+// are in the observer's view: map_size up to four patches, beyond that shrunk so that all of them together
+// hold about as many texels as four full maps. Each map renders mapTexels(volume, this) (pvrr/view_volume.h).
+int patchMapSize(int map_size, size_t patches_in_view);
+
 class Renderer {
  public:
   Renderer(const Scene& scene, const RayScene& rays, RendererOptions options);

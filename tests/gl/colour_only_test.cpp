@@ -4,6 +4,8 @@
 
 #include <string>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include "pvrr/gl/context.h"
 #include "pvrr/gl/renderer.h"
 #include "pvrr/scene_build.h"
@@ -71,6 +73,42 @@ TEST_P(ColourOnlyTest, FirstFrameOfEachModeEqualsALaterOne) {
     EXPECT_GT(element_pixels, 200u) << "mode " << int(mode);
     EXPECT_EQ(same, first.color.size()) << "mode " << int(mode);
     EXPECT_LE(worst, kColourTol) << "mode " << int(mode);
+  }
+}
+
+// No pass clears its colour attachments (the sky covers every pixel nothing else does, and a map renders
+// only the region its volume needs): a renderer that has drawn another view first must give exactly the
+// picture, seen points and element ids of a fresh renderer. A pixel or texel left unwritten would keep the
+// other view's value. The concave mirror's zooming region takes the reversed-depth map path.
+TEST_P(ColourOnlyTest, EveryPixelIsDrawnWithoutAColourClear) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  for (const char* scene : {"car-mirror", "concave-mirror", "spectacle-lens"}) {
+    Scene s = buildScene(loadScene(std::string(PVRR_SOURCE_DIR) + "/models/" + scene + ".json",
+                                   {"observer.image_size=[96,72]", "render.map_size=256"}));
+    RayScene rays(s);
+    for (gl::RasterMode mode : {gl::RasterMode::Pvrr, gl::RasterMode::Raster}) {
+      // In raster mode the spectacle lens is a uniform grey filling the view from any direction: nothing to see.
+      if (mode == gl::RasterMode::Raster && std::string(scene) == "spectacle-lens") continue;
+      const gl::RasterFrame fresh = gl::Renderer(s, rays, gl::RendererOptions{}).render(mode);
+      gl::Renderer reused(s, rays, gl::RendererOptions{});
+      const Vec3 target = s.observer.target;
+      s.observer.target = s.observer.eye + Vec3(glm::rotate(Mat4(1.0), radians(25.0), s.observer.up) *
+                                                Vec4(target - s.observer.eye, 0.0));
+      const gl::RasterFrame other = reused.render(mode);
+      s.observer.target = target;
+      const gl::RasterFrame again = reused.render(mode);
+      ASSERT_EQ(again.color.size(), fresh.color.size());
+      size_t differs_from_other = 0, mismatches = 0;
+      for (size_t i = 0; i < fresh.color.size(); ++i) {
+        differs_from_other += glm::length(other.color[i] - fresh.color[i]) > 1e-3;
+        const bool same = glm::length(again.color[i] - fresh.color[i]) <= kColourTol &&
+                          again.element[i] == fresh.element[i] && glm::length(again.seen[i] - fresh.seen[i]) <= 1e-9 * (1.0 + glm::length(fresh.seen[i]));
+        mismatches += !same;
+      }
+      EXPECT_GT(differs_from_other, fresh.color.size() / 4) << scene << " mode " << int(mode) << ": the other view must differ";
+      EXPECT_EQ(mismatches, 0u) << scene << " mode " << int(mode);
+    }
   }
 }
 

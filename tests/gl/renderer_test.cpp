@@ -2,8 +2,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <map>
 #include <set>
+#include <sstream>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -304,7 +306,18 @@ TEST_P(RendererTest, AutomaticSplitStopsAtFourQuadsAPatchAndShrinksTheMaps) {
   const StageTiming* fp = f.stages.find("first-pass");
   ASSERT_NE(fp, nullptr);
   EXPECT_EQ(fp->count, 9);
-  EXPECT_EQ(fp->note, "9 x 512^2");
+  // "n x WxH, ...": nine maps, each with its longer side 512 (the shorter one follows the patch's frustum).
+  std::istringstream note(fp->note);
+  std::string entry;
+  int maps = 0;
+  while (std::getline(note, entry, ',')) {
+    int n = 0, w = 0, h = 0;
+    ASSERT_EQ(std::sscanf(entry.c_str(), " %d x %dx%d", &n, &w, &h), 3) << fp->note;
+    maps += n;
+    EXPECT_EQ(std::max(w, h), 512) << fp->note;
+    EXPECT_GE(std::min(w, h), 16) << fp->note;
+  }
+  EXPECT_EQ(maps, 9) << fp->note;
 }
 
 const StageTiming& stage(const gl::RasterFrame& f, const std::string& name) {
@@ -549,6 +562,11 @@ TEST(PatchSeam, CarMirrorSeamIsBelowOneTexel) {
   fitPatchViews(s, f, opt);
   ASSERT_EQ(f.views.size(), 4u);
   const double map_size = s.render.map_size;
+  // A jump in (s, t) in texels of the patch's map (square texels: mapTexels).
+  auto texels = [&](const PatchView& pv) {
+    const std::array<int, 2> t = mapTexels(pv.volume, gl::patchMapSize(int(map_size), f.views.size()));
+    return Vec2(t[0], t[1]);
+  };
   auto seenAt = [&](const ViewVolume& v, const Vec2& st) {
     const double x = v.left + st.x * (v.right_ - v.left), y = v.bottom + st.y * (v.top - v.bottom);
     const Vec3 on_near = v.eye + v.near_m * v.forward + x * v.right + y * v.up;
@@ -601,8 +619,8 @@ TEST(PatchSeam, CarMirrorSeamIsBelowOneTexel) {
             const bool unoccluded = glm::length(x0 - y) < 0.01 * glm::length(y - v0.volume.eye) &&
                                     glm::length(x1 - y) < 0.01 * glm::length(y - v1.volume.eye);
             std::vector<double>& out = same_surface && unoccluded ? jumps : edge_jumps;
-            out.push_back(map_size * glm::length(projectToTexture(v0.volume, x1) - st0));
-            out.push_back(map_size * glm::length(projectToTexture(v1.volume, x0) - st1));
+            out.push_back(glm::length((projectToTexture(v0.volume, x1) - st0) * texels(v0)));
+            out.push_back(glm::length((projectToTexture(v1.volume, x0) - st1) * texels(v1)));
           }
         }
     }
@@ -612,7 +630,7 @@ TEST(PatchSeam, CarMirrorSeamIsBelowOneTexel) {
   ASSERT_GT(jumps.size(), edge_jumps.size());
   std::sort(jumps.begin(), jumps.end());
   std::sort(edge_jumps.begin(), edge_jumps.end());
-  std::printf("seam: %zu boundary edges; on one surface: jump median %.4f, p95 %.4f, max %.4f texels of a %d^2 map "
+  std::printf("seam: %zu boundary edges; on one surface: jump median %.4f, p95 %.4f, max %.4f texels of a map %d on its longer side "
               "(%zu samples); across scene edges: max %.3f texels (%zu samples)\n",
               edges, jumps[jumps.size() / 2], jumps[jumps.size() * 95 / 100], jumps.back(), int(map_size), jumps.size(),
               edge_jumps.empty() ? 0.0 : edge_jumps.back(), edge_jumps.size());

@@ -177,6 +177,33 @@ TEST(ViewVolume, FrustumIsAsymmetricWhenTheRaysAre) {
   EXPECT_NEAR(b, phi - radians(-20.0), kRounding);
 }
 
+// Square texels on the near plane: a symmetric fan of +-30 deg across and +-10 deg up has extents in the ratio
+// tan 30 / tan 10 = 3.274; the longer side keeps the requested texels, the shorter one its share, rounded up.
+TEST(ViewVolume, MapTexelsAreSquareOnTheNearPlane) {
+  ViewVolumeOptions opt;
+  opt.margin = 0;
+  const ViewVolume wide = buildViewVolume(Vec3(0), fan({-30, 0, 30}, {-10, 10}), opt);
+  const double ratio = std::tan(radians(30.0)) / std::tan(radians(10.0));
+  ASSERT_NEAR((wide.right_ - wide.left) / (wide.top - wide.bottom), ratio, 1e-9);
+  const std::array<int, 2> t = mapTexels(wide, 1024);
+  EXPECT_EQ(t[0], 1024);
+  EXPECT_EQ(t[1], int(std::ceil(1024 / ratio)));  // 313
+  // The texel's size on the near plane is the same across and up (within the rounding of one texel).
+  const double across = (wide.right_ - wide.left) / t[0], up = (wide.top - wide.bottom) / t[1];
+  EXPECT_LE(up, across);
+  EXPECT_GT(up, across * (1.0 - 1.0 / t[1]));
+  // Taller than wide: the roles swap.
+  const ViewVolume tall = buildViewVolume(Vec3(0), fan({-10, 10}, {-30, 0, 30}), opt);
+  const std::array<int, 2> u = mapTexels(tall, 512);
+  EXPECT_EQ(u[1], 512);
+  EXPECT_EQ(u[0], int(std::ceil(512 / ratio)));
+  // A square frustum keeps a square map; a sliver never goes below 16 texels (or the map itself).
+  EXPECT_EQ(mapTexels(buildViewVolume(Vec3(0), fan({-5, 5}, {-5, 5}), opt), 256), (std::array<int, 2>{256, 256}));
+  const ViewVolume sliver = buildViewVolume(Vec3(0), fan({-40, 40}, {-0.01, 0.01}), opt);
+  EXPECT_EQ(mapTexels(sliver, 1024)[1], 16);
+  EXPECT_EQ(mapTexels(sliver, 8)[1], 8);
+}
+
 TEST(ViewVolume, UpHintIsHonoured) {
   const Vec3 eye(0.25, 0.1, 1.0);
   const auto rays = sphereMirror(eye, 1.2, true, 0.1, 7, 1.0, 25.0);
