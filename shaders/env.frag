@@ -12,12 +12,20 @@ layout(location = 0) out vec4 o_color;
 layout(location = 1) out vec4 o_seen;
 layout(location = 2) out vec4 o_surface;
 #include "shading.glsl"
+#if defined(FACETED)
+flat in vec3 v_face_normal;
+flat in vec3 v_face_light;
+#endif
 void main() {
-  vec3 n = normalize(v_normal);
-  if (dot(n, v_pos - u_view_origin) > 0.0) n = -n;  // two-sided: face the viewer, as the tracer does
   vec3 albedo = u_albedo;
   if (u_has_texture) albedo *= texture(u_texture, v_uv).rgb;
+#if defined(FACETED)
+  o_color = vec4(albedo * (v_face_light + pointLights(v_pos, v_face_normal)), 1.0);
+#else
+  vec3 n = normalize(v_normal);
+  if (dot(n, v_pos - u_view_origin) > 0.0) n = -n;  // two-sided: face the viewer, as the tracer does
   o_color = vec4(shadeDiffuse(albedo, v_pos, n), 1.0);
+#endif
   o_seen = vec4(v_pos, 1.0);
   o_surface = vec4(0.0);
 }

@@ -1,6 +1,10 @@
 #version 330 core
 // Environment meshes. Vertices are relative to the mesh anchor; u_offset = anchor - camera origin (computed
 // in double on the CPU), so world-space magnitudes never reach float.
+// FACETED (a mesh whose triangles each have one normal at all three corners: quads, grounds, boxes): the
+// face's normal, turned to the viewer, and its ambient + directional light are computed here once per vertex
+// and passed flat; on a planar face they are the same at every point, so this equals the per-fragment
+// result (env.frag) at a fraction of llvmpipe's cost.
 layout(location = 0) in vec3 a_pos;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv;
@@ -9,9 +13,21 @@ uniform vec3 u_offset;
 out vec3 v_pos;            // relative to the camera origin
 out vec3 v_normal;
 out vec2 v_uv;
+#if defined(FACETED)
+uniform vec3 u_view_origin;
+flat out vec3 v_face_normal;  // facing the viewer
+flat out vec3 v_face_light;   // ambientAndDirectional(v_face_normal)
+#include "shading.glsl"
+#endif
 void main() {
   v_pos = a_pos + u_offset;
   v_normal = a_normal;
   v_uv = a_uv;
+#if defined(FACETED)
+  vec3 n = normalize(a_normal);
+  if (dot(n, v_pos - u_view_origin) > 0.0) n = -n;  // two-sided, as env.frag
+  v_face_normal = n;
+  v_face_light = ambientAndDirectional(n);
+#endif
   gl_Position = u_view_proj * vec4(v_pos, 1.0);
 }

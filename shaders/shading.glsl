@@ -21,11 +21,18 @@ uniform vec3 u_point_light_pos[NUM_POINT_LIGHTS];         // relative to the cam
 uniform vec3 u_point_light_radiance[NUM_POINT_LIGHTS];
 #endif
 
-vec3 shadeDiffuse(vec3 albedo, vec3 p, vec3 n) {
+// The light that depends on the normal only: ambient and directional (constant over a planar face).
+vec3 ambientAndDirectional(vec3 n) {
   vec3 light = u_ambient;
 #if NUM_DIR_LIGHTS > 0
   for (int i = 0; i < NUM_DIR_LIGHTS; ++i) light += max(0.0, -dot(n, u_dir_light_dir[i])) * u_dir_light_radiance[i];
 #endif
+  return light;
+}
+
+// The light that depends on the point too: point lights.
+vec3 pointLights(vec3 p, vec3 n) {
+  vec3 light = vec3(0.0);
 #if NUM_POINT_LIGHTS > 0
   for (int i = 0; i < NUM_POINT_LIGHTS; ++i) {
     vec3 to = u_point_light_pos[i] - p;
@@ -33,5 +40,7 @@ vec3 shadeDiffuse(vec3 albedo, vec3 p, vec3 n) {
     if (d2 > 0.0) light += max(0.0, dot(n, to) * inversesqrt(d2)) / d2 * u_point_light_radiance[i];
   }
 #endif
-  return albedo * light;
+  return light;
 }
+
+vec3 shadeDiffuse(vec3 albedo, vec3 p, vec3 n) { return albedo * (ambientAndDirectional(n) + pointLights(p, n)); }

@@ -236,6 +236,7 @@ struct Renderer::Impl {
     return d;
   }
   Program env_program = makeProgram("env.vert", "env.frag", defines({}));
+  Program env_faceted_program = makeProgram("env.vert", "env.frag", defines({"#define FACETED"}));
   Program sky_program = makeProgram("sky.vert", "sky.frag");
   Program plain_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_PLAIN"}));
   Program envmap_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_ENVMAP"}));
@@ -246,6 +247,7 @@ struct Renderer::Impl {
   Program lens3_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_PVRR", "#define CHANNELS 3", "#define LENS"}));
   GLuint empty_vao = 0;
   std::vector<MeshBuffers> env_meshes;
+  std::vector<bool> env_faceted;  // per environment mesh: every triangle has one normal at its three corners
   std::vector<Texture> textures;  // environment textures, in Scene::textures order
   std::unique_ptr<Framebuffer> frame_target;      // the second pass: colour, seen point, surface point
   std::vector<std::unique_ptr<Framebuffer>> maps;  // first-pass maps, one per patch view (reused)
@@ -280,6 +282,10 @@ struct Renderer::Impl {
       idx.reserve(mesh.triangles.size() * 3);
       for (const auto& t : mesh.triangles) idx.insert(idx.end(), {t.x, t.y, t.z});
       uploadMesh(env_meshes[m], data, {3, 3, 2}, idx);
+      env_faceted.push_back(std::all_of(mesh.triangles.begin(), mesh.triangles.end(), [&](const auto& t) {
+        const glm::vec3 n = mesh.normals[t.x];
+        return glm::length(mesh.normals[t.y] - n) <= 1e-6f && glm::length(mesh.normals[t.z] - n) <= 1e-6f;
+      }));
     }
     checkGlError("uploading the environment");
   }
@@ -339,18 +345,22 @@ struct Renderer::Impl {
     glEnable(GL_DEPTH_TEST);
     glDepthMask(GL_TRUE);
     glDepthFunc(reversed_depth ? GL_GREATER : GL_LESS);
-    env_program.use();
-    env_program.set("u_view_proj", toFloat(vp));
-    env_program.set("u_view_origin", rays_from ? glm::vec3(*rays_from - origin) : glm::vec3(0.0f));
-    env_program.set("u_texture", 0);
-    setLights(env_program, origin);
+    for (const Program* p : {&env_faceted_program, &env_program}) {
+      p->use();
+      p->set("u_view_proj", toFloat(vp));
+      p->set("u_view_origin", rays_from ? glm::vec3(*rays_from - origin) : glm::vec3(0.0f));
+      p->set("u_texture", 0);
+      setLights(*p, origin);
+    }
     glActiveTexture(GL_TEXTURE0);
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
       const EnvMesh& mesh = scene.meshes[m];
       const DiffuseMaterial& mat = scene.materials[size_t(mesh.material)];
-      env_program.set("u_offset", glm::vec3(mesh.anchor - origin));
-      env_program.set("u_albedo", glm::vec3(mat.color));
-      env_program.set("u_has_texture", mat.texture >= 0 ? 1 : 0);
+      const Program& p = env_faceted[m] ? env_faceted_program : env_program;
+      p.use();
+      p.set("u_offset", glm::vec3(mesh.anchor - origin));
+      p.set("u_albedo", glm::vec3(mat.color));
+      p.set("u_has_texture", mat.texture >= 0 ? 1 : 0);
       if (mat.texture >= 0) glBindTexture(GL_TEXTURE_2D, textures[size_t(mat.texture)].name());
       draw(env_meshes[m]);
     }
