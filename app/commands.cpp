@@ -189,6 +189,7 @@ RenderedFrame timedFrame(LoadedScene& ls, const std::string& mode, const std::st
     // Its own scope: its renderer is released while its context is current, before the next one exists.
     RenderSession timing;
     timing.seen_points = false;
+    timing.read_back = false;  // the pixels come from the frame below: no readback in the timed frames
     for (int i = 0; i <= frames; ++i) {
       timing.cache = gl::FrameCache{};
       timed = renderFrame(ls, mode, gl_backend_name, &timing);
@@ -254,6 +255,7 @@ RenderedFrame renderFrame(LoadedScene& ls, const std::string& mode, const std::s
     ro.vertex.channels.clear();  // per element: dispersionChannels(scene, e), rgb or spectral as the scene says
     session->renderer = std::make_unique<gl::Renderer>(scene, *session->rays, ro);
   }
+  session->renderer->setReadBack(session->read_back);
   gl::RasterFrame f = session->renderer->render(rm, &session->cache);
   takePixels(out, f);
   out.stages = std::move(f.stages);
@@ -306,6 +308,7 @@ int cmdRender(const std::vector<std::string>& argv) {
       session.cache.environment_changed = false;
     }
     if (i > 0 && orbit_deg == 0) session.cache.environment_changed = false;
+    session.read_back = i + 1 == frames;  // only the last frame is written out
     last = renderFrame(ls, mode, gl_name, &session);
     if (i + 1 == rss_frame) rss_baseline_mb = currentRssMb();
     if ((i + 1) % sample_every == 0 || i + 1 == frames) rss_samples.push_back({i + 1, currentRssMb()});

@@ -36,6 +36,9 @@ struct RenderSession {
   int seen_channel = -1;  // gl::RendererOptions::seen_channel of the renderer this session creates
   bool moving_elements = false;  // RaySceneOptions::moving_elements: the head turns between frames
   bool seen_points = true;       // gl::RendererOptions::seen_points: off when only the picture is wanted
+  // Whether the next raster frame is read back from the GPU (RenderedFrame's pixels): off for frames that are
+  // only timed or not written, so that no frame time includes the readback (a viewer presents the frame).
+  bool read_back = true;
 };
 
 RenderedFrame renderFrame(LoadedScene& ls, const std::string& mode, const std::string& gl_backend_name,

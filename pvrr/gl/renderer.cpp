@@ -753,6 +753,7 @@ Renderer::Renderer(const Scene& scene, const RayScene& rays, RendererOptions opt
 Renderer::~Renderer() = default;
 
 RasterFrame Renderer::render(RasterMode mode, FrameCache* cache) { return impl_->render(mode, cache); }
+void Renderer::setReadBack(bool on) { impl_->options.read_back = on; }
 
 RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   const auto frame_start = Clock::now();

@@ -79,6 +79,8 @@ class Renderer {
   // Renders one frame of `scene` (which may have moved since construction only in its observer and in the
   // poses of elements attached to the observer) as seen by the scene's observer.
   RasterFrame render(RasterMode mode, FrameCache* cache = nullptr);
+  // RendererOptions::read_back for the next frames (e.g. only the last of a run is written out).
+  void setReadBack(bool on);
 
  private:
   struct Impl;
