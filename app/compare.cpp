@@ -479,10 +479,12 @@ int cmdVertices(const std::vector<std::string>& argv) {
   for (const ElementFrame& f : frames) {
     const Element& el = scene.elements[size_t(f.element)];
     json patches = json::array();
-    const size_t in_view = size_t(std::count_if(f.views.begin(), f.views.end(), [](const PatchView& v) { return v.in_view; }));
+    gl::RendererOptions ro;
+    ro.map_size = scene.render.map_size;
+    ro.map_texels_per_pixel = scene.render.map_texels_per_pixel;
     for (const PatchView& pv : f.views) {
       const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
-      const std::array<int, 2> texels = mapTexels(pv.volume, gl::patchMapSize(scene.render.map_size, std::max<size_t>(1, in_view)));
+      const std::array<int, 2> texels = mapTexels(pv.volume, gl::topLevelMapSide(scene, f, pv, ro));
       for (size_t c = 0; c < pv.st.size(); ++c) {
         const double wl = f.channels[c].wavelength_nm > 0 ? f.channels[c].wavelength_nm : kLineD_nm;
         auto rm = [](const Mat4& m) { auto r = rowMajor16(m); return json(std::vector<double>(r.begin(), r.end())); };

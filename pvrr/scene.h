@@ -101,7 +101,8 @@ struct Element {
 
 struct RenderSettings {
   std::string mode = "pvrr";
-  int map_size = 1024;
+  int map_size = 1024;               // a map's longer side at most (texels)
+  double map_texels_per_pixel = 4;   // a top-level map's texels per image pixel of its patch; 0: map_size
   std::string output;
   int max_depth = 4;
   std::string dispersion = "off";  // off | rgb | spectral

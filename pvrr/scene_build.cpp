@@ -348,6 +348,7 @@ Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
   RenderSettings& rs = scene.render;
   rs.mode = toString(desc.render.mode);
   rs.map_size = desc.render.map_size;
+  rs.map_texels_per_pixel = desc.render.map_texels_per_pixel;
   rs.output = desc.render.output.empty() ? "out/" + scene.name + ".png" : desc.render.output;
   rs.max_depth = desc.render.max_depth;
   rs.dispersion = toString(desc.render.dispersion);

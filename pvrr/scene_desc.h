@@ -192,6 +192,7 @@ struct RenderDesc {
   enum class Dispersion { Off, Rgb, Spectral };
   Mode mode = Mode::Pvrr;
   int map_size = 1024;
+  double map_texels_per_pixel = 4;  // 0: every map at map_size
   std::string output;  // relative to the current directory, as written (default out/<scene name>.png)
   int max_depth = 4;
   Dispersion dispersion = Dispersion::Off;

@@ -365,4 +365,23 @@ void updateTextureCoordinates(const RayScene& rays, ElementFrame& f) {
   f.rays_ms = msSince(t0);
 }
 
+double patchScreenPixels(const ElementFrame& f, const PatchView& pv, const Mat4& world_to_clip, int width, int height) {
+  const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
+  std::vector<Vec2> px(gp.vertices.size());
+  std::vector<char> front(gp.vertices.size());
+  for (size_t k = 0; k < gp.vertices.size(); ++k) {
+    const Vec4 c = world_to_clip * Vec4(f.world_pos[gp.vertices[k]], 1.0);
+    front[k] = c.w > 0;
+    if (front[k])
+      px[k] = Vec2((glm::clamp(c.x / c.w, -1.0, 1.0) + 1) * 0.5 * width, (glm::clamp(c.y / c.w, -1.0, 1.0) + 1) * 0.5 * height);
+  }
+  double area = 0;
+  for (const auto& t : gp.triangles) {
+    if (!front[t.x] || !front[t.y] || !front[t.z]) continue;
+    const Vec2 a = px[t.y] - px[t.x], b = px[t.z] - px[t.x];
+    area += 0.5 * std::abs(a.x * b.y - a.y * b.x);
+  }
+  return area;
+}
+
 }  // namespace pvrr

@@ -132,4 +132,9 @@ void fitPatchViews(const Scene& scene, ElementFrame& f, const VertexStageOptions
 void moveRigidly(ElementFrame& f, const Mat4& motion);
 void updateTextureCoordinates(const RayScene& rays, ElementFrame& f);
 
+// The image pixels a patch covers: the summed screen area of its triangles (either face), each vertex
+// projected through `world_to_clip` and clamped to the image (a triangle partly outside it counts its part
+// inside, roughly); triangles with a vertex at or behind the eye plane are left out. width x height: the image.
+double patchScreenPixels(const ElementFrame& f, const PatchView& pv, const Mat4& world_to_clip, int width, int height);
+
 }  // namespace pvrr

@@ -300,6 +300,16 @@ std::array<int, 2> mapTexels(const ViewVolume& vv, int longest_side) {
   return w >= h ? std::array<int, 2>{longest_side, share(h / w)} : std::array<int, 2>{share(w / h), longest_side};
 }
 
+int mapSideForPixels(const ViewVolume& vv, double pixels, double texels_per_pixel, int max_side) {
+  if (!(texels_per_pixel > 0) || !(pixels >= 0)) return max_side;
+  const double w = vv.right_ - vv.left, h = vv.top - vv.bottom;
+  const double ratio = (w > 0 && h > 0 && std::isfinite(w / h)) ? std::min(w, h) / std::max(w, h) : 1.0;
+  const double side = std::sqrt(texels_per_pixel * pixels / ratio);
+  const int lo = std::min(max_side, 128);
+  if (!(side < max_side)) return max_side;
+  return std::clamp(32 * int(std::ceil(side / 32.0)), lo, max_side);
+}
+
 std::array<double, 16> rowMajor16(const Mat4& m) {
   std::array<double, 16> out{};
   for (int r = 0; r < 4; ++r)

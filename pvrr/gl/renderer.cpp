@@ -190,6 +190,15 @@ int patchMapSize(int map_size, size_t patches) {
   return std::max(128, int(double(map_size) / shrink));
 }
 
+int topLevelMapSide(const Scene& scene, const ElementFrame& f, const PatchView& pv, const RendererOptions& options) {
+  const size_t in_view = size_t(std::count_if(f.views.begin(), f.views.end(), [](const PatchView& v) { return v.in_view; }));
+  const int size = patchMapSize(options.map_size, std::max<size_t>(1, in_view));
+  if (!(options.map_texels_per_pixel > 0)) return size;
+  const Observer& ob = scene.observer;
+  const double pixels = patchScreenPixels(f, pv, ob.visibilityProjection() * ob.view(), ob.width, ob.height);
+  return mapSideForPixels(pv.volume, pixels, options.map_texels_per_pixel, size);
+}
+
 namespace {
 
 // A camera of one pass (the second pass, or a first pass from a virtual viewpoint): positions are relative
@@ -251,6 +260,7 @@ struct Renderer::Impl {
   std::vector<Texture> textures;  // environment textures, in Scene::textures order
   std::unique_ptr<Framebuffer> frame_target;      // the second pass: colour, seen point, surface point
   std::vector<std::unique_ptr<Framebuffer>> maps;  // first-pass maps, one per patch view (reused)
+  std::vector<int> map_side;  // per map slot: the longer side its last first pass rendered (MapPass::side)
   std::vector<std::unique_ptr<CubeTarget>> cubes;  // envmap cubes, one per element
   std::vector<MeshBuffers> element_meshes;     // per (element, patch) in pvrr mode; per element otherwise
 
@@ -470,8 +480,9 @@ struct Renderer::Impl {
     int depth = 0;     // the tracer's depth (events before) of what this map shows: 1 behind a mirror seen
                        // from the eye, 2 behind a lens (two interfaces)
     size_t slot = 0;   // index into `maps`
-    int size = 0;      // the map texture's width and height (nestedMapSize for nested maps); the pass renders
-                       // the lower-left mapTexels(volume, size) of it
+    int size = 0;      // the map texture's width and height (nestedMapSize for nested maps)
+    int side = 0;      // the longer side rendered (topLevelMapSide; nested: size): the pass renders the
+                       // lower-left mapTexels(volume, side) of the texture
     bool visible = true;  // false: a top-level element the observer cannot see; its map is left as it is
     std::vector<NestedDraw> nested;
   };
@@ -572,7 +583,8 @@ struct Renderer::Impl {
     for (const ElementFrame& f : frames)
       for (size_t v = 0; v < f.views.size(); ++v)
         passes.push_back({&f, v, interfaces(scene.elements[size_t(f.element)]), slot++,
-                          patchMapSize(options.map_size, std::max<size_t>(1, inView(f))), true, {}});
+                          patchMapSize(options.map_size, std::max<size_t>(1, inView(f))),
+                          topLevelMapSide(scene, f, f.views[v], options), true, {}});
     const size_t top = passes.size();
     // A top-level element outside the observer's view needs no map (its second-pass triangles are clipped).
     const Observer& ob = scene.observer;
@@ -622,11 +634,13 @@ struct Renderer::Impl {
         const size_t first = slot;
         const int size = nestedMapSize(passes[i].size);
         for (size_t v = 0; v < nf->views.size(); ++v)  // a patch the owner's map camera cannot see: no map
-          passes.push_back({nf.get(), v, depth + interfaces(el), slot++, size, nf->views[v].in_view, {}});
+          passes.push_back({nf.get(), v, depth + interfaces(el), slot++, size, size, nf->views[v].in_view, {}});
         passes[i].nested.push_back({int(b), nf.get(), first});
         nested_frames.push_back(std::move(nf));
       }
     }
+    map_side.assign(passes.size(), 0);
+    for (const MapPass& mp : passes) map_side[mp.slot] = mp.side;
     return passes.size() - top;
   }
 
@@ -671,7 +685,7 @@ struct Renderer::Impl {
       p.set("u_seen_offset", glm::vec3(pv.volume.eye - cam.origin));
       // The map fills the lower-left mapTexels() of its texture: (s, t) in [0, 1]^2 of the volume scale to
       // that region, clamped half a texel inside it (as GL_CLAMP_TO_EDGE does at the texture's own edge).
-      const std::array<int, 2> region = mapTexels(pv.volume, map.width());
+      const std::array<int, 2> region = mapTexels(pv.volume, map_side[first_slot + v]);
       const glm::vec2 texels{float(region[0]), float(region[1])}, size{float(map.width()), float(map.height())};
       p.set("u_st_scale", texels / size);
       p.set("u_st_max", (texels - 0.5f) / size);
@@ -724,7 +738,7 @@ struct Renderer::Impl {
       const Framebuffer& t = mapTarget(mp.slot, mp.size);
       if (!mp.visible) continue;
       // No colour clear: the sky covers every texel nothing else does (drawEnvironment).
-      const std::array<int, 2> region = mapTexels(pv.volume, mp.size);
+      const std::array<int, 2> region = mapTexels(pv.volume, mp.side);
       t.clearDepth(pv.volume.backward ? 0.0f : 1.0f);
       t.bindRegion(region[0], region[1]);
       // In a reversed (zooming) map the rays come from the mirror, not from the viewpoint.
@@ -896,7 +910,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     // The note: how many maps of which size, and what was not rendered.
     std::map<std::array<int, 2>, int, std::greater<std::array<int, 2>>> sizes;
     for (const MapPass& mp : passes)
-      if (mp.visible) ++sizes[mapTexels(mp.owner->views[mp.view].volume, mp.size)];
+      if (mp.visible) ++sizes[mapTexels(mp.owner->views[mp.view].volume, mp.side)];
     std::string note;
     for (const auto& [texels, n] : sizes)
       note += (note.empty() ? "" : ", ") + std::to_string(n) + " x " + std::to_string(texels[0]) + "x" +

@@ -37,7 +37,10 @@ struct RasterFrame {
 };
 
 struct RendererOptions {
-  int map_size = 1024;              // first-pass map (pvrr) or cube face (envmap) size
+  int map_size = 1024;              // first-pass map's longer side at most (pvrr), cube face size (envmap)
+  // pvrr: each top-level map's texels per image pixel of its patch (Scene render.map_texels_per_pixel); the
+  // map's longer side is lowered from map_size to that (topLevelMapSide). 0: always map_size.
+  double map_texels_per_pixel = 4;
   // Viewpoint options and channels. Channels empty: each element gets dispersionChannels(scene, element)
   // (the scene's render.dispersion and spectral_samples); otherwise every element gets these channels.
   VertexStageOptions vertex;
@@ -68,6 +71,11 @@ struct FrameCache {
 // are in the observer's view: map_size up to four patches, beyond that shrunk so that all of them together
 // hold about as many texels as four full maps. Each map renders mapTexels(volume, this) (pvrr/view_volume.h).
 int patchMapSize(int map_size, size_t patches_in_view);
+
+// The longer side (texels) of the map of the top-level patch `pv` of `f`: patchMapSize, lowered to what the
+// patch's pixels in the observer's image need at options.map_texels_per_pixel (mapSideForPixels of
+// patchScreenPixels). It renders mapTexels(pv.volume, this) texels.
+int topLevelMapSide(const Scene& scene, const ElementFrame& f, const PatchView& pv, const RendererOptions& options);
 
 class Renderer {
  public:

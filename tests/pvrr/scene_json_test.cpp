@@ -349,6 +349,7 @@ TEST(SceneJson, DefaultsAreFilledIn) {
   EXPECT_EQ(s.lights[0].type, LightDesc::Type::Ambient);
   EXPECT_EQ(s.render.mode, RenderDesc::Mode::Pvrr);
   EXPECT_EQ(s.render.map_size, 1024);
+  EXPECT_EQ(s.render.map_texels_per_pixel, 4.0);
   EXPECT_EQ(s.render.max_depth, 4);
   EXPECT_EQ(s.render.output, "out/test.png");
   EXPECT_TRUE(s.elements[1].attached_to_observer);
@@ -556,6 +557,8 @@ TEST(SceneJson, OverridesAreValidatedLikeTheFile) {
             kName + ": elements[0].pose.normal: expected a non-zero direction [x, y, z], got [0,0,0] (from --set "
                     "elements[0].pose.normal=[0,0,0])");
   expectContains(errorOf(kBase, {"observer.target=[0,1.2,0]"}), "observer.target: expected a point different");
+  EXPECT_EQ(parse(kBase, {"render.map_texels_per_pixel=0"}).render.map_texels_per_pixel, 0.0);
+  expectContains(errorOf(kBase, {"render.map_texels_per_pixel=-1"}), "render.map_texels_per_pixel: expected a number in [0, 10000]");
 }
 
 TEST(SceneJson, OverrideOfAnUnknownPathFailsNamingIt) {

@@ -43,6 +43,36 @@ TEST(VertexStage, PlaneMirrorViewpointIsTheMirrorImageOfTheEye) {
   }
 }
 
+// A plane rectangle facing the eye head-on projects to a rectangle: (w / (2 d tan(fov_y / 2) * aspect)) *
+// width by (h / (2 d tan(fov_y / 2))) * height pixels. Half of it out of the image counts half. Behind the
+// eye: nothing.
+TEST(VertexStage, PatchScreenPixelsOfAHeadOnRectangle) {
+  Scene s = test::roomScene(Vec3(0, 0, 2), Vec3(0, 0, 0), 400, 300);
+  const double w = 0.6, h = 0.4;
+  const cad::Outline outline = cad::Outline::rectangle(w, h);
+  test::addMirror(s, cad::makePlane(outline), outline, test::pose(Vec3(0), Vec3(0, 0, 1)), 9);
+  s.updateBounds();
+  RayScene rays(s);
+  ElementFrame f = prepareElement(s, 0);
+  traceVertexRays(rays, f, s.observer.eye, VertexStageOptions{});
+  fitPatchViews(s, f, VertexStageOptions{});
+  ASSERT_EQ(f.views.size(), 1u);
+  const PatchView& pv = f.views[0];
+  const double half_h = 2.0 * std::tan(s.observer.fov_y_rad / 2), half_w = half_h * 400.0 / 300.0;  // at d = 2
+  const double expected = (w / (2 * half_w) * 400) * (h / (2 * half_h) * 300);
+  const Mat4 clip = s.observer.visibilityProjection() * s.observer.view();
+  EXPECT_NEAR(patchScreenPixels(f, pv, clip, 400, 300), expected, 1e-6 * expected);
+  // Looking so that the image's left edge runs through the mirror's centre: the half inside counts.
+  const double yaw = std::atan(half_w / 2.0);  // the left edge of the view is yaw from the axis
+  s.observer.target = s.observer.eye + Vec3(std::sin(yaw), 0, -std::cos(yaw));
+  const double off = patchScreenPixels(f, pv, s.observer.visibilityProjection() * s.observer.view(), 400, 300);
+  EXPECT_GT(off, 0.3 * expected);
+  EXPECT_LT(off, 0.7 * expected);
+  // Looking away: the mirror is behind the eye plane.
+  s.observer.target = s.observer.eye + Vec3(0, 0, 1);
+  EXPECT_EQ(patchScreenPixels(f, pv, s.observer.visibilityProjection() * s.observer.view(), 400, 300), 0.0);
+}
+
 TEST(VertexStage, MirrorRaysObeyTheLawOfReflection) {
   Scene s = test::roomScene(Vec3(0.2, 0.1, 1.5), Vec3(0, 0, 0));
   const cad::Outline outline = cad::Outline::rectangle(0.3, 0.2, 0.03);

@@ -204,6 +204,25 @@ TEST(ViewVolume, MapTexelsAreSquareOnTheNearPlane) {
   EXPECT_EQ(mapTexels(sliver, 8)[1], 8);
 }
 
+// The map side for a patch's pixels: texels_per_pixel * pixels texels at square texels, rounded up to 32,
+// within [min(max, 128), max]; 0 texels per pixel: max.
+TEST(ViewVolume, MapSideForPixels) {
+  ViewVolumeOptions opt;
+  opt.margin = 0;
+  const ViewVolume square = buildViewVolume(Vec3(0), fan({-5, 5}, {-5, 5}), opt);
+  EXPECT_EQ(mapSideForPixels(square, 10000, 4, 1024), 224);  // sqrt(40000) = 200 -> 224
+  EXPECT_EQ(mapSideForPixels(square, 1e7, 4, 1024), 1024);
+  EXPECT_EQ(mapSideForPixels(square, 10, 4, 1024), 128);
+  EXPECT_EQ(mapSideForPixels(square, 10, 4, 100), 100);
+  EXPECT_EQ(mapSideForPixels(square, 10000, 0, 1024), 1024);
+  // A 3.274 : 1 frustum: the longer side grows by sqrt(3.274) so that the texels stay 4 per pixel.
+  const ViewVolume wide = buildViewVolume(Vec3(0), fan({-30, 0, 30}, {-10, 10}), opt);
+  const int side = mapSideForPixels(wide, 10000, 4, 1024);
+  EXPECT_EQ(side, 32 * int(std::ceil(std::sqrt(40000 * std::tan(radians(30.0)) / std::tan(radians(10.0))) / 32)));
+  const std::array<int, 2> t = mapTexels(wide, side);
+  EXPECT_GE(double(t[0]) * t[1], 40000);
+}
+
 TEST(ViewVolume, UpHintIsHonoured) {
   const Vec3 eye(0.25, 0.1, 1.0);
   const auto rays = sphereMirror(eye, 1.2, true, 0.1, 7, 1.0, 25.0);
