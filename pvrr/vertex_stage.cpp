@@ -377,7 +377,9 @@ double patchScreenPixels(const ElementFrame& f, const PatchView& pv, const Mat4&
   }
   double area = 0;
   for (const auto& t : gp.triangles) {
-    if (!front[t.x] || !front[t.y] || !front[t.z]) continue;
+    const int n_front = front[t.x] + front[t.y] + front[t.z];
+    if (n_front == 0) continue;
+    if (n_front < 3) return double(width) * double(height);  // reaches behind the eye: the whole image at most
     const Vec2 a = px[t.y] - px[t.x], b = px[t.z] - px[t.x];
     area += 0.5 * std::abs(a.x * b.y - a.y * b.x);
   }

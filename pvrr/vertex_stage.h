@@ -134,7 +134,8 @@ void updateTextureCoordinates(const RayScene& rays, ElementFrame& f);
 
 // The image pixels a patch covers: the summed screen area of its triangles (either face), each vertex
 // projected through `world_to_clip` and clamped to the image (a triangle partly outside it counts its part
-// inside, roughly); triangles with a vertex at or behind the eye plane are left out. width x height: the image.
+// inside, roughly); triangles wholly at or behind the eye plane are left out, and a patch with a triangle
+// across that plane counts as the whole image (its projection is unbounded). width x height: the image.
 double patchScreenPixels(const ElementFrame& f, const PatchView& pv, const Mat4& world_to_clip, int width, int height);
 
 }  // namespace pvrr

@@ -71,6 +71,10 @@ TEST(VertexStage, PatchScreenPixelsOfAHeadOnRectangle) {
   // Looking away: the mirror is behind the eye plane.
   s.observer.target = s.observer.eye + Vec3(0, 0, 1);
   EXPECT_EQ(patchScreenPixels(f, pv, s.observer.visibilityProjection() * s.observer.view(), 400, 300), 0.0);
+  // Looking along the mirror's plane from its middle: part of it lies behind the eye plane, so the whole image.
+  s.observer.eye = Vec3(0, 0, 0.01);
+  s.observer.target = Vec3(1, 0, 0.01);
+  EXPECT_EQ(patchScreenPixels(f, pv, s.observer.visibilityProjection() * s.observer.view(), 400, 300), 400.0 * 300.0);
 }
 
 TEST(VertexStage, MirrorRaysObeyTheLawOfReflection) {
