@@ -57,7 +57,9 @@ const std::map<std::string, Command>& commands() {
         "pvrr sweep SCENE [--tessellation N1,N2,...] [--map-size S1,S2,...] [--vary PATH=V1,V2,...]... [--modes M1,...]\n"
         "           [--size WxH] [--frames N] [--gl B] --out DIR\n"
         "  Writes DIR/sweep.csv (mode,tessellation,map_size,vertices,frame_ms,median_arcmin,p95_arcmin,max_arcmin,\n"
-        "  psnr_db,reference_ms,vary), DIR/error_vs_time.png and .svg, DIR/error_vs_vertices.png."}},
+        "  psnr_db,reference_ms,vary), DIR/error_vs_time.png and .svg, DIR/error_vs_vertices.png.\n"
+        "  --map-size fixes each map's longer side (render.map_texels_per_pixel=0 unless --set says otherwise);\n"
+        "  without it, the scene's own map sizing."}},
       {"plot",
        {cmdPlot, "redraw the plots of a sweep from its CSV", "pvrr plot DIR/sweep.csv [--out DIR]"}},
       {"mesh",

@@ -94,6 +94,9 @@ int cmdSweep(const std::vector<std::string>& argv) {
     for (int n : tess)
       for (int map : maps) {
         std::vector<std::string> sets = base_sets;
+        // Explicit map sizes are the maps' sizes: not lowered to the element's pixels (a --set of
+        // render.map_texels_per_pixel, coming later, still wins).
+        if (a.has("map-size")) sets.insert(sets.begin(), "render.map_texels_per_pixel=0");
         for (size_t e = 0; e < ref_scene.scene.elements.size(); ++e)
           sets.push_back("elements[" + std::to_string(e) + "].tessellation=" + std::to_string(n));
         sets.push_back("render.map_size=" + std::to_string(map));

@@ -127,8 +127,8 @@ Vec2 projectToTexel(const ViewVolume& vv, const Vec3& world_point, int width, in
 std::array<int, 2> mapTexels(const ViewVolume& vv, int longest_side);
 
 // The longer side of a map of this volume that holds `texels_per_pixel` texels for each of `pixels` image
-// pixels (mapTexels' w * h >= texels_per_pixel * pixels), rounded up to a multiple of 32, at least
-// min(max_side, 128) and at most max_side. texels_per_pixel <= 0: max_side.
+// pixels (mapTexels' w * h >= texels_per_pixel * pixels), rounded up to a multiple of 32 and at least 128,
+// unless capped at max_side (returned as it is). texels_per_pixel <= 0: max_side.
 int mapSideForPixels(const ViewVolume& vv, double pixels, double texels_per_pixel, int max_side);
 
 // m as 16 doubles, row-major (out[4 * row + col]), e.g. for printing or row-major APIs; glm is column-major.

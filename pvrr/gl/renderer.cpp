@@ -174,9 +174,9 @@ constexpr size_t kElementFloats = 27;
 // and depth target. Elements that would need more are drawn dark in their map, and the stats say so.
 constexpr size_t kMaxFirstPasses = 16;
 
-// The map size of an element seen in a map of size `parent`: half of it, at least 128 texels. A nested
-// element covers part of its parent's map, which covers part of the image, so half the parent's texels
-// still exceed the pixels it covers in the shipped scenes; full-size nested maps (28 MB each at 1024^2 then: RGBA16F
+// The map size of an element seen in a map of size `parent`: half of it, at least 128 texels (for both the
+// texture and the side rendered). A nested element covers part of its parent's map, which covers part of the
+// image, so half the parent's texels still exceed the pixels it covers in the shipped scenes; full-size nested maps (28 MB each at 1024^2 then: RGBA16F
 // colour, RGBA32F seen points, 32-bit depth) took the mirror pair's render at 1280 x 720 to 460 MB.
 int nestedMapSize(int parent) { return parent <= 128 ? parent : std::max(128, parent / 2); }
 
@@ -292,9 +292,14 @@ struct Renderer::Impl {
       idx.reserve(mesh.triangles.size() * 3);
       for (const auto& t : mesh.triangles) idx.insert(idx.end(), {t.x, t.y, t.z});
       uploadMesh(env_meshes[m], data, {3, 3, 2}, idx);
+      // Faceted: each triangle's three normals equal and perpendicular to it (a supplied normal tilted from
+      // its face would make the per-vertex two-sided flip differ from the per-fragment one).
       env_faceted.push_back(std::all_of(mesh.triangles.begin(), mesh.triangles.end(), [&](const auto& t) {
         const glm::vec3 n = mesh.normals[t.x];
-        return glm::length(mesh.normals[t.y] - n) <= 1e-6f && glm::length(mesh.normals[t.z] - n) <= 1e-6f;
+        const Vec3 face = glm::cross(Vec3(mesh.positions[t.y] - mesh.positions[t.x]), Vec3(mesh.positions[t.z] - mesh.positions[t.x]));
+        const double len = glm::length(face);
+        const bool perpendicular = len == 0 || std::abs(glm::dot(face / len, Vec3(n))) >= 1 - 1e-6;
+        return perpendicular && glm::length(mesh.normals[t.y] - n) <= 1e-6f && glm::length(mesh.normals[t.z] - n) <= 1e-6f;
       }));
     }
     checkGlError("uploading the environment");
@@ -481,7 +486,7 @@ struct Renderer::Impl {
                        // from the eye, 2 behind a lens (two interfaces)
     size_t slot = 0;   // index into `maps`
     int size = 0;      // the map texture's width and height (nestedMapSize for nested maps)
-    int side = 0;      // the longer side rendered (topLevelMapSide; nested: size): the pass renders the
+    int side = 0;      // the longer side rendered (topLevelMapSide; nested: half the parent's): the pass renders the
                        // lower-left mapTexels(volume, side) of the texture
     bool visible = true;  // false: a top-level element the observer cannot see; its map is left as it is
     std::vector<NestedDraw> nested;
@@ -632,9 +637,11 @@ struct Renderer::Impl {
           continue;
         }
         const size_t first = slot;
-        const int size = nestedMapSize(passes[i].size);
+        // The texture at half the parent's texture (it never reallocates), the rendered side at half the
+        // parent's rendered side.
+        const int size = nestedMapSize(passes[i].size), side = std::min(size, nestedMapSize(passes[i].side));
         for (size_t v = 0; v < nf->views.size(); ++v)  // a patch the owner's map camera cannot see: no map
-          passes.push_back({nf.get(), v, depth + interfaces(el), slot++, size, size, nf->views[v].in_view, {}});
+          passes.push_back({nf.get(), v, depth + interfaces(el), slot++, size, side, nf->views[v].in_view, {}});
         passes[i].nested.push_back({int(b), nf.get(), first});
         nested_frames.push_back(std::move(nf));
       }

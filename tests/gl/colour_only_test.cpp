@@ -79,7 +79,9 @@ TEST_P(ColourOnlyTest, FirstFrameOfEachModeEqualsALaterOne) {
 // No pass clears its colour attachments (the sky covers every pixel nothing else does, and a map renders
 // only the region its volume needs): a renderer that has drawn another view first must give exactly the
 // picture, seen points and element ids of a fresh renderer. A pixel or texel left unwritten would keep the
-// other view's value. The concave mirror's zooming region takes the reversed-depth map path.
+// other view's value. The other view is at 8 times the image size, so its maps fill larger regions of their
+// textures: a texture read outside the current region (a wrong scale or clamp) would see them. The concave
+// mirror's zooming region takes the reversed-depth map path.
 TEST_P(ColourOnlyTest, EveryPixelIsDrawnWithoutAColourClear) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
@@ -95,9 +97,20 @@ TEST_P(ColourOnlyTest, EveryPixelIsDrawnWithoutAColourClear) {
       const Vec3 target = s.observer.target;
       s.observer.target = s.observer.eye + Vec3(glm::rotate(Mat4(1.0), radians(25.0), s.observer.up) *
                                                 Vec4(target - s.observer.eye, 0.0));
-      const gl::RasterFrame other = reused.render(mode);
+      s.observer.width *= 8;
+      s.observer.height *= 8;
+      const gl::RasterFrame other_large = reused.render(mode);
+      s.observer.width /= 8;
+      s.observer.height /= 8;
+      const gl::RasterFrame other = reused.render(mode);  // the same view at the test's size, to compare
       s.observer.target = target;
       const gl::RasterFrame again = reused.render(mode);
+      EXPECT_EQ(other_large.color.size(), 64 * fresh.color.size());
+      if (mode == gl::RasterMode::Pvrr) {  // the large view's maps were larger (the first-pass notes say so)
+        const StageTiming *large_fp = other_large.stages.find("first-pass"), *fp = again.stages.find("first-pass");
+        ASSERT_TRUE(large_fp && fp);
+        EXPECT_NE(large_fp->note, fp->note) << scene;
+      }
       ASSERT_EQ(again.color.size(), fresh.color.size());
       size_t differs_from_other = 0, mismatches = 0;
       for (size_t i = 0; i < fresh.color.size(); ++i) {
