@@ -2,6 +2,9 @@
 // Optical elements. Variants by prepended defines:
 //   MODE_PVRR    the warped first-pass map (paper 3.4). CHANNELS 1: one texture-coordinate set; CHANNELS 3:
 //                three sets (RGB dispersion, or three samples of a spectral set), colour = sum_i w_i * map(st_i).
+//                RGB_CHANNELS (with CHANNELS 3): the sets are the R, G and B channels, whose weights are zero
+//                but in their own component: colour = (w_0.r map(st_0).r, w_1.g map(st_1).g, w_2.b map(st_2).b),
+//                the same sum with two thirds of the weights left uninterpolated.
 //                More than three channels: one additive draw per set of three (pvrr/gl/renderer.cpp).
 //   MODE_ENVMAP  the classic dynamic cube map from the element centre (lens: looked up along the
 //                interpolated exact exit directions of the vertices, the 'refraction vectors' baseline)
@@ -79,9 +82,14 @@ void main() {
                   fresnelConductor(cos_i, u_metal_n.b, u_metal_k.b));
 #endif
 #if defined(MODE_PVRR)
+#if CHANNELS == 3 && defined(RGB_CHANNELS)
+  vec3 c = vec3(v_w0.r * texture(u_map, mapST(v_st0)).r, v_w1.g * texture(u_map, mapST(v_st1)).g,
+                v_w2.b * texture(u_map, mapST(v_st2)).b);
+#else
   vec3 c = v_w0 * texture(u_map, mapST(v_st0)).rgb;
 #if CHANNELS == 3
   c += v_w1 * texture(u_map, mapST(v_st1)).rgb + v_w2 * texture(u_map, mapST(v_st2)).rgb;
+#endif
 #endif
 #if defined(NO_SEEN_POINTS)
   vec4 seen = vec4(0.0);

@@ -254,6 +254,8 @@ struct Renderer::Impl {
   Program pvrr3_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_PVRR", "#define CHANNELS 3"}));
   Program lens_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_PVRR", "#define CHANNELS 1", "#define LENS"}));
   Program lens3_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_PVRR", "#define CHANNELS 3", "#define LENS"}));
+  Program lens_rgb_program = makeProgram("element.vert", "element.frag",
+                                         defines({"#define MODE_PVRR", "#define CHANNELS 3", "#define LENS", "#define RGB_CHANNELS"}));
   GLuint empty_vao = 0;
   std::vector<MeshBuffers> env_meshes;
   std::vector<bool> env_faceted;  // per environment mesh: every triangle has one normal at its three corners
@@ -659,7 +661,11 @@ struct Renderer::Impl {
     const Vec3 anchor = Vec3(el.local_to_world[3]);
     const bool lens = el.type == ElementType::Lens;
     const size_t channels = f.rays.size();
-    const Program& p = lens ? (channels > 1 ? lens3_program : lens_program) : (channels > 1 ? pvrr3_program : pvrr_program);
+    // Three channels whose weights are the unit R, G and B vectors: each weight has one non-zero component.
+    bool rgb = lens && channels == 3 && f.channels.size() == 3;
+    for (size_t c = 0; c < 3 && rgb; ++c) rgb = channelWeight(f.channels, c) == Vec3(c == 0, c == 1, c == 2);
+    const Program& p = lens ? (rgb ? lens_rgb_program : channels > 1 ? lens3_program : lens_program)
+                            : (channels > 1 ? pvrr3_program : pvrr_program);
     p.use();
     p.set("u_view_proj", toFloat(cam.view_proj));
     p.set("u_offset", glm::vec3(anchor - cam.origin));
