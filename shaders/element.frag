@@ -43,8 +43,12 @@ uniform samplerCube u_seen_cube;
 uniform bool u_dark;
 #endif
 layout(location = 0) out vec4 o_color;
+#if defined(NO_SEEN_POINTS)
+vec4 o_seen, o_surface;  // colour only: not outputs, so the compiler drops them and what only they need
+#else
 layout(location = 1) out vec4 o_seen;
 layout(location = 2) out vec4 o_surface;
+#endif
 #include "shading.glsl"
 
 // Exact unpolarised conductor Fresnel reflectance, outside index 1 (pvrr/optics.cpp fresnelConductor).

@@ -246,7 +246,7 @@ struct Renderer::Impl {
   }
   Program env_program = makeProgram("env.vert", "env.frag", defines({}));
   Program env_faceted_program = makeProgram("env.vert", "env.frag", defines({"#define FACETED"}));
-  Program sky_program = makeProgram("sky.vert", "sky.frag");
+  Program sky_program = makeProgram("sky.vert", "sky.frag", defines({}));
   Program plain_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_PLAIN"}));
   Program envmap_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_ENVMAP"}));
   Program lens_envmap_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_ENVMAP", "#define LENS"}));
