@@ -68,7 +68,12 @@ TEST(Reports, SweepAndCompareRunOnEveryDefaultScene) {
       for (const char* region : {"zooming", "outside_zooming", "not_classified"}) sum += v["regions"][region]["pixels"].get<size_t>();
       EXPECT_EQ(sum, v["pixels"].get<size_t>()) << scene << " " << mode;
       EXPECT_TRUE(fs::exists(cmp / (std::string(mode) + "-error.png"))) << scene << " " << mode;
+      // The colour against the 2x2-supersampled reference: a finite PSNR over the same pixels.
+      const double ss = v["psnr_supersampled_db"].get<double>();
+      EXPECT_TRUE(ss > 5 && ss < 99) << scene << " " << mode << ": " << ss;
     }
+    const double ref_ss = m["reference"]["psnr_supersampled_db"].get<double>();
+    EXPECT_TRUE(ref_ss > 5 && ref_ss < 99) << scene << ": " << ref_ss;
   }
   fs::remove_all(dir);
 }
