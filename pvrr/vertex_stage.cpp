@@ -167,23 +167,48 @@ namespace {
 
 // The patch's rays for the fit and the view volume: flagged rays (TIR, or out through the lens's edge
 // band) say nothing about where the scene is seen from and are left out, unless too few remain.
-// only_in_view: only the rays of vertices in view (ElementFrame::in_view), unless fewer than 3 of the
-// patch's are (`*out_of_view` counts what was left out; 0 when all were taken).
+// `seen`: only what the viewer sees (ElementFrame::in_view): the rays of the vertices inside its clip volume
+// and, where it cuts a triangle, the rays interpolated there (PatchView::view_edge); unless fewer than 3
+// result, then the rays of every vertex of a seen triangle, then all (`*out_of_view` counts the vertices
+// left out).
 std::vector<ViewpointRay> patchRays(const ElementFrame& f, const cad::GridPatch& gp, int* excluded,
-                                    bool only_in_view = false, int* out_of_view = nullptr) {
+                                    const PatchView* seen = nullptr, int* out_of_view = nullptr) {
   const std::vector<VertexRay>& rs = f.rays[f.rays.size() / 2];  // the middle (green) channel, or the only one
   std::vector<uint32_t> verts;
-  verts.reserve(gp.vertices.size());
-  if (only_in_view && !f.in_view.empty())
-    for (uint32_t vi : gp.vertices)
-      if (f.in_view[vi]) verts.push_back(vi);
-  if (verts.size() < 3) verts = gp.vertices;
-  if (out_of_view) *out_of_view = int(gp.vertices.size() - verts.size());
   std::vector<ViewpointRay> kept;
-  kept.reserve(verts.size());
+  verts.reserve(gp.vertices.size());
+  if (seen && !f.in_view.empty()) {
+    for (uint32_t vi : gp.vertices)
+      if (f.in_view[vi] == 2) verts.push_back(vi);
+    for (const PatchView::ViewEdgeSample& e : seen->view_edge) {
+      Vec3 origin(0.0), hit(0.0);
+      bool flagged = false;
+      for (int j = 0; j < 3; ++j) {
+        const VertexRay& r = rs[gp.vertices[e.corners[j]]];
+        flagged = flagged || (e.weights[j] > 0 && r.status == VertexStatus::Tir);
+        origin += e.weights[j] * r.origin;
+        hit += e.weights[j] * r.hit;
+      }
+      const double len = glm::length(hit - origin);
+      if (!flagged && len > 0) kept.push_back(ViewpointRay{origin, (hit - origin) / len, hit});
+    }
+    if (verts.size() + kept.size() < 3) {
+      verts.clear();
+      kept.clear();
+      for (uint32_t vi : gp.vertices)
+        if (f.in_view[vi]) verts.push_back(vi);
+    }
+  }
+  if (verts.size() + kept.size() < 3) {
+    verts = gp.vertices;
+    kept.clear();
+  }
+  if (out_of_view) *out_of_view = int(gp.vertices.size() - verts.size());
+  const size_t samples = kept.size();
+  kept.reserve(samples + verts.size());
   for (uint32_t vi : verts)
     if (rs[vi].status != VertexStatus::Tir) kept.push_back(ViewpointRay{rs[vi].origin, rs[vi].dir, rs[vi].hit});
-  if (excluded) *excluded = int(verts.size() - kept.size());
+  if (excluded) *excluded = int(verts.size() + samples - kept.size());
   if (kept.size() >= 3) return kept;
   std::vector<ViewpointRay> all;
   all.reserve(verts.size());
@@ -192,7 +217,7 @@ std::vector<ViewpointRay> patchRays(const ElementFrame& f, const cad::GridPatch&
 }
 
 // View volume, projective weights and texture coordinates of a patch whose viewpoint is fitted.
-// `rays`: the patch's patchRays(..., only_in_view = true): the view volume holds what the viewer sees.
+// `rays`: the patch's patchRays(..., &pv): the view volume holds what the viewer sees.
 void buildPatchMap(const Scene& scene, const ElementFrame& f, const Element& el, PatchView& pv,
                    const std::vector<ViewpointRay>& rays) {
   const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
@@ -240,16 +265,60 @@ void buildPatchMap(const Scene& scene, const ElementFrame& f, const Element& el,
     }
 }
 
+// Where the viewer's clip volume cuts the patch's triangles that it sees in part (PatchView::view_edge):
+// each such triangle clipped in the viewer's clip space (Sutherland-Hodgman against x = +-w, y = +-w and
+// the near plane z = -w), the new corners kept as barycentric weights. `clip`: each vertex's clip position.
+std::vector<PatchView::ViewEdgeSample> viewEdge(const cad::GridPatch& gp, const std::vector<Vec4>& clip) {
+  std::vector<PatchView::ViewEdgeSample> out;
+  struct Corner {
+    Vec4 c;
+    Vec3 w;
+  };
+  const auto plane = [](int p, const Vec4& c) {
+    switch (p) {
+      case 0: return c.w + c.x;
+      case 1: return c.w - c.x;
+      case 2: return c.w + c.y;
+      case 3: return c.w - c.y;
+      default: return c.w + c.z;
+    }
+  };
+  for (const cad::Triangle& t : gp.triangles) {
+    const Vec4 c[3] = {clip[gp.vertices[t.x]], clip[gp.vertices[t.y]], clip[gp.vertices[t.z]]};
+    const unsigned a = clipOutcode(c[0]), b = clipOutcode(c[1]), d = clipOutcode(c[2]);
+    if ((a & b & d) != 0 || (a | b | d) == 0) continue;  // not seen, or wholly inside
+    std::vector<Corner> poly = {{c[0], Vec3(1, 0, 0)}, {c[1], Vec3(0, 1, 0)}, {c[2], Vec3(0, 0, 1)}};
+    for (int p = 0; p < 5 && !poly.empty(); ++p) {
+      std::vector<Corner> next;
+      for (size_t i = 0; i < poly.size(); ++i) {
+        const Corner &P = poly[i], &Q = poly[(i + 1) % poly.size()];
+        const double dp = plane(p, P.c), dq = plane(p, Q.c);
+        if (dp >= 0) next.push_back(P);
+        if ((dp >= 0) != (dq >= 0)) {
+          const double s = dp / (dp - dq);
+          next.push_back({P.c + s * (Q.c - P.c), P.w + s * (Q.w - P.w)});
+        }
+      }
+      poly = std::move(next);
+    }
+    for (const Corner& k : poly)
+      if (std::max({k.w.x, k.w.y, k.w.z}) < 1.0)  // a new corner, not one of the triangle's own
+        out.push_back({glm::u32vec3(t.x, t.y, t.z), k.w});
+  }
+  return out;
+}
+
 void fitOnePatch(const Scene& scene, const ElementFrame& f, size_t patch_index, const Element& el, PatchView& pv,
-                 const ViewpointOptions& vopt) {
+                 const ViewpointOptions& vopt, const std::vector<Vec4>& clip) {
   pv.patch = int(patch_index);
   // The viewpoint is fitted to all the patch's rays, the view volume to those the viewer sees. (Fitting the
   // viewpoint to the seen rays alone fits them better, but interpolates worse between the vertices: on the
   // spectacle lens at 640 x 480, 1.02' median against 0.68'.)
   const cad::GridPatch& gp = f.grid_patches[patch_index];
   const std::vector<ViewpointRay> all_rays = patchRays(f, gp, &pv.rays_excluded);
+  pv.view_edge = f.in_view.empty() || clip.empty() ? std::vector<PatchView::ViewEdgeSample>{} : viewEdge(gp, clip);
   const std::vector<ViewpointRay> seen_rays =
-      f.in_view.empty() ? all_rays : patchRays(f, gp, nullptr, true, &pv.rays_out_of_view);
+      f.in_view.empty() ? all_rays : patchRays(f, gp, nullptr, &pv, &pv.rays_out_of_view);
   // Seen when one of its triangles has all three vertices in view (conservative: those vertices may owe it
   // to neighbouring triangles).
   pv.in_view = f.in_view.empty() || std::any_of(gp.triangles.begin(), gp.triangles.end(), [&](const cad::Triangle& t) {
@@ -262,14 +331,15 @@ void fitOnePatch(const Scene& scene, const ElementFrame& f, size_t patch_index, 
 // The automatic split stops where a patch would have fewer quads a side than this.
 constexpr int kMinPatchQuads = 4;
 
-// ElementFrame::in_view for a viewer with world -> clip matrix `clip`: the vertices of every grid triangle
-// not entirely outside one clip plane (clipOutcode). All 1 when every triangle is.
-std::vector<char> verticesInView(const ElementFrame& f, const Mat4& clip) {
+// ElementFrame::in_view from each vertex's clip position: the vertices of every grid triangle not entirely
+// outside one clip plane (clipOutcode), 2 for those inside the clip volume, 1 for the others.
+std::vector<char> verticesInView(const ElementFrame& f, const std::vector<Vec4>& clip) {
   std::vector<unsigned> code(f.world_pos.size());
-  for (size_t i = 0; i < f.world_pos.size(); ++i) code[i] = clipOutcode(clip * Vec4(f.world_pos[i], 1.0));
+  for (size_t i = 0; i < f.world_pos.size(); ++i) code[i] = clipOutcode(clip[i]);
   std::vector<char> in(f.world_pos.size(), 0);
   for (const cad::Triangle& t : f.grid.triangles)
-    if ((code[t.x] & code[t.y] & code[t.z]) == 0) in[t.x] = in[t.y] = in[t.z] = 1;
+    if ((code[t.x] & code[t.y] & code[t.z]) == 0)
+      for (uint32_t v : {t.x, t.y, t.z}) in[v] = code[v] == 0 ? 2 : 1;
   return in;
 }
 
@@ -278,9 +348,12 @@ std::vector<char> verticesInView(const ElementFrame& f, const Mat4& clip) {
 void fitPatchViews(const Scene& scene, ElementFrame& f, const VertexStageOptions& opt) {
   auto t0 = std::chrono::steady_clock::now();
   f.in_view.clear();
+  std::vector<Vec4> clip;
   if (opt.viewer_clip) {
-    f.in_view = verticesInView(f, *opt.viewer_clip);
-    if (std::all_of(f.in_view.begin(), f.in_view.end(), [](char c) { return c != 0; })) f.in_view.clear();
+    clip.resize(f.world_pos.size());
+    for (size_t i = 0; i < f.world_pos.size(); ++i) clip[i] = *opt.viewer_clip * Vec4(f.world_pos[i], 1.0);
+    f.in_view = verticesInView(f, clip);
+    if (std::all_of(f.in_view.begin(), f.in_view.end(), [](char c) { return c == 2; })) f.in_view.clear();
   }
   const Element& el = scene.elements[size_t(f.element)];
   const double max_fov = opt.max_patch_fov_rad > 0 ? opt.max_patch_fov_rad : el.max_patch_fov_rad;
@@ -290,7 +363,7 @@ void fitPatchViews(const Scene& scene, ElementFrame& f, const VertexStageOptions
     f.grid_patches = cad::splitGrid(f.grid, pu, pv);
     f.views.clear();
     f.views.resize(f.grid_patches.size());
-    for (size_t p = 0; p < f.grid_patches.size(); ++p) fitOnePatch(scene, f, p, el, f.views[p], opt.viewpoint);
+    for (size_t p = 0; p < f.grid_patches.size(); ++p) fitOnePatch(scene, f, p, el, f.views[p], opt.viewpoint, clip);
     if (max_fov <= 0 || round >= opt.max_patch_splits) break;
     double worst_x = 0, worst_y = 0;
     for (const PatchView& v : f.views) {
@@ -361,7 +434,7 @@ void updateTextureCoordinates(const RayScene& rays, ElementFrame& f) {
     });
   const Element& el = scene.elements[size_t(f.element)];
   for (PatchView& pv : f.views)
-    buildPatchMap(scene, f, el, pv, patchRays(f, f.grid_patches[size_t(pv.patch)], nullptr, true));
+    buildPatchMap(scene, f, el, pv, patchRays(f, f.grid_patches[size_t(pv.patch)], nullptr, &pv));
   f.rays_ms = msSince(t0);
 }
 

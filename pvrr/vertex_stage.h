@@ -41,7 +41,17 @@ struct PatchView {
   // (plain affine interpolation, as in the paper) when some vertex lies behind the viewpoint.
   std::vector<double> q;
   int rays_excluded = 0;  // flagged (tir / edge) rays left out of the fit
-  int rays_out_of_view = 0;  // rays of vertices the viewer cannot see, left out of the view volume
+  int rays_out_of_view = 0;  // rays of vertices outside the viewer's clip volume, left out of the view volume
+  // Where the viewer's clip volume cuts the patch's triangles that it sees in part: a point of a triangle (its
+  // corners, indices into GridPatch::vertices, and barycentric weights). The view volume holds the rays
+  // interpolated there in place of the rays of the corners outside the viewer's view, so the map covers what
+  // the image shows rather than whole edge triangles (a spectacle lens tessellated 24 x 24 has triangles of
+  // ~10 degrees at 12 mm from the eye).
+  struct ViewEdgeSample {
+    glm::u32vec3 corners{0};
+    Vec3 weights{0};
+  };
+  std::vector<ViewEdgeSample> view_edge;
   bool in_view = true;    // false: the viewer sees none of the patch (its map need not be rendered)
 };
 
@@ -105,9 +115,10 @@ struct ElementFrame {
   double rays_ms = 0, fit_ms = 0;
   int patches_u = 1, patches_v = 1;
   std::string split_note;                    // why patches were split, if they were
-  // Per vertex: 1 when a triangle holding it can be seen by VertexStageOptions::viewer_clip (empty: all
-  // vertices, no viewer given). Vertices of triangles the viewer cannot see get texture coordinates too,
-  // but they shape no pixel.
+  // Per vertex: non-zero when a triangle holding it can be seen by VertexStageOptions::viewer_clip (empty:
+  // all vertices, no viewer given): 2 inside the viewer's clip volume, 1 outside it (a corner of a triangle
+  // seen in part). Vertices of triangles the viewer cannot see get texture coordinates too, but they shape
+  // no pixel.
   std::vector<char> in_view;
 };
 

@@ -145,9 +145,11 @@ TEST(VertexStage, LensRaysObeySnellAtBothSurfaces) {
 }
 
 // A spectacle lens 12 mm from the eye spans ~150 deg; a 50 deg view sees a small part of it. With the
-// observer as the viewer, the view volume holds only the rays of the vertices it sees: a much narrower
-// frustum (more texels where they are looked at), every seen vertex's hit inside the map, and the same
-// fitted viewpoint (fitted to all the rays either way).
+// observer as the viewer, the view volume holds only what it sees: the rays of the vertices inside its view
+// and, where its edge cuts a triangle, the rays interpolated there (not the far corners of those triangles:
+// at 24 x 24 a triangle spans ~10 deg). So: a much narrower frustum (more texels where they are looked at),
+// close to the view itself plus the lens's prism; every seen point's texture coordinate inside the map; and
+// the same fitted viewpoint (fitted to all the rays either way).
 TEST(VertexStage, ViewVolumeHoldsWhatTheViewerSees) {
   Scene s = buildScene(loadScene(std::string(PVRR_SOURCE_DIR) + "/models/spectacle-lens.json", {"observer.image_size=[320,240]"}));
   RayScene rays(s);
@@ -162,18 +164,36 @@ TEST(VertexStage, ViewVolumeHoldsWhatTheViewerSees) {
   ASSERT_EQ(seen.views.size(), 1u);
   EXPECT_TRUE(all.in_view.empty());
   ASSERT_EQ(seen.in_view.size(), seen.world_pos.size());
-  const size_t in = size_t(std::count(seen.in_view.begin(), seen.in_view.end(), 1));
-  EXPECT_GT(in, 20u);
-  EXPECT_LT(in, seen.world_pos.size() / 2);  // most of the lens is outside a 50 deg view
-  EXPECT_EQ(seen.views[0].rays_out_of_view, int(seen.world_pos.size() - in));
-  EXPECT_EQ(seen.views[0].fit.eye, all.views[0].fit.eye);
+  const size_t inside = size_t(std::count(seen.in_view.begin(), seen.in_view.end(), 2));
+  const size_t corners = size_t(std::count(seen.in_view.begin(), seen.in_view.end(), 1));
+  EXPECT_GT(inside, 20u);
+  EXPECT_GT(corners, 20u);
+  EXPECT_LT(inside + corners, seen.world_pos.size() / 2);  // most of the lens is outside a 50 deg view
+  const PatchView& pv = seen.views[0];
+  EXPECT_EQ(pv.rays_out_of_view, int(seen.world_pos.size() - inside));
+  EXPECT_GT(pv.view_edge.size(), corners);  // each cut triangle adds two or more points
+  EXPECT_EQ(pv.fit.eye, all.views[0].fit.eye);
   EXPECT_GT(all.views[0].volume.fov_y_rad, radians(120.0));
-  EXPECT_LT(seen.views[0].volume.fov_y_rad, 0.6 * all.views[0].volume.fov_y_rad);
+  // The view's 50 deg, the -3 D lens's prism at its edge (~2 deg a side) and the 2 % margins; with the whole
+  // edge triangles it was 79 deg at 1280 x 720.
+  EXPECT_LT(pv.volume.fov_y_rad, radians(62.0));
+  EXPECT_GT(pv.volume.fov_y_rad, radians(50.0));
   const cad::GridPatch& gp = seen.grid_patches[0];
   for (size_t k = 0; k < gp.vertices.size(); ++k) {
-    if (!seen.in_view[gp.vertices[k]]) continue;
-    const Vec2 st = seen.views[0].st[0][k];
+    if (seen.in_view[gp.vertices[k]] != 2) continue;
+    const Vec2 st = pv.st[0][k];
     EXPECT_TRUE(st.x >= -1e-9 && st.x <= 1 + 1e-9 && st.y >= -1e-9 && st.y <= 1 + 1e-9) << "vertex " << gp.vertices[k];
+  }
+  // What the rasteriser shows where the view's edge cuts a triangle: (s q, t q, q) interpolated linearly over
+  // the triangle. Inside the map, within the interpolation's curvature (1 % of the map).
+  for (const PatchView::ViewEdgeSample& e : pv.view_edge) {
+    Vec3 stq(0.0);
+    for (int j = 0; j < 3; ++j) {
+      const size_t k = e.corners[j];
+      stq += e.weights[j] * pv.q[k] * Vec3(pv.st[0][k], 1.0);
+    }
+    const Vec2 st = Vec2(stq) / stq.z;
+    EXPECT_TRUE(st.x >= -0.01 && st.x <= 1.01 && st.y >= -0.01 && st.y <= 1.01) << st.x << ", " << st.y;
   }
 }
 
