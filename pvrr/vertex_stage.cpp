@@ -167,57 +167,75 @@ namespace {
 
 // The patch's rays for the fit and the view volume: flagged rays (TIR, or out through the lens's edge
 // band) say nothing about where the scene is seen from and are left out, unless too few remain.
-// `seen`: only what the viewer sees (ElementFrame::in_view): the rays of the vertices inside its clip volume
-// and, where it cuts a triangle, the rays interpolated there (PatchView::view_edge); unless fewer than 3
-// result, then the rays of every vertex of a seen triangle, then all (`*out_of_view` counts the vertices
-// left out).
-std::vector<ViewpointRay> patchRays(const ElementFrame& f, const cad::GridPatch& gp, int* excluded,
-                                    const PatchView* seen = nullptr, int* out_of_view = nullptr) {
+std::vector<ViewpointRay> patchRays(const ElementFrame& f, const cad::GridPatch& gp, int* excluded) {
   const std::vector<VertexRay>& rs = f.rays[f.rays.size() / 2];  // the middle (green) channel, or the only one
-  std::vector<uint32_t> verts;
-  std::vector<ViewpointRay> kept;
-  verts.reserve(gp.vertices.size());
-  if (seen && !f.in_view.empty()) {
+  std::vector<ViewpointRay> kept, all;
+  kept.reserve(gp.vertices.size());
+  for (uint32_t vi : gp.vertices) {
+    all.push_back(ViewpointRay{rs[vi].origin, rs[vi].dir, rs[vi].hit});
+    if (rs[vi].status != VertexStatus::Tir) kept.push_back(all.back());
+  }
+  if (excluded) *excluded = int(all.size() - kept.size());
+  return kept.size() >= 3 ? kept : all;
+}
+
+// The rays of what the viewer sees of a patch whose viewpoint pv.fit.eye is fitted (ElementFrame::in_view),
+// for its view volume: the unflagged rays of the vertices inside the viewer's clip volume and, where the
+// viewer's view cuts a triangle (PatchView::view_edge), a ray for each cut point. The cut point's ray leaves
+// the surface there towards the viewpoint's blend of the corners' hits: the unit directions from the
+// viewpoint to the corners' hits, weighted as the rasteriser weights the corners' texture coordinates (the
+// corners' own depths in the map camera are about equal, so by the barycentric weights alone); blending
+// the hit points themselves would lean towards the farthest (an escaping ray's far point). Fewer than 3:
+// the unflagged rays of every vertex of a seen triangle, then patchRays. `*out_of_view`: the patch's
+// vertices whose own rays are not taken.
+std::vector<ViewpointRay> seenRays(const ElementFrame& f, const cad::GridPatch& gp, const PatchView& pv,
+                                   int* out_of_view) {
+  const std::vector<VertexRay>& rs = f.rays[f.rays.size() / 2];
+  const Vec3 e = pv.fit.eye;
+  std::vector<ViewpointRay> out;
+  int taken = 0;
+  for (uint32_t vi : gp.vertices)
+    if (f.in_view[vi] == 2 && rs[vi].status != VertexStatus::Tir) {
+      out.push_back(ViewpointRay{rs[vi].origin, rs[vi].dir, rs[vi].hit});
+      ++taken;
+    }
+  for (const PatchView::ViewEdgeSample& c : pv.view_edge) {
+    Vec3 origin(0.0), toward(0.0);
+    double dist = 0;
+    bool flagged = false;
+    for (int j = 0; j < 3; ++j) {
+      const VertexRay& r = rs[gp.vertices[c.corners[j]]];
+      if (!(c.weights[j] > 0)) continue;
+      flagged = flagged || r.status == VertexStatus::Tir;
+      const double d = glm::length(r.hit - e);
+      origin += c.weights[j] * r.origin;
+      if (d > 0) toward += c.weights[j] * (r.hit - e) / d;
+      dist += c.weights[j] * d;
+    }
+    const double len = glm::length(toward);
+    if (flagged || !(len > 0) || !(dist > 0)) continue;
+    const Vec3 hit = e + dist * toward / len, d = hit - origin;
+    if (glm::length(d) > 0 && std::isfinite(hit.x + hit.y + hit.z)) out.push_back(ViewpointRay{origin, glm::normalize(d), hit});
+  }
+  if (out.size() < 3) {
+    out.clear();
+    taken = 0;
     for (uint32_t vi : gp.vertices)
-      if (f.in_view[vi] == 2) verts.push_back(vi);
-    for (const PatchView::ViewEdgeSample& e : seen->view_edge) {
-      Vec3 origin(0.0), hit(0.0);
-      bool flagged = false;
-      for (int j = 0; j < 3; ++j) {
-        const VertexRay& r = rs[gp.vertices[e.corners[j]]];
-        flagged = flagged || (e.weights[j] > 0 && r.status == VertexStatus::Tir);
-        origin += e.weights[j] * r.origin;
-        hit += e.weights[j] * r.hit;
+      if (f.in_view[vi] && rs[vi].status != VertexStatus::Tir) {
+        out.push_back(ViewpointRay{rs[vi].origin, rs[vi].dir, rs[vi].hit});
+        ++taken;
       }
-      const double len = glm::length(hit - origin);
-      if (!flagged && len > 0) kept.push_back(ViewpointRay{origin, (hit - origin) / len, hit});
-    }
-    if (verts.size() + kept.size() < 3) {
-      verts.clear();
-      kept.clear();
-      for (uint32_t vi : gp.vertices)
-        if (f.in_view[vi]) verts.push_back(vi);
-    }
   }
-  if (verts.size() + kept.size() < 3) {
-    verts = gp.vertices;
-    kept.clear();
+  if (out.size() < 3) {
+    out = patchRays(f, gp, nullptr);
+    taken = int(out.size());
   }
-  if (out_of_view) *out_of_view = int(gp.vertices.size() - verts.size());
-  const size_t samples = kept.size();
-  kept.reserve(samples + verts.size());
-  for (uint32_t vi : verts)
-    if (rs[vi].status != VertexStatus::Tir) kept.push_back(ViewpointRay{rs[vi].origin, rs[vi].dir, rs[vi].hit});
-  if (excluded) *excluded = int(verts.size() + samples - kept.size());
-  if (kept.size() >= 3) return kept;
-  std::vector<ViewpointRay> all;
-  all.reserve(verts.size());
-  for (uint32_t vi : verts) all.push_back(ViewpointRay{rs[vi].origin, rs[vi].dir, rs[vi].hit});
-  return all;
+  if (out_of_view) *out_of_view = int(gp.vertices.size()) - taken;
+  return out;
 }
 
 // View volume, projective weights and texture coordinates of a patch whose viewpoint is fitted.
-// `rays`: the patch's patchRays(..., &pv): the view volume holds what the viewer sees.
+// `rays`: what the viewer sees of the patch (buildSeenPatchMap).
 void buildPatchMap(const Scene& scene, const ElementFrame& f, const Element& el, PatchView& pv,
                    const std::vector<ViewpointRay>& rays) {
   const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
@@ -267,7 +285,7 @@ void buildPatchMap(const Scene& scene, const ElementFrame& f, const Element& el,
 
 // Where the viewer's clip volume cuts the patch's triangles that it sees in part (PatchView::view_edge):
 // each such triangle clipped in the viewer's clip space (Sutherland-Hodgman against x = +-w, y = +-w and
-// the near plane z = -w), the new corners kept as barycentric weights. `clip`: each vertex's clip position.
+// z = +-w, the planes clipOutcode tests), the new corners kept as barycentric weights. `clip`: each vertex's clip position.
 std::vector<PatchView::ViewEdgeSample> viewEdge(const cad::GridPatch& gp, const std::vector<Vec4>& clip) {
   std::vector<PatchView::ViewEdgeSample> out;
   struct Corner {
@@ -280,7 +298,8 @@ std::vector<PatchView::ViewEdgeSample> viewEdge(const cad::GridPatch& gp, const 
       case 1: return c.w - c.x;
       case 2: return c.w + c.y;
       case 3: return c.w - c.y;
-      default: return c.w + c.z;
+      case 4: return c.w + c.z;
+      default: return c.w - c.z;
     }
   };
   for (const cad::Triangle& t : gp.triangles) {
@@ -288,7 +307,7 @@ std::vector<PatchView::ViewEdgeSample> viewEdge(const cad::GridPatch& gp, const 
     const unsigned a = clipOutcode(c[0]), b = clipOutcode(c[1]), d = clipOutcode(c[2]);
     if ((a & b & d) != 0 || (a | b | d) == 0) continue;  // not seen, or wholly inside
     std::vector<Corner> poly = {{c[0], Vec3(1, 0, 0)}, {c[1], Vec3(0, 1, 0)}, {c[2], Vec3(0, 0, 1)}};
-    for (int p = 0; p < 5 && !poly.empty(); ++p) {
+    for (int p = 0; p < 6 && !poly.empty(); ++p) {
       std::vector<Corner> next;
       for (size_t i = 0; i < poly.size(); ++i) {
         const Corner &P = poly[i], &Q = poly[(i + 1) % poly.size()];
@@ -308,6 +327,28 @@ std::vector<PatchView::ViewEdgeSample> viewEdge(const cad::GridPatch& gp, const 
   return out;
 }
 
+// buildPatchMap with the rays of what the viewer sees (seenRays; all the patch's rays without a viewer).
+// A corner of a triangle seen in part whose hit lies behind the narrowed map camera would get a placeholder
+// texture coordinate and colour the seen part of its triangle: its own ray then goes into the volume too.
+void buildSeenPatchMap(const Scene& scene, const ElementFrame& f, const Element& el, PatchView& pv) {
+  const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
+  pv.rays_out_of_view = 0;
+  if (f.in_view.empty()) return buildPatchMap(scene, f, el, pv, patchRays(f, gp, nullptr));
+  std::vector<ViewpointRay> rays = seenRays(f, gp, pv, &pv.rays_out_of_view);
+  buildPatchMap(scene, f, el, pv, rays);
+  const std::vector<VertexRay>& rs = f.rays[f.rays.size() / 2];
+  bool again = false;
+  for (uint32_t vi : gp.vertices) {
+    if (f.in_view[vi] != 1 || rs[vi].status == VertexStatus::Tir) continue;
+    const Vec2 st = projectToTexture(pv.volume, rs[vi].hit);
+    if (std::isfinite(st.x) && std::isfinite(st.y)) continue;
+    rays.push_back(ViewpointRay{rs[vi].origin, rs[vi].dir, rs[vi].hit});
+    --pv.rays_out_of_view;
+    again = true;
+  }
+  if (again) buildPatchMap(scene, f, el, pv, rays);
+}
+
 void fitOnePatch(const Scene& scene, const ElementFrame& f, size_t patch_index, const Element& el, PatchView& pv,
                  const ViewpointOptions& vopt, const std::vector<Vec4>& clip) {
   pv.patch = int(patch_index);
@@ -317,15 +358,13 @@ void fitOnePatch(const Scene& scene, const ElementFrame& f, size_t patch_index, 
   const cad::GridPatch& gp = f.grid_patches[patch_index];
   const std::vector<ViewpointRay> all_rays = patchRays(f, gp, &pv.rays_excluded);
   pv.view_edge = f.in_view.empty() || clip.empty() ? std::vector<PatchView::ViewEdgeSample>{} : viewEdge(gp, clip);
-  const std::vector<ViewpointRay> seen_rays =
-      f.in_view.empty() ? all_rays : patchRays(f, gp, nullptr, &pv, &pv.rays_out_of_view);
   // Seen when one of its triangles has all three vertices in view (conservative: those vertices may owe it
   // to neighbouring triangles).
   pv.in_view = f.in_view.empty() || std::any_of(gp.triangles.begin(), gp.triangles.end(), [&](const cad::Triangle& t) {
                  return f.in_view[gp.vertices[t.x]] && f.in_view[gp.vertices[t.y]] && f.in_view[gp.vertices[t.z]];
                });
   pv.fit = fitViewpoint(all_rays, vopt);
-  buildPatchMap(scene, f, el, pv, seen_rays);
+  buildSeenPatchMap(scene, f, el, pv);
 }
 
 // The automatic split stops where a patch would have fewer quads a side than this.
@@ -434,7 +473,7 @@ void updateTextureCoordinates(const RayScene& rays, ElementFrame& f) {
     });
   const Element& el = scene.elements[size_t(f.element)];
   for (PatchView& pv : f.views)
-    buildPatchMap(scene, f, el, pv, patchRays(f, f.grid_patches[size_t(pv.patch)], nullptr, &pv));
+    buildSeenPatchMap(scene, f, el, pv);
   f.rays_ms = msSince(t0);
 }
 

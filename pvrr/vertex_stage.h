@@ -96,10 +96,11 @@ struct VertexStageOptions {
   double max_patch_fov_rad = 0;  // overrides the element's when > 0
   int max_patch_splits = 4;      // doublings per direction for the automatic split
   // World -> clip of the camera that draws the element (the observer's, or the map camera of the element
-  // that shows it). When set, each patch's view volume holds only the rays of the vertices of the triangles
-  // that camera can see (ElementFrame::in_view), so the map spends its texels on what is seen: a spectacle
-  // lens 12 mm from the eye spans ~150 deg, of which a 50 deg view sees a tenth. The viewpoint is still
-  // fitted to all the patch's rays. Unset: all.
+  // that shows it). When set, each patch's view volume holds only what that camera sees (ElementFrame::
+  // in_view): the rays of the vertices inside its view and the rays interpolated where its view cuts a
+  // triangle (PatchView::view_edge), so the map spends its texels on what is seen: a spectacle lens 12 mm from
+  // the eye spans ~150 deg, of which a 50 deg view sees about a third across. The viewpoint is still fitted
+  // to all the patch's rays. Unset: all.
   std::optional<Mat4> viewer_clip;
 };
 

@@ -178,6 +178,19 @@ TEST(VertexStage, ViewVolumeHoldsWhatTheViewerSees) {
   // edge triangles it was 79 deg at 1280 x 720.
   EXPECT_LT(pv.volume.fov_y_rad, radians(62.0));
   EXPECT_GT(pv.volume.fov_y_rad, radians(50.0));
+  const double view_x = 2 * std::atan(std::tan(radians(25.0)) * 320.0 / 240.0);  // 63.6 deg
+  EXPECT_LT(pv.volume.fov_x_rad, view_x + radians(12.0));
+  EXPECT_GT(pv.volume.fov_x_rad, view_x);
+  std::printf("seen frustum %.1f x %.1f deg (all rays: %.1f x %.1f)\n", pv.volume.fov_x_rad * 180 / kPi,
+              pv.volume.fov_y_rad * 180 / kPi, all.views[0].volume.fov_x_rad * 180 / kPi, all.views[0].volume.fov_y_rad * 180 / kPi);
+  // Every cut point lies on the edge of the viewer's view: on one of its clip planes.
+  for (const PatchView::ViewEdgeSample& e : pv.view_edge) {
+    Vec3 p(0.0);
+    for (int j = 0; j < 3; ++j) p += e.weights[j] * seen.world_pos[seen.grid_patches[0].vertices[e.corners[j]]];
+    const Vec4 c = *opt.viewer_clip * Vec4(p, 1.0);
+    const double on = std::min({std::abs(c.w - std::abs(c.x)), std::abs(c.w - std::abs(c.y)), std::abs(c.w - std::abs(c.z))});
+    EXPECT_LT(on, 1e-9 * std::abs(c.w)) << c.x << " " << c.y << " " << c.z << " " << c.w;
+  }
   const cad::GridPatch& gp = seen.grid_patches[0];
   for (size_t k = 0; k < gp.vertices.size(); ++k) {
     if (seen.in_view[gp.vertices[k]] != 2) continue;
