@@ -3,8 +3,9 @@
 //   MODE_PVRR    the warped first-pass map (paper 3.4). CHANNELS 1: one texture-coordinate set; CHANNELS 3:
 //                three sets (RGB dispersion, or three samples of a spectral set), colour = sum_i w_i * map(st_i).
 //                RGB_CHANNELS (with CHANNELS 3): the sets are the R, G and B channels, whose weights are zero
-//                but in their own component: colour = (w_0.r map(st_0).r, w_1.g map(st_1).g, w_2.b map(st_2).b),
-//                the same sum with two thirds of the weights left uninterpolated.
+//                but in their own component, and the map is three R32F planes (shaders/outputs.glsl, PLANES):
+//                colour = (w_0.r R(st_0), w_1.g G(st_1), w_2.b B(st_2)), the same sum with two thirds of the
+//                weights left uninterpolated and one float per texel read.
 //                More than three channels: one additive draw per set of three (pvrr/gl/renderer.cpp).
 //   MODE_ENVMAP  the classic dynamic cube map from the element centre (lens: looked up along the
 //                interpolated exact exit directions of the vertices, the 'refraction vectors' baseline)
@@ -32,6 +33,10 @@ uniform bool u_additive;         // the second or later of the additive draws of
 #if defined(MODE_PVRR)
 uniform sampler2D u_map;         // first pass colour (linear)
 uniform sampler2D u_seen_map;    // first pass seen points, relative to the map's camera origin (LINEAR)
+#if defined(RGB_CHANNELS)
+uniform sampler2D u_map_g;       // the G and B planes (u_map: the R plane)
+uniform sampler2D u_map_b;
+#endif
 uniform vec2 u_st_scale;         // the map fills the lower-left (texels / texture size) of its texture
 uniform vec2 u_st_max;           // half a texel inside that region's far edges
 // A projective texture coordinate (s q, t q, q) of the volume's [0, 1]^2 to the map's region of its texture.
@@ -42,13 +47,7 @@ uniform samplerCube u_seen_cube;
 #elif defined(MODE_PLAIN)
 uniform bool u_dark;
 #endif
-layout(location = 0) out vec4 o_color;
-#if defined(NO_SEEN_POINTS)
-vec4 o_seen, o_surface;  // colour only: not outputs, so the compiler drops them and what only they need
-#else
-layout(location = 1) out vec4 o_seen;
-layout(location = 2) out vec4 o_surface;
-#endif
+#include "outputs.glsl"
 #include "shading.glsl"
 
 // Exact unpolarised conductor Fresnel reflectance, outside index 1 (pvrr/optics.cpp fresnelConductor).
@@ -87,8 +86,8 @@ void main() {
 #endif
 #if defined(MODE_PVRR)
 #if CHANNELS == 3 && defined(RGB_CHANNELS)
-  vec3 c = vec3(v_w0.r * texture(u_map, mapST(v_st0)).r, v_w1.g * texture(u_map, mapST(v_st1)).g,
-                v_w2.b * texture(u_map, mapST(v_st2)).b);
+  vec3 c = vec3(v_w0.r * texture(u_map, mapST(v_st0)).r, v_w1.g * texture(u_map_g, mapST(v_st1)).r,
+                v_w2.b * texture(u_map_b, mapST(v_st2)).r);
 #else
   vec3 c = v_w0 * texture(u_map, mapST(v_st0)).rgb;
 #if CHANNELS == 3

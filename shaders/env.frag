@@ -8,13 +8,7 @@ uniform vec3 u_albedo;
 uniform bool u_has_texture;
 uniform sampler2D u_texture;   // GL_SRGB8: decoded to linear before filtering
 uniform vec3 u_view_origin;    // the point rays come from (the camera, or the virtual viewpoint), relative
-layout(location = 0) out vec4 o_color;
-#if defined(NO_SEEN_POINTS)
-vec4 o_seen, o_surface;  // colour only: not outputs, so the compiler drops them and what only they need
-#else
-layout(location = 1) out vec4 o_seen;
-layout(location = 2) out vec4 o_surface;
-#endif
+#include "outputs.glsl"
 #include "shading.glsl"
 #if defined(FACETED)
 flat in vec3 v_face_normal;

@@ -5,13 +5,7 @@ in vec2 v_ndc;
 uniform mat4 u_inv_view_proj;  // inverse of the camera-relative projection * view
 uniform vec3 u_background;
 uniform float u_far;
-layout(location = 0) out vec4 o_color;
-#if defined(NO_SEEN_POINTS)
-vec4 o_seen, o_surface;  // colour only: not outputs, so the compiler drops them and what only they need
-#else
-layout(location = 1) out vec4 o_seen;
-layout(location = 2) out vec4 o_surface;
-#endif
+#include "outputs.glsl"
 void main() {
   vec4 a = u_inv_view_proj * vec4(v_ndc, -1.0, 1.0);
   vec4 b = u_inv_view_proj * vec4(v_ndc, 1.0, 1.0);

@@ -17,6 +17,7 @@ const char* formatName(ColorFormat f) {
     case ColorFormat::SRGB8A8: return "SRGB8_ALPHA8";
     case ColorFormat::RGBA16F: return "RGBA16F";
     case ColorFormat::RGBA32F: return "RGBA32F";
+    case ColorFormat::R32F: return "R32F";
   }
   return "?";
 }
@@ -27,6 +28,7 @@ GLenum internalFormat(ColorFormat f) {
     case ColorFormat::SRGB8A8: return GL_SRGB8_ALPHA8;
     case ColorFormat::RGBA16F: return GL_RGBA16F;
     case ColorFormat::RGBA32F: return GL_RGBA32F;
+    case ColorFormat::R32F: return GL_R32F;
   }
   return GL_RGBA8;
 }
@@ -183,8 +185,8 @@ Framebuffer::Framebuffer(int width, int height, const std::vector<ColorFormat>& 
     glBindTexture(GL_TEXTURE_2D, color_textures_[i]);
     // No data is uploaded, so format/type only need to be a valid pair for the internal format.
     const GLenum type = colors[i] == ColorFormat::RGBA8 || colors[i] == ColorFormat::SRGB8A8 ? GL_UNSIGNED_BYTE : GL_FLOAT;
-    glTexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(internalFormat(colors[i])), width, height, 0, GL_RGBA, type,
-                 nullptr);
+    glTexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(internalFormat(colors[i])), width, height, 0,
+                 colors[i] == ColorFormat::R32F ? GL_RED : GL_RGBA, type, nullptr);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);

@@ -208,6 +208,7 @@ struct PassCamera {
   Mat4 view_proj{1.0};   // relativeViewProj: acts on positions relative to origin
   Vec3 rays_from{0};     // where the viewing rays start, relative to origin (0: the camera itself)
   bool reversed_depth = false;
+  bool planes = false;   // the target is a lens map in R, G and B planes (shaders/outputs.glsl PLANES)
 };
 
 // Whether any part of the convex hull of `points` can be inside the view volume: false only when every
@@ -254,8 +255,36 @@ struct Renderer::Impl {
   Program pvrr3_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_PVRR", "#define CHANNELS 3"}));
   Program lens_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_PVRR", "#define CHANNELS 1", "#define LENS"}));
   Program lens3_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_PVRR", "#define CHANNELS 3", "#define LENS"}));
+  // RGB dispersion: its maps are R, G and B planes.
   Program lens_rgb_program = makeProgram("element.vert", "element.frag",
                                          defines({"#define MODE_PVRR", "#define CHANNELS 3", "#define LENS", "#define RGB_CHANNELS"}));
+  // The variants that draw into a planes map (PLANES), built on first use: only scenes with a lens with RGB
+  // dispersion draw into one.
+  mutable std::map<std::string, std::unique_ptr<Program>> planes_programs;
+  const Program& planesVariant(const std::string& vert, const std::string& frag, std::vector<std::string> d) const {
+    d.push_back("#define PLANES");
+    std::string key = vert + " " + frag;
+    for (const std::string& x : d) key += "|" + x;
+    std::unique_ptr<Program>& p = planes_programs[key];
+    if (!p) p = std::make_unique<Program>(makeProgram(vert, frag, defines(d)));
+    return *p;
+  }
+  const Program& envProgram(bool faceted, bool planes) const {
+    if (!planes) return faceted ? env_faceted_program : env_program;
+    return planesVariant("env.vert", "env.frag", faceted ? std::vector<std::string>{"#define FACETED"} : std::vector<std::string>{});
+  }
+  const Program& skyProgram(bool planes) const { return planes ? planesVariant("sky.vert", "sky.frag", {}) : sky_program; }
+  const Program& plainProgram(bool planes) const {
+    return planes ? planesVariant("element.vert", "element.frag", {"#define MODE_PLAIN"}) : plain_program;
+  }
+  // A lens with RGB dispersion (three channels of unit R, G and B weights): its maps are planes, its second
+  // pass reads one component per channel.
+  static bool rgbLens(const Element& el, const ElementFrame& f) {
+    if (el.type != ElementType::Lens || f.rays.size() != 3 || f.channels.size() != 3) return false;
+    for (size_t c = 0; c < 3; ++c)
+      if (channelWeight(f.channels, c) != Vec3(c == 0, c == 1, c == 2)) return false;
+    return true;
+  }
   GLuint empty_vao = 0;
   std::vector<MeshBuffers> env_meshes;
   std::vector<bool> env_faceted;  // per environment mesh: every triangle has one normal at its three corners
@@ -344,13 +373,14 @@ struct Renderer::Impl {
   // no pixel is shaded twice for it; what was drawn into the target before (the elements of the second
   // pass, drawn first so that the environment behind them fails the early depth test) stays.
   void drawEnvironment(const Mat4& view, const Mat4& proj, const Vec3& origin, bool reversed_depth = false,
-                       const Vec3* rays_from = nullptr) const {
+                       const Vec3* rays_from = nullptr, bool planes = false) const {
     const Mat4 vp = relativeViewProj(proj, view, origin);
+    const Program& sky = skyProgram(planes);
     auto drawSky = [&] {
-      sky_program.use();
-      sky_program.set("u_inv_view_proj", toFloat(glm::inverse(vp)));
-      sky_program.set("u_background", glm::vec3(scene.render.background));
-      sky_program.set("u_far", float(scene.render.far_distance_m));
+      sky.use();
+      sky.set("u_inv_view_proj", toFloat(glm::inverse(vp)));
+      sky.set("u_background", glm::vec3(scene.render.background));
+      sky.set("u_far", float(scene.render.far_distance_m));
       glBindVertexArray(empty_vao);
       glDrawArrays(GL_TRIANGLES, 0, 3);
     };
@@ -362,7 +392,7 @@ struct Renderer::Impl {
     glEnable(GL_DEPTH_TEST);
     glDepthMask(GL_TRUE);
     glDepthFunc(reversed_depth ? GL_GREATER : GL_LESS);
-    for (const Program* p : {&env_faceted_program, &env_program}) {
+    for (const Program* p : {&envProgram(true, planes), &envProgram(false, planes)}) {
       p->use();
       p->set("u_view_proj", toFloat(vp));
       p->set("u_view_origin", rays_from ? glm::vec3(*rays_from - origin) : glm::vec3(0.0f));
@@ -373,7 +403,7 @@ struct Renderer::Impl {
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
       const EnvMesh& mesh = scene.meshes[m];
       const DiffuseMaterial& mat = scene.materials[size_t(mesh.material)];
-      const Program& p = env_faceted[m] ? env_faceted_program : env_program;
+      const Program& p = envProgram(env_faceted[m], planes);
       p.use();
       p.set("u_offset", glm::vec3(mesh.anchor - origin));
       p.set("u_albedo", glm::vec3(mat.color));
@@ -450,19 +480,21 @@ struct Renderer::Impl {
     uploadMesh(mb, data, kElementLayout, idx);
   }
 
-  Framebuffer& mapTarget(size_t i, int size) {
+  // The map texture of slot i: size x size, colour RGBA32F (planes: three R32F planes), then the seen points
+  // (RGBA32F) when they are wanted.
+  Framebuffer& mapTarget(size_t i, int size, bool planes) {
     if (maps.size() <= i) maps.resize(i + 1);
-    if (!maps[i] || maps[i]->width() != size) {
+    const bool is_planes = maps[i] && maps[i]->colorFormat(0) == ColorFormat::R32F;
+    if (!maps[i] || maps[i]->width() != size || is_planes != planes) {
       // RGBA32F colour: llvmpipe filters it faster than RGBA16F (three bilinear reads of a 1024^2 map over
-      // 1280 x 720: 14.9 against 18.2 ms), and it keeps values above 1 exactly.
-      maps[i] = std::make_unique<Framebuffer>(size, size,
-                                              options.seen_points
-                                                  ? std::vector<ColorFormat>{ColorFormat::RGBA32F, ColorFormat::RGBA32F}
-                                                  : std::vector<ColorFormat>{ColorFormat::RGBA32F},
-                                              DepthFormat::Depth32F);
+      // 1280 x 720: 14.9 against 18.2 ms), and it keeps values above 1 exactly. Planes: one float a read.
+      std::vector<ColorFormat> formats = planes ? std::vector<ColorFormat>{ColorFormat::R32F, ColorFormat::R32F, ColorFormat::R32F}
+                                                : std::vector<ColorFormat>{ColorFormat::RGBA32F};
+      if (options.seen_points) formats.push_back(ColorFormat::RGBA32F);
+      maps[i] = std::make_unique<Framebuffer>(size, size, formats, DepthFormat::Depth32F);
       // Colour and seen points filter linearly: seen points are exact within a surface and blend only across
       // depth edges (nearest filtering would quantise every seen point by up to half a texel).
-      for (int a = 0; a < (options.seen_points ? 2 : 1); ++a) {
+      for (int a = 0; a < maps[i]->colorCount(); ++a) {
         glBindTexture(GL_TEXTURE_2D, maps[i]->colorTexture(a));
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
@@ -661,17 +693,25 @@ struct Renderer::Impl {
     const Vec3 anchor = Vec3(el.local_to_world[3]);
     const bool lens = el.type == ElementType::Lens;
     const size_t channels = f.rays.size();
-    // Three channels whose weights are the unit R, G and B vectors: each weight has one non-zero component.
-    bool rgb = lens && channels == 3 && f.channels.size() == 3;
-    for (size_t c = 0; c < 3 && rgb; ++c) rgb = channelWeight(f.channels, c) == Vec3(c == 0, c == 1, c == 2);
-    const Program& p = lens ? (rgb ? lens_rgb_program : channels > 1 ? lens3_program : lens_program)
-                            : (channels > 1 ? pvrr3_program : pvrr_program);
+    // RGB dispersion: its maps are planes, read one component per channel.
+    const bool rgb = rgbLens(el, f);
+    const Program* base = lens ? (rgb ? &lens_rgb_program : channels > 1 ? &lens3_program : &lens_program)
+                               : (channels > 1 ? &pvrr3_program : &pvrr_program);
+    if (cam.planes) {  // drawn into a planes map (only RGB scenes have them: never more than three channels)
+      std::vector<std::string> d = {"#define MODE_PVRR", channels > 1 ? "#define CHANNELS 3" : "#define CHANNELS 1"};
+      if (lens) d.push_back("#define LENS");
+      if (rgb) d.push_back("#define RGB_CHANNELS");
+      base = &planesVariant("element.vert", "element.frag", d);
+    }
+    const Program& p = *base;
     p.use();
     p.set("u_view_proj", toFloat(cam.view_proj));
     p.set("u_offset", glm::vec3(anchor - cam.origin));
     p.set("u_view_origin", glm::vec3(cam.rays_from));
     p.set("u_map", 0);
     p.set("u_seen_map", 1);
+    p.set("u_map_g", 2);
+    p.set("u_map_b", 3);
     setLights(p, cam.origin);
     setElementMaterial(p, el, f.element);
     // The seen point's channel: the one nearest the d line unless asked (the tracer's seen point is the d
@@ -691,10 +731,17 @@ struct Renderer::Impl {
     for (size_t v = 0; v < f.views.size(); ++v) {
       const PatchView& pv = f.views[v];
       const Framebuffer& map = *maps[first_slot + v];
+      const int planes = map.colorFormat(0) == ColorFormat::R32F ? 3 : 1;  // colour attachments before the seen points
       glActiveTexture(GL_TEXTURE0);
       glBindTexture(GL_TEXTURE_2D, map.colorTexture(0));
+      if (planes == 3) {
+        glActiveTexture(GL_TEXTURE2);
+        glBindTexture(GL_TEXTURE_2D, map.colorTexture(1));
+        glActiveTexture(GL_TEXTURE3);
+        glBindTexture(GL_TEXTURE_2D, map.colorTexture(2));
+      }
       glActiveTexture(GL_TEXTURE1);
-      if (options.seen_points) glBindTexture(GL_TEXTURE_2D, map.colorTexture(1));
+      if (options.seen_points) glBindTexture(GL_TEXTURE_2D, map.colorTexture(planes));
       p.set("u_seen_offset", glm::vec3(pv.volume.eye - cam.origin));
       // The map fills the lower-left mapTexels() of its texture: (s, t) in [0, 1]^2 of the volume scale to
       // that region, clamped half a texel inside it (as GL_CLAMP_TO_EDGE does at the texture's own edge).
@@ -731,13 +778,14 @@ struct Renderer::Impl {
   void drawDarkElement(const ElementFrame& f, const PassCamera& cam) {
     const Element& el = scene.elements[size_t(f.element)];
     const Vec3 anchor = Vec3(el.local_to_world[3]);
-    plain_program.use();
-    plain_program.set("u_view_proj", toFloat(cam.view_proj));
-    plain_program.set("u_offset", glm::vec3(anchor - cam.origin));
-    plain_program.set("u_view_origin", glm::vec3(cam.rays_from));
-    plain_program.set("u_dark", 1);
-    setLights(plain_program, cam.origin);
-    setElementMaterial(plain_program, el, f.element);
+    const Program& plain = plainProgram(cam.planes);
+    plain.use();
+    plain.set("u_view_proj", toFloat(cam.view_proj));
+    plain.set("u_offset", glm::vec3(anchor - cam.origin));
+    plain.set("u_view_origin", glm::vec3(cam.rays_from));
+    plain.set("u_dark", 1);
+    setLights(plain, cam.origin);
+    setElementMaterial(plain, el, f.element);
     MeshBuffers& mb = meshSlot();
     uploadElementGrid(mb, f, anchor);
     draw(mb);
@@ -748,7 +796,8 @@ struct Renderer::Impl {
     for (size_t i = passes.size(); i-- > 0;) {
       const MapPass& mp = passes[i];
       const PatchView& pv = mp.owner->views[mp.view];
-      const Framebuffer& t = mapTarget(mp.slot, mp.size);
+      const bool planes = rgbLens(scene.elements[size_t(mp.owner->element)], *mp.owner);
+      const Framebuffer& t = mapTarget(mp.slot, mp.size, planes);
       if (!mp.visible) continue;
       // No colour clear: the sky covers every texel nothing else does (drawEnvironment).
       const std::array<int, 2> region = mapTexels(pv.volume, mp.side);
@@ -757,8 +806,9 @@ struct Renderer::Impl {
       // In a reversed (zooming) map the rays come from the mirror, not from the viewpoint.
       const Vec3 element_centre = Vec3(scene.elements[size_t(mp.owner->element)].local_to_world[3]);
       drawEnvironment(pv.volume.view, pv.volume.projection, pv.volume.eye, pv.volume.backward,
-                      pv.volume.backward ? &element_centre : nullptr);
+                      pv.volume.backward ? &element_centre : nullptr, planes);
       PassCamera cam;
+      cam.planes = planes;
       cam.origin = pv.volume.eye;
       cam.view_proj = relativeViewProj(pv.volume.projection, pv.volume.view, pv.volume.eye);
       cam.rays_from = pv.volume.backward ? element_centre - pv.volume.eye : Vec3(0.0);

@@ -10,6 +10,7 @@
 #include "pvrr/gl/renderer.h"
 #include "pvrr/scene_build.h"
 #include "pvrr/scene_json.h"
+#include "pvrr/spectrum.h"
 #include "support/gl_backends.h"
 
 namespace pvrr {
@@ -123,6 +124,40 @@ TEST_P(ColourOnlyTest, EveryPixelIsDrawnWithoutAColourClear) {
       EXPECT_EQ(mismatches, 0u) << scene << " mode " << int(mode);
     }
   }
+}
+
+// A lens with RGB dispersion renders its maps as three R32F planes and reads one float per channel
+// (shaders/outputs.glsl PLANES); any other channel set uses an RGBA32F map and the general weighted sum. The
+// same RGB channels with a weight off the unit vectors by 1e-30 take the general path: the colours must
+// agree to float rounding, and the seen points exactly (both read the same seen-point map).
+TEST_P(ColourOnlyTest, RgbLensPlanesEqualTheGeneralMap) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  Scene s = buildScene(loadScene(std::string(PVRR_SOURCE_DIR) + "/models/reading-lens.json",
+                                 {"observer.image_size=[96,72]", "render.map_size=256", "render.dispersion=rgb"}));
+  RayScene rays(s);
+  gl::RendererOptions planes, general;
+  planes.vertex.channels = dispersionChannels(s, 0, "rgb", s.render.spectral_samples);
+  ASSERT_EQ(planes.vertex.channels.size(), 3u);
+  general.vertex.channels = planes.vertex.channels;
+  for (size_t c = 0; c < 3; ++c) {
+    Vec3 w(0.0);
+    w[int(c)] = 1.0;
+    w[int((c + 1) % 3)] = 1e-30;
+    general.vertex.channels[c].rgb_weight = w;
+  }
+  const gl::RasterFrame a = gl::Renderer(s, rays, planes).render(gl::RasterMode::Pvrr);
+  const gl::RasterFrame b = gl::Renderer(s, rays, general).render(gl::RasterMode::Pvrr);
+  ASSERT_EQ(a.color.size(), b.color.size());
+  size_t lens_pixels = 0;
+  double worst = 0;
+  for (size_t i = 0; i < a.color.size(); ++i) {
+    lens_pixels += a.element[i] == 0;
+    worst = std::max(worst, glm::length(a.color[i] - b.color[i]));
+    EXPECT_EQ(a.seen[i], b.seen[i]) << "pixel " << i;
+  }
+  EXPECT_GT(lens_pixels, 200u);
+  EXPECT_LE(worst, kColourTol);
 }
 
 PVRR_GL_BACKENDS(ColourOnlyTest);

@@ -1,0 +1,34 @@
+// The fragment outputs of every program that draws into a pass (env.frag, sky.frag, element.frag), by
+// variant. The shader writes o_color, o_seen and o_surface; what they become:
+//   default          location 0 colour, 1 seen point, 2 surface point (second pass; maps have no 2)
+//   NO_SEEN_POINTS   colour only: o_seen and o_surface are locals the compiler drops, with what only they need
+//   PLANES           a map of a lens with RGB dispersion: R, G and B in three R32F attachments (locations 0-2),
+//                    the seen point at 3. The second pass reads each channel's plane at that channel's
+//                    texture coordinates: one float per texel read instead of four.
+#if defined(PLANES)
+layout(location = 0) out float o_plane_r;
+layout(location = 1) out float o_plane_g;
+layout(location = 2) out float o_plane_b;
+vec4 o_color;
+#else
+layout(location = 0) out vec4 o_color;
+#endif
+#if defined(NO_SEEN_POINTS)
+vec4 o_seen, o_surface;
+#elif defined(PLANES)
+layout(location = 3) out vec4 o_seen;
+vec4 o_surface;  // maps have no surface attachment
+#else
+layout(location = 1) out vec4 o_seen;
+layout(location = 2) out vec4 o_surface;
+#endif
+#if defined(PLANES)
+void shade();
+void main() {
+  shade();
+  o_plane_r = o_color.r;
+  o_plane_g = o_color.g;
+  o_plane_b = o_color.b;
+}
+#define main shade
+#endif
