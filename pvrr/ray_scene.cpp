@@ -292,6 +292,8 @@ bool RayScene::resolveCandidate(const Vec3& o, const Vec3& d, double t_min, doub
 }
 
 RayHit RayScene::intersect(const Vec3& o, const Vec3& d, double t_min, double t_max) const {
+  // A ray that is not finite (degenerate input upstream) meets nothing; Embree asserts on it.
+  if (!std::isfinite(o.x + o.y + o.z + d.x + d.y + d.z)) return RayHit{};
   const Impl& im = *impl_;
   // After a rejected candidate the next query starts strictly beyond it (the float slack must not bring the
   // same triangle back).
@@ -374,6 +376,7 @@ void RayScene::intersectPacket(const Vec3* o, const Vec3* d, int count, RayHit* 
 
 RayHit RayScene::intersectElementSurface(int element, int surface, const Vec3& o, const Vec3& d, double t_min,
                                          double t_max, double search_from, bool within_outline) const {
+  if (!std::isfinite(o.x + o.y + o.z + d.x + d.y + d.z)) return RayHit{};
   const Impl& im = *impl_;
   const int gid = im.element_geoms[size_t(element)][size_t(surface)];
   if (gid < 0) return RayHit{};

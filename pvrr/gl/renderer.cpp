@@ -732,6 +732,10 @@ struct Renderer::Impl {
       const PatchView& pv = f.views[v];
       const Framebuffer& map = *maps[first_slot + v];
       const int planes = map.colorFormat(0) == ColorFormat::R32F ? 3 : 1;  // colour attachments before the seen points
+      if ((planes == 3) != rgb) throw Error("renderer: map slot " + std::to_string(first_slot + v) + " of " + el.name + " is " +
+                                            (planes == 3 ? "in planes" : "RGBA") + " but the element's channels are " +
+                                            (rgb ? "RGB" : "not RGB") + " (internal error)");
+      if (cam.planes && sets > 1) throw Error("renderer: additive channel draws into a planes map (internal error)");
       glActiveTexture(GL_TEXTURE0);
       glBindTexture(GL_TEXTURE_2D, map.colorTexture(0));
       if (planes == 3) {
@@ -970,14 +974,17 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     const auto t1 = Clock::now();
     renderPasses(frames);
     glFinish();
-    // The note: how many maps of which size, and what was not rendered.
-    std::map<std::array<int, 2>, int, std::greater<std::array<int, 2>>> sizes;
+    // The note: how many maps of which size (and which are R, G, B planes), and what was not rendered.
+    std::map<std::array<int, 3>, int, std::greater<std::array<int, 3>>> sizes;
     for (const MapPass& mp : passes)
-      if (mp.visible) ++sizes[mapTexels(mp.owner->views[mp.view].volume, mp.side)];
+      if (mp.visible) {
+        const std::array<int, 2> t = mapTexels(mp.owner->views[mp.view].volume, mp.side);
+        ++sizes[{t[0], t[1], maps[mp.slot]->colorFormat(0) == ColorFormat::R32F}];
+      }
     std::string note;
     for (const auto& [texels, n] : sizes)
       note += (note.empty() ? "" : ", ") + std::to_string(n) + " x " + std::to_string(texels[0]) + "x" +
-              std::to_string(texels[1]);
+              std::to_string(texels[1]) + (texels[2] ? " RGB planes" : "");
     if (rendered != int(passes.size()))
       note += (note.empty() ? "" : "; ") + std::to_string(passes.size() - size_t(rendered)) +
               " map(s) of elements outside the observer's view or beyond the depth limit not rendered";

@@ -41,6 +41,21 @@ TEST(Tracer, PlaneMirrorMapsAPointToItsMirrorImage) {
   EXPECT_EQ(r.bounces, 1);
 }
 
+// A ray that is not finite (degenerate geometry upstream) meets nothing instead of reaching Embree, which
+// asserts on it (an element posed with its up along its normal had NaN vertices and aborted the renderer).
+TEST(Tracer, NonFiniteRaysMeetNothing) {
+  Scene s = test::roomScene(Vec3(0.3, 0.2, 2.0), Vec3(0, 0, 0));
+  const cad::Outline outline = cad::Outline::rectangle(0.6, 0.4);
+  test::addMirror(s, cad::makePlane(outline), outline, test::pose(Vec3(0), Vec3(0, 0, 1)));
+  s.updateBounds();
+  RayScene rays(s);
+  const double nan = std::nan("");
+  EXPECT_TRUE(rays.intersect(Vec3(0, 0, 1), Vec3(0, 0, -1), 0).hit());  // the mirror, for contrast
+  EXPECT_FALSE(rays.intersect(Vec3(nan, 0, 1), Vec3(0, 0, -1), 0).hit());
+  EXPECT_FALSE(rays.intersect(Vec3(0, 0, 1), Vec3(0, nan, -1), 0).hit());
+  EXPECT_FALSE(rays.intersectElementSurface(0, 0, Vec3(0, 0, 1), Vec3(nan, 0, -1), 0).hit());
+}
+
 TEST(Tracer, SphericalMirrorMatchesAnalyticReflection) {
   const double R = 1.2;  // convex, centre behind the mirror at z = -R
   Scene s = test::roomScene(Vec3(0.1, 0.05, 1.5), Vec3(0, 0, 0));
