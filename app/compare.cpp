@@ -284,8 +284,9 @@ std::vector<ElementFrame> vertexStageFrames(const Scene& scene, const RayScene& 
 const char* kDefinitions[][2] = {
     {"frame_ms", "a mode's median full-frame time over --frames frames after a warm-up, every stage run (no cache), "
                  "the GPU finished, drawn as pvrr render draws it: colour only, without the seen-point attachments "
-                 "that the accuracy figures are read from (those come from one more frame with them on); the "
-                 "reference's: one multithreaded ray-traced frame"},
+                 "that the accuracy figures are read from (those come from one more frame with them on), and not "
+                 "read back from the GPU (a viewer presents the frame); the reference's: one multithreaded "
+                 "ray-traced frame"},
     {"angular_error", "per pixel where the reference sees a mirror or lens: the angle, at the reference's surface point, "
                       "between the directions to the mode's seen point and to the reference's"},
     {"zooming_region", "pixels whose reference seen point lies behind the fitted virtual viewpoint of the pvrr patch under "
