@@ -123,6 +123,20 @@ void writeHeatMap(const std::string& path, int w, int h, const std::vector<doubl
   writePngAtomic(path, img);
 }
 
+// Squared difference of two linear colours, sRGB-encoded and clamped to [0, 1], summed over R, G and B.
+double srgbSquaredError(const Vec3& a, const Vec3& b) {
+  double se = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double d = linearToSrgb(std::clamp(a[k], 0.0, 1.0)) - linearToSrgb(std::clamp(b[k], 0.0, 1.0));
+    se += d * d;
+  }
+  return se;
+}
+
+// The RMSE of srgbSquaredError summed over `pixels` pixels, and its PSNR (99 dB for no error).
+double colourRmse(double se, size_t pixels) { return pixels ? std::sqrt(se / (3.0 * double(pixels))) : 0.0; }
+double psnrDb(double rmse) { return rmse > 0 ? 20.0 * std::log10(1.0 / rmse) : 99.0; }
+
 }  // namespace
 
 ErrorStats compareToReference(const RenderedFrame& ref, const RenderedFrame& mode, std::vector<double>* errors,
@@ -138,18 +152,15 @@ ErrorStats compareToReference(const RenderedFrame& ref, const RenderedFrame& mod
     if (!std::isfinite(a)) continue;
     e.push_back(a);
     if (errors) (*errors)[i] = a;
-    for (int k = 0; k < 3; ++k) {
-      const double d = linearToSrgb(std::clamp(ref.color[i][k], 0.0, 1.0)) - linearToSrgb(std::clamp(mode.color[i][k], 0.0, 1.0));
-      se += d * d;
-    }
+    se += srgbSquaredError(ref.color[i], mode.color[i]);
   }
   s.pixels = e.size();
   if (e.empty()) return s;
   s.median_arcmin = quantile(e, 0.5);
   s.p95_arcmin = quantile(e, 0.95);
   s.max_arcmin = *std::max_element(e.begin(), e.end());
-  s.rmse = std::sqrt(se / (3.0 * double(e.size())));
-  s.psnr_db = s.rmse > 0 ? 20.0 * std::log10(1.0 / s.rmse) : 99.0;
+  s.rmse = colourRmse(se, e.size());
+  s.psnr_db = psnrDb(s.rmse);
   return s;
 }
 
@@ -331,15 +342,10 @@ double elementPsnr(const RenderedFrame& ref, const std::vector<Vec3>& truth, con
   size_t n = 0;
   for (size_t i = 0; i < ref.element.size() && i < truth.size() && i < colour.size(); ++i) {
     if (ref.element[i] < 0) continue;
-    for (int k = 0; k < 3; ++k) {
-      const double d = linearToSrgb(std::clamp(truth[i][k], 0.0, 1.0)) - linearToSrgb(std::clamp(colour[i][k], 0.0, 1.0));
-      se += d * d;
-    }
+    se += srgbSquaredError(truth[i], colour[i]);
     ++n;
   }
-  if (n == 0) return 0;
-  const double rmse = std::sqrt(se / (3.0 * double(n)));
-  return rmse > 0 ? 20.0 * std::log10(1.0 / rmse) : 99.0;
+  return n == 0 ? 0.0 : psnrDb(colourRmse(se, n));
 }
 
 }  // namespace

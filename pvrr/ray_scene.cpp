@@ -256,6 +256,33 @@ FloatRay floatRay(const Vec3& o, const Vec3& d, const Vec3& anchor, double tnear
   return r;
 }
 
+// A single Embree query for floatRay(...), no hit yet.
+RTCRayHit rayHit1(const FloatRay& fr) {
+  RTCRayHit rh{};
+  rh.ray.org_x = fr.org[0];
+  rh.ray.org_y = fr.org[1];
+  rh.ray.org_z = fr.org[2];
+  rh.ray.dir_x = fr.dir[0];
+  rh.ray.dir_y = fr.dir[1];
+  rh.ray.dir_z = fr.dir[2];
+  rh.ray.tnear = fr.tnear;
+  rh.ray.tfar = fr.tfar;
+  rh.ray.mask = ~0u;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  return rh;
+}
+
+// The surface parameters of an element candidate: the tessellation's (u, v) at its vertices interpolated
+// with Embree's barycentrics (bu, bv of the triangle's vertices 1 and 2).
+Vec2 candidateParams(RTCScene scene, const GeomInfo& g, unsigned geom_id, unsigned prim_id, double bu, double bv) {
+  const RTCGeometry geom = rtcGetGeometry(scene, geom_id);
+  const auto* idx = static_cast<const unsigned*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_INDEX, 0));
+  const unsigned* tri = idx + 3 * size_t(prim_id);
+  return (1.0 - bu - bv) * g.params[tri[0]] + bu * g.params[tri[1]] + bv * g.params[tri[2]];
+}
+
 }  // namespace
 
 bool RayScene::resolveCandidate(const Vec3& o, const Vec3& d, double t_min, double t_max, unsigned geom_id,
@@ -280,13 +307,8 @@ bool RayScene::resolveCandidate(const Vec3& o, const Vec3& d, double t_min, doub
     hit.mesh = g.index;
     return true;
   }
-  // Element candidate: interpolate the tessellation's parameters (Embree's (u, v) are the barycentrics of
-  // the triangle's vertices 1 and 2) and refine on the exact surface.
-  const RTCGeometry geom = rtcGetGeometry(im.scene, geom_id);
-  const auto* idx = static_cast<const unsigned*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_INDEX, 0));
-  const unsigned* tri = idx + 3 * size_t(prim_id);
-  const double bu = bu_f, bv = bv_f;
-  const Vec2 uv = (1.0 - bu - bv) * g.params[tri[0]] + bu * g.params[tri[1]] + bv * g.params[tri[2]];
+  // Element candidate: refined on the exact surface.
+  const Vec2 uv = candidateParams(im.scene, g, geom_id, prim_id, bu_f, bv_f);
   hit = refineElementHit(g.index, g.surface, o, d, t_min, t_max, uv, double(t_candidate), true);
   return hit.hit();
 }
@@ -304,20 +326,7 @@ RayHit RayScene::intersect(const Vec3& o, const Vec3& d, double t_min, double t_
     // Default context flags: incoherent (secondary rays).
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
-    const FloatRay fr = floatRay(o, d, im.anchor, t_min, t_max, past);
-    RTCRayHit rh{};
-    rh.ray.org_x = fr.org[0];
-    rh.ray.org_y = fr.org[1];
-    rh.ray.org_z = fr.org[2];
-    rh.ray.dir_x = fr.dir[0];
-    rh.ray.dir_y = fr.dir[1];
-    rh.ray.dir_z = fr.dir[2];
-    rh.ray.tnear = fr.tnear;
-    rh.ray.tfar = fr.tfar;
-    rh.ray.mask = ~0u;
-    rh.ray.flags = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    RTCRayHit rh = rayHit1(floatRay(o, d, im.anchor, t_min, t_max, past));
     rtcIntersect1(im.scene, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return RayHit{};
     RayHit hit;
@@ -375,7 +384,7 @@ void RayScene::intersectPacket(const Vec3* o, const Vec3* d, int count, RayHit* 
 }
 
 RayHit RayScene::intersectElementSurface(int element, int surface, const Vec3& o, const Vec3& d, double t_min,
-                                         double t_max, double search_from, bool within_outline) const {
+                                         double t_max, bool within_outline) const {
   if (!std::isfinite(o.x + o.y + o.z + d.x + d.y + d.z)) return RayHit{};
   const Impl& im = *impl_;
   const int gid = im.element_geoms[size_t(element)][size_t(surface)];
@@ -384,31 +393,13 @@ RayHit RayScene::intersectElementSurface(int element, int surface, const Vec3& o
   // Candidate: the nearest hit on this surface's own tessellation.
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
-  const Vec3 ol = o - im.anchor;
-  const double slack = floatSlack(ol);
-  RTCRayHit rh{};
-  rh.ray.org_x = float(ol.x);
-  rh.ray.org_y = float(ol.y);
-  rh.ray.org_z = float(ol.z);
-  rh.ray.dir_x = float(d.x);
-  rh.ray.dir_y = float(d.y);
-  rh.ray.dir_z = float(d.z);
-  rh.ray.tnear = float(search_from >= 0 ? search_from : std::max(0.0, t_min - slack));
-  rh.ray.tfar = std::isfinite(t_max) ? float(t_max + slack) : std::numeric_limits<float>::infinity();
-  rh.ray.mask = ~0u;
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  RTCRayHit rh = rayHit1(floatRay(o, d, im.anchor, t_min, t_max, 0.0f));
   rtcIntersect1(im.element_scenes[size_t(element)][size_t(surface)], &ctx, &rh);
   Vec2 uv{0};
   double t = -1;  // no candidate: the direct solve in refineElementHit
   if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
     t = rh.ray.tfar;
-    // Embree's (u, v) are the barycentrics of the triangle's vertices 1 and 2.
-    const RTCGeometry geom = rtcGetGeometry(im.scene, unsigned(gid));
-    const auto* idx = static_cast<const unsigned*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_INDEX, 0));
-    const unsigned* tri = idx + 3 * size_t(rh.hit.primID);
-    const double bu = rh.hit.u, bv = rh.hit.v;
-    uv = (1.0 - bu - bv) * g.params[tri[0]] + bu * g.params[tri[1]] + bv * g.params[tri[2]];
+    uv = candidateParams(im.scene, g, unsigned(gid), rh.hit.primID, rh.hit.u, rh.hit.v);
   }
   return refineElementHit(element, surface, o, d, t_min, t_max, uv, t, within_outline);
 }

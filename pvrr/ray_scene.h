@@ -58,11 +58,10 @@ class RayScene {
   void intersectPacket(const Vec3* o, const Vec3* d, int count, RayHit* out, double t_min = 0,
                        double t_max = kInf, bool coherent = true) const;
   // Exact intersection with one surface of one element only (e.g. a lens's back surface from inside).
-  // `search_from` (>= 0) starts the candidate search on the tessellation there instead of at t_min.
   // `within_outline` false: a sag surface is intersected as its analytic extension beyond the outline
   // (used to continue a lens's rim rays smoothly; see vertex_stage.cpp).
   RayHit intersectElementSurface(int element, int surface, const Vec3& o, const Vec3& d, double t_min = 0,
-                                 double t_max = kInf, double search_from = -1, bool within_outline = true) const;
+                                 double t_max = kInf, bool within_outline = true) const;
 
   // After elements moved (Element::local_to_world changed, e.g. spectacles turning with the head): moves
   // their candidate tessellations in Embree and recommits. The environment is untouched.

@@ -124,7 +124,7 @@ static void traceVertexRaysFrom(const RayScene& rays, ElementFrame& f, const Vec
         // thinner than the drift, usually below a pixel. A back surface from a CAD file is a NURBS sag graph
         // (cad::makeNurbsSag): its extension is the file's surface itself where it reaches past the outline
         // (a lens blank), then its second-order Taylor continuation.
-        if (!back.hit()) back = rays.intersectElementSurface(f.element, 1, p, in.direction, eps, kInf, -1, false);
+        if (!back.hit()) back = rays.intersectElementSurface(f.element, 1, p, in.direction, eps, kInf, false);
         if (!back.hit()) {
           // The internal ray leaves through the edge band: no back point. Treated like TIR: flagged.
           vr.status = VertexStatus::Tir;
@@ -194,11 +194,15 @@ std::vector<ViewpointRay> seenRays(const ElementFrame& f, const cad::GridPatch& 
   const Vec3 e = pv.fit.eye;
   std::vector<ViewpointRay> out;
   int taken = 0;
-  for (uint32_t vi : gp.vertices)
-    if (f.in_view[vi] == 2 && rs[vi].status != VertexStatus::Tir) {
-      out.push_back(ViewpointRay{rs[vi].origin, rs[vi].dir, rs[vi].hit});
-      ++taken;
-    }
+  // The unflagged rays of the vertices whose in_view is at least `level`.
+  const auto takeVertices = [&](char level) {
+    for (uint32_t vi : gp.vertices)
+      if (f.in_view[vi] >= level && rs[vi].status != VertexStatus::Tir) {
+        out.push_back(ViewpointRay{rs[vi].origin, rs[vi].dir, rs[vi].hit});
+        ++taken;
+      }
+  };
+  takeVertices(2);
   for (const PatchView::ViewEdgeSample& c : pv.view_edge) {
     Vec3 origin(0.0), toward(0.0);
     double dist = 0;
@@ -220,11 +224,7 @@ std::vector<ViewpointRay> seenRays(const ElementFrame& f, const cad::GridPatch& 
   if (out.size() < 3) {
     out.clear();
     taken = 0;
-    for (uint32_t vi : gp.vertices)
-      if (f.in_view[vi] && rs[vi].status != VertexStatus::Tir) {
-        out.push_back(ViewpointRay{rs[vi].origin, rs[vi].dir, rs[vi].hit});
-        ++taken;
-      }
+    takeVertices(1);
   }
   if (out.size() < 3) {
     out = patchRays(f, gp, nullptr);
@@ -472,8 +472,7 @@ void updateTextureCoordinates(const RayScene& rays, ElementFrame& f) {
       r.hit = h.hit() ? h.point : r.origin + far * r.dir;
     });
   const Element& el = scene.elements[size_t(f.element)];
-  for (PatchView& pv : f.views)
-    buildSeenPatchMap(scene, f, el, pv);
+  for (PatchView& pv : f.views) buildSeenPatchMap(scene, f, el, pv);
   f.rays_ms = msSince(t0);
 }
 

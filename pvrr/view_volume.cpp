@@ -292,22 +292,27 @@ Vec2 projectToTexel(const ViewVolume& vv, const Vec3& p, int width, int height) 
   return {st.x * width, st.y * height};
 }
 
+namespace {
+// Width over height of the frustum on its near plane; 1 for a degenerate one.
+double frustumAspect(const ViewVolume& vv) {
+  const double a = (vv.right_ - vv.left) / (vv.top - vv.bottom);
+  return a > 0 && std::isfinite(a) ? a : 1.0;
+}
+}  // namespace
+
 std::array<int, 2> mapTexels(const ViewVolume& vv, int longest_side) {
-  const double w = vv.right_ - vv.left, h = vv.top - vv.bottom;
-  if (!(w > 0) || !(h > 0) || !std::isfinite(w / h)) return {longest_side, longest_side};
+  const double a = frustumAspect(vv);
   const int shortest = std::min(longest_side, 16);
   auto share = [&](double ratio) { return std::clamp(int(std::ceil(longest_side * ratio - 1e-9)), shortest, longest_side); };
-  return w >= h ? std::array<int, 2>{longest_side, share(h / w)} : std::array<int, 2>{share(w / h), longest_side};
+  return a >= 1 ? std::array<int, 2>{longest_side, share(1 / a)} : std::array<int, 2>{share(a), longest_side};
 }
 
 int mapSideForPixels(const ViewVolume& vv, double pixels, double texels_per_pixel, int max_side) {
   if (!(texels_per_pixel > 0) || !(pixels >= 0)) return max_side;
-  const double w = vv.right_ - vv.left, h = vv.top - vv.bottom;
-  const double ratio = (w > 0 && h > 0 && std::isfinite(w / h)) ? std::min(w, h) / std::max(w, h) : 1.0;
+  const double a = frustumAspect(vv), ratio = std::min(a, 1 / a);  // shorter over longer side
   const double side = std::sqrt(texels_per_pixel * pixels / ratio);
-  const int lo = std::min(max_side, 128);
   if (!(side < max_side)) return max_side;
-  return std::clamp(32 * int(std::ceil(side / 32.0)), lo, max_side);
+  return std::clamp(32 * int(std::ceil(side / 32.0)), std::min(max_side, 128), max_side);
 }
 
 std::array<double, 16> rowMajor16(const Mat4& m) {

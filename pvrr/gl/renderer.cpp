@@ -190,9 +190,15 @@ int patchMapSize(int map_size, size_t patches) {
   return std::max(128, int(double(map_size) / shrink));
 }
 
+namespace {
+// Patch views a viewer can see (the others render no map).
+size_t inView(const ElementFrame& f) {
+  return size_t(std::count_if(f.views.begin(), f.views.end(), [](const PatchView& v) { return v.in_view; }));
+}
+}  // namespace
+
 int topLevelMapSide(const Scene& scene, const ElementFrame& f, const PatchView& pv, const RendererOptions& options) {
-  const size_t in_view = size_t(std::count_if(f.views.begin(), f.views.end(), [](const PatchView& v) { return v.in_view; }));
-  const int size = patchMapSize(options.map_size, std::max<size_t>(1, in_view));
+  const int size = patchMapSize(options.map_size, std::max<size_t>(1, inView(f)));
   if (!(options.map_texels_per_pixel > 0)) return size;
   const Observer& ob = scene.observer;
   const double pixels = patchScreenPixels(f, pv, ob.visibilityProjection() * ob.view(), ob.width, ob.height);
@@ -392,7 +398,8 @@ struct Renderer::Impl {
     glEnable(GL_DEPTH_TEST);
     glDepthMask(GL_TRUE);
     glDepthFunc(reversed_depth ? GL_GREATER : GL_LESS);
-    for (const Program* p : {&envProgram(true, planes), &envProgram(false, planes)}) {
+    const Program &faceted = envProgram(true, planes), &smooth = envProgram(false, planes);
+    for (const Program* p : {&faceted, &smooth}) {
       p->use();
       p->set("u_view_proj", toFloat(vp));
       p->set("u_view_origin", rays_from ? glm::vec3(*rays_from - origin) : glm::vec3(0.0f));
@@ -403,7 +410,7 @@ struct Renderer::Impl {
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
       const EnvMesh& mesh = scene.meshes[m];
       const DiffuseMaterial& mat = scene.materials[size_t(mesh.material)];
-      const Program& p = envProgram(env_faceted[m], planes);
+      const Program& p = env_faceted[m] ? faceted : smooth;
       p.use();
       p.set("u_offset", glm::vec3(mesh.anchor - origin));
       p.set("u_albedo", glm::vec3(mat.color));
@@ -530,10 +537,6 @@ struct Renderer::Impl {
   size_t next_mesh = 0;
 
   static int interfaces(const Element& el) { return el.type == ElementType::Lens ? 2 : 1; }
-  // Patch views a viewer can see (the others render no map).
-  static size_t inView(const ElementFrame& f) {
-    return size_t(std::count_if(f.views.begin(), f.views.end(), [](const PatchView& v) { return v.in_view; }));
-  }
   // Planned first passes that render a map (the budget counts these).
   size_t visiblePasses() const {
     return size_t(std::count_if(passes.begin(), passes.end(), [](const MapPass& m) { return m.visible; }));
