@@ -141,25 +141,20 @@ double psnrDb(double rmse) { return rmse > 0 ? 20.0 * std::log10(1.0 / rmse) : 9
 
 ErrorStats compareToReference(const RenderedFrame& ref, const RenderedFrame& mode, std::vector<double>* errors,
                               int only_element) {
-  ErrorStats s;
-  const size_t n = ref.color.size();
-  if (errors) errors->assign(n, std::nan(""));
-  std::vector<double> e;
+  std::vector<double> local;
+  std::vector<double>& e = errors ? *errors : local;
+  e.assign(ref.color.size(), std::nan(""));
   double se = 0;
-  for (size_t i = 0; i < n; ++i) {
+  for (size_t i = 0; i < e.size(); ++i) {
     if (ref.element[i] < 0 || (only_element >= 0 && ref.element[i] != only_element)) continue;
     const double a = arcminutes(seenAngle(ref.element_point[i], ref.seen[i], mode.seen[i]));
     if (!std::isfinite(a)) continue;
-    e.push_back(a);
-    if (errors) (*errors)[i] = a;
+    e[i] = a;
     se += srgbSquaredError(ref.color[i], mode.color[i]);
   }
-  s.pixels = e.size();
-  if (e.empty()) return s;
-  s.median_arcmin = quantile(e, 0.5);
-  s.p95_arcmin = quantile(e, 0.95);
-  s.max_arcmin = *std::max_element(e.begin(), e.end());
-  s.rmse = colourRmse(se, e.size());
+  ErrorStats s = summarizeErrors(e);
+  if (s.pixels == 0) return s;
+  s.rmse = colourRmse(se, s.pixels);
   s.psnr_db = psnrDb(s.rmse);
   return s;
 }

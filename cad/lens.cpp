@@ -78,6 +78,9 @@ struct NurbsGraph {
   std::vector<Vec2> table_uv, table_xy;  // regular samples only (see singular())
   double min_nz = 0;    // cos(max slope)
 
+  // det d(x, y)/d(u, v).
+  static double jacobian(const SurfaceDerivs& d) { return d.du.x * d.dv.y - d.dv.x * d.du.y; }
+
   Vec2 clampUv(Vec2 uv) const {
     return Vec2(std::clamp(uv.x, dom.u0, dom.u1), std::clamp(uv.y, dom.v0, dom.v1));
   }
@@ -95,7 +98,7 @@ struct NurbsGraph {
       r_len = std::hypot(rx, ry);
       if (!std::isfinite(r_len)) return -1;
       if (r_len <= tol) return 1;
-      const double det = d.du.x * d.dv.y - d.dv.x * d.du.y;
+      const double det = jacobian(d);
       if (!std::isfinite(det) || det == 0) return -1;
       const Vec2 next = clampUv(uv + Vec2((-d.dv.y * rx + d.dv.x * ry) / det, (d.du.y * rx - d.du.x * ry) / det));
       if (next == uv) return r_len <= accept ? 1 : 0;  // stalled: at rounding, or pinned at the boundary
@@ -133,18 +136,17 @@ struct NurbsGraph {
     return second == 1;
   }
 
-  // Graph z(x, y) = z of the surface and its derivatives, from the derivatives at the (u, v) over (x, y):
-  // with J = d(x, y)/d(u, v) and a_i = J^-1 e_i, z_i = grad z . a_i and, differentiating F(u(x)) = x twice,
-  // z_ij = Q_z(a_i, a_j) - grad z . J^-1 Q_xy(a_i, a_j), Q(a, b) = P_uu a0 b0 + P_uv (a0 b1 + a1 b0) + P_vv a1 b1.
   // Whether d(x, y)/d(u, v) is singular at d: a collapsed edge or a pole of the parametrisation (the apex
   // of a spherical cap built from arcs, say), where the graph is smooth but graph() would divide by zero.
   static bool singular(const SurfaceDerivs& d) {
-    const double det = d.du.x * d.dv.y - d.dv.x * d.du.y;
-    return !(std::abs(det) > 1e-9 * glm::length(Vec2(d.du)) * glm::length(Vec2(d.dv)));
+    return !(std::abs(jacobian(d)) > 1e-9 * glm::length(Vec2(d.du)) * glm::length(Vec2(d.dv)));
   }
 
+  // Graph z(x, y) = z of the surface and its derivatives, from the derivatives at the (u, v) over (x, y):
+  // with J = d(x, y)/d(u, v) and a_i = J^-1 e_i, z_i = grad z . a_i and, differentiating F(u(x)) = x twice,
+  // z_ij = Q_z(a_i, a_j) - grad z . J^-1 Q_xy(a_i, a_j), Q(a, b) = P_uu a0 b0 + P_uv (a0 b1 + a1 b0) + P_vv a1 b1.
   static SagDerivs graph(const SurfaceDerivs& d) {
-    const double det = d.du.x * d.dv.y - d.dv.x * d.du.y;
+    const double det = jacobian(d);
     const Vec2 a1(d.dv.y / det, -d.du.y / det), a2(-d.dv.x / det, d.du.x / det);
     const Vec2 gz(d.du.z, d.dv.z);
     auto q = [&](Vec2 p, Vec2 r) { return d.duu * (p.x * r.x) + d.duv * (p.x * r.y + p.y * r.x) + d.dvv * (p.y * r.y); };
@@ -199,6 +201,12 @@ class NurbsSag final : public SagSurface {
     return std::make_shared<NurbsSag>(g_, outline(), z_vertex);
   }
 
+  std::string describe() const override {
+    const Vec3 lo = g_->surface->evaluate(g_->dom.u0, g_->dom.v0).p, hi = g_->surface->evaluate(g_->dom.u1, g_->dom.v1).p;
+    return g_->surface->describe() + " from " + g_->what + " (spanning (" + num(lo.x) + ", " + num(lo.y) +
+           ") to (" + num(hi.x) + ", " + num(hi.y) + ") m" + (g_->trim ? ", trimmed)" : ")");
+  }
+
  private:
   // The graph's derivatives at a singular point of the parametrisation, whose z is d.p.z: the mean of the
   // derivatives at the four points h away along x and y, which is the value at the centre to O(h^2)
@@ -226,15 +234,6 @@ class NurbsSag final : public SagSurface {
     return m;
   }
 
- public:
-
-  std::string describe() const override {
-    const Vec3 lo = g_->surface->evaluate(g_->dom.u0, g_->dom.v0).p, hi = g_->surface->evaluate(g_->dom.u1, g_->dom.v1).p;
-    return g_->surface->describe() + " from " + g_->what + " (spanning (" + num(lo.x) + ", " + num(lo.y) +
-           ") to (" + num(hi.x) + ", " + num(hi.y) + ") m" + (g_->trim ? ", trimmed)" : ")");
-  }
-
- private:
   std::shared_ptr<const NurbsGraph> g_;
 };
 

@@ -130,6 +130,11 @@ struct Partial {
     sum += o.sum, hxx += o.hxx, hxy += o.hxy, hxz += o.hxz, hyy += o.hyy, hyz += o.hyz, hzz += o.hzz;
     gx += o.gx, gy += o.gy, gz += o.gz;
   }
+  Matrix3d hessian() const {
+    Matrix3d H;
+    H << hxx, hxy, hxz, hxy, hyy, hyz, hxz, hyz, hzz;
+    return H;
+  }
 };
 
 Partial evaluateRange(const Data& D, const Vector3d& e, double b, bool derivatives, size_t begin, size_t end) {
@@ -194,7 +199,7 @@ Eval evaluate(const Data& D, const Vector3d& e, double b, const Prior& prior, bo
   E.F = 0.5 * P.sum;
   if (prior.active) E.F += 0.5 * prior.k * prior.k * (e - prior.nominal).squaredNorm();
   if (derivatives) {
-    E.H << P.hxx, P.hxy, P.hxz, P.hxy, P.hyy, P.hyz, P.hxz, P.hyz, P.hzz;
+    E.H = P.hessian();
     E.g = Vector3d(P.gx, P.gy, P.gz);
     if (prior.active) {
       E.H.diagonal().array() += prior.k * prior.k;
@@ -573,9 +578,7 @@ ViewpointFit fitViewpoint(const std::vector<ViewpointRay>& rays, const Viewpoint
   fit.rms_line_distance_m = std::sqrt(M.sum_dist2 / double(n));
   fit.rms_angle_rad = std::sqrt(M.sum_ang2 / double(n));
   fit.max_angle_rad = M.max_ang;
-  Matrix3d H;
-  H << M.gn.hxx, M.gn.hxy, M.gn.hxz, M.gn.hxy, M.gn.hyy, M.gn.hyz, M.gn.hxz, M.gn.hyz, M.gn.hzz;
-  fit.condition_number_solution = conditionOf(H);
+  fit.condition_number_solution = conditionOf(M.gn.hessian());
   return fit;
 }
 
