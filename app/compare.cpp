@@ -527,6 +527,7 @@ int cmdVertices(const std::vector<std::string>& argv) {
     gl::RendererOptions ro;
     ro.map_size = scene.render.map_size;
     ro.map_texels_per_pixel = scene.render.map_texels_per_pixel;
+    ro.map_reuse_margin_deg = scene.render.map_reuse_margin_deg;
     for (const PatchView& pv : f.views) {
       const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
       const std::array<int, 2> texels = mapTexels(pv.volume, gl::topLevelMapSide(scene, f, pv, ro));

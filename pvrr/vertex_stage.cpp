@@ -259,28 +259,7 @@ void buildPatchMap(const Scene& scene, const ElementFrame& f, const Element& el,
       pv.volume.note += (pv.volume.note.empty() ? "" : "; ") + std::to_string(rays.size() - zooming) +
                         " hit(s) beyond the viewpoint are not in this reversed map";
   }
-  // Vertices out of view (their triangles are clipped away by the viewer) take no part in the choice of
-  // projective weights.
-  auto counts = [&](uint32_t vi) { return f.in_view.empty() || !pv.in_view || f.in_view[vi]; };
-  pv.q.assign(gp.vertices.size(), 1.0);
-  bool all_in_front = true;
-  for (size_t k = 0; k < gp.vertices.size(); ++k) {
-    const Vec4 clip = pv.volume.projection * pv.volume.view * Vec4(f.world_pos[gp.vertices[k]], 1.0);
-    pv.q[k] = clip.w;
-    if (counts(gp.vertices[k])) all_in_front = all_in_front && clip.w > 0;
-    else if (!(clip.w > 0)) pv.q[k] = 1.0;
-  }
-  if (!all_in_front) pv.q.assign(gp.vertices.size(), 1.0);
-  const size_t channels = f.rays.size();
-  pv.st.assign(channels, std::vector<Vec2>(gp.vertices.size()));
-  for (size_t c = 0; c < channels; ++c)
-    for (size_t k = 0; k < gp.vertices.size(); ++k) {
-      // Finite always: a vertex out of view, or with a flagged ray (TIR: dark, transmittance 0) whose far
-      // point lies behind the map camera, gets the map centre rather than NaN.
-      Vec2 st = projectToTexture(pv.volume, f.rays[c][gp.vertices[k]].hit);
-      if (!(std::isfinite(st.x) && std::isfinite(st.y))) st = Vec2(0.5);
-      pv.st[c][k] = st;
-    }
+  projectPatchMap(f, pv);
 }
 
 // Where the viewer's clip volume cuts the patch's triangles that it sees in part (PatchView::view_edge):
@@ -434,6 +413,32 @@ void fitPatchViews(const Scene& scene, ElementFrame& f, const VertexStageOptions
 }  // namespace pvrr
 
 namespace pvrr {
+
+void projectPatchMap(const ElementFrame& f, PatchView& pv) {
+  const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
+  // Vertices out of view (their triangles are clipped away by the viewer) take no part in the choice of
+  // projective weights.
+  auto counts = [&](uint32_t vi) { return f.in_view.empty() || !pv.in_view || f.in_view[vi]; };
+  pv.q.assign(gp.vertices.size(), 1.0);
+  bool all_in_front = true;
+  for (size_t k = 0; k < gp.vertices.size(); ++k) {
+    const Vec4 clip = pv.volume.projection * pv.volume.view * Vec4(f.world_pos[gp.vertices[k]], 1.0);
+    pv.q[k] = clip.w;
+    if (counts(gp.vertices[k])) all_in_front = all_in_front && clip.w > 0;
+    else if (!(clip.w > 0)) pv.q[k] = 1.0;
+  }
+  if (!all_in_front) pv.q.assign(gp.vertices.size(), 1.0);
+  const size_t channels = f.rays.size();
+  pv.st.assign(channels, std::vector<Vec2>(gp.vertices.size()));
+  for (size_t c = 0; c < channels; ++c)
+    for (size_t k = 0; k < gp.vertices.size(); ++k) {
+      // Finite always: a vertex out of view, or with a flagged ray (TIR: dark, transmittance 0) whose far
+      // point lies behind the map camera, gets the map centre rather than NaN.
+      Vec2 st = projectToTexture(pv.volume, f.rays[c][gp.vertices[k]].hit);
+      if (!(std::isfinite(st.x) && std::isfinite(st.y))) st = Vec2(0.5);
+      pv.st[c][k] = st;
+    }
+}
 
 void moveRigidly(ElementFrame& f, const Mat4& motion) {
   auto point = [&](Vec3& p) { p = Vec3(motion * Vec4(p, 1.0)); };

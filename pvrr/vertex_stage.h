@@ -136,6 +136,11 @@ void traceVertexRays(const RayScene& rays, ElementFrame& f, const Vec3& eye, con
 // texture coordinates. Throws nothing for degenerate input: each fit reports its condition and fallback.
 void fitPatchViews(const Scene& scene, ElementFrame& f, const VertexStageOptions& opt);
 
+// The projective weights (PatchView::q) and texture coordinates (PatchView::st) of the patch's vertices
+// through pv.volume: the hit points projected by that camera. Used after the view volume is replaced (the
+// renderer's map reuse gives a patch the volume of the map it already holds).
+void projectPatchMap(const ElementFrame& f, PatchView& pv);
+
 // Eye-fixed caching (paper section 5): when the element has not moved relative to the eye, its rays in the
 // eye's frame and its fitted viewpoints are unchanged. moveRigidly carries a cached frame along with the
 // eye (motion = new eye pose * inverse of the old one); updateTextureCoordinates then re-intersects the

@@ -315,6 +315,48 @@ int mapSideForPixels(const ViewVolume& vv, double pixels, double texels_per_pixe
   return std::clamp(32 * int(std::ceil(side / 32.0)), std::min(max_side, 128), max_side);
 }
 
+ViewVolume widenViewVolume(const ViewVolume& vv, double margin_rad, double max_fov_rad, double far_factor) {
+  if (vv.backward) return vv;
+  ViewVolume w = vv;
+  const double n = vv.near_m, lim = 0.5 * std::min(max_fov_rad, kPi - 1e-6);
+  auto side = [&](double extent, double turn) {
+    const double a = std::atan(extent / n);
+    // A side already beyond the limit (it cannot be: fitSides clamps) stays where it is.
+    return n * std::tan(turn < 0 ? std::min(a, std::max(a + turn, -lim)) : std::max(a, std::min(a + turn, lim)));
+  };
+  w.left = side(vv.left, -margin_rad);
+  w.right_ = side(vv.right_, margin_rad);
+  w.bottom = side(vv.bottom, -margin_rad);
+  w.top = side(vv.top, margin_rad);
+  w.far_m = vv.far_m * std::max(1.0, far_factor);
+  finish(w);
+  w.hits_outside = 0;  // the hits of vv lie inside its sides, and so inside these
+  return w;
+}
+
+bool frustumContains(const ViewVolume& outer, const ViewVolume& inner) {
+  const Mat4 clip = outer.projection * outer.view;
+  for (int k = 0; k < 8; ++k) {
+    const bool far = k & 4;
+    const double d = far ? inner.far_m : inner.near_m, s = d / inner.near_m;
+    const double x = s * ((k & 1) ? inner.right_ : inner.left), y = s * ((k & 2) ? inner.top : inner.bottom);
+    const Vec3 p = inner.eye + d * inner.forward + x * inner.right + y * inner.up;
+    const Vec4 c = clip * Vec4(p, 1.0);
+    if (!(c.w > 0) || std::abs(c.x) > c.w || std::abs(c.y) > c.w || (far && c.z > c.w)) return false;
+  }
+  return true;
+}
+
+double longerExtentTan(const ViewVolume& vv) {
+  return std::max(vv.right_ - vv.left, vv.top - vv.bottom) / vv.near_m;
+}
+
+double minTexelAngle(const ViewVolume& vv, int longest_side) {
+  const double tx = std::max(std::abs(vv.left), std::abs(vv.right_)) / vv.near_m,
+               ty = std::max(std::abs(vv.bottom), std::abs(vv.top)) / vv.near_m;
+  return longerExtentTan(vv) / std::max(1, longest_side) / (1 + tx * tx + ty * ty);
+}
+
 std::array<double, 16> rowMajor16(const Mat4& m) {
   std::array<double, 16> out{};
   for (int r = 0; r < 4; ++r)

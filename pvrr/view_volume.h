@@ -131,6 +131,26 @@ std::array<int, 2> mapTexels(const ViewVolume& vv, int longest_side);
 // unless capped at max_side (returned as it is). texels_per_pixel <= 0: max_side.
 int mapSideForPixels(const ViewVolume& vv, double pixels, double texels_per_pixel, int max_side);
 
+// Map reuse across frames (renderer, render.map_reuse_margin_deg): a map rendered for a slightly wider view
+// than the frame needs serves the next frames for as long as their views stay inside it.
+//
+// A copy of a forward volume with each of its four sides turned outwards by margin_rad (each side kept
+// within max_fov_rad / 2 of forward) and its far plane times far_factor (>= 1). The near plane, frame and
+// eye are kept. A backward (reversed) volume is returned unchanged: its far plane is what clips the mirror.
+ViewVolume widenViewVolume(const ViewVolume& vv, double margin_rad, double max_fov_rad = radians(150.0),
+                           double far_factor = 1.1);
+// Whether `inner`'s frustum lies inside `outer`'s sides and before its far plane: each of inner's eight
+// corners, projected by outer's camera, lies in front of it with |x|, |y| <= w (and z <= w for the far
+// corners). Outer's near plane is not checked (both lie just beyond the element).
+bool frustumContains(const ViewVolume& outer, const ViewVolume& inner);
+// The longer frustum extent on the near plane over the near distance (a tangent): the map's longer side
+// spans this, so texels per unit of it measure the map's sampling density.
+double longerExtentTan(const ViewVolume& vv);
+// The smallest angle (rad) one texel of a map of vv with `longest_side` texels (square texels, mapTexels)
+// subtends as seen from its eye: at the frustum corner farthest from forward, where a tangent step spans
+// the least angle (d angle = d tan * cos^2).
+double minTexelAngle(const ViewVolume& vv, int longest_side);
+
 // m as 16 doubles, row-major (out[4 * row + col]), e.g. for printing or row-major APIs; glm is column-major.
 std::array<double, 16> rowMajor16(const Mat4& m);
 

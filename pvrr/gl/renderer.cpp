@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <map>
 
@@ -219,6 +220,13 @@ struct PassCamera {
 
 // Whether any part of the convex hull of `points` can be inside the view volume: false only when every
 // point lies outside one and the same clip plane (homogeneous outcodes; exact for a convex hull).
+// x with `digits` significant digits, for notes.
+std::string num(double x, int digits) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, x);
+  return buf;
+}
+
 bool mayBeInVolume(const std::vector<Vec3>& points, const Mat4& m) {
   unsigned all = 0x3f;
   for (const Vec3& p : points) {
@@ -297,6 +305,7 @@ struct Renderer::Impl {
   std::vector<Texture> textures;  // environment textures, in Scene::textures order
   std::unique_ptr<Framebuffer> frame_target;      // the second pass: colour, seen point, surface point
   std::vector<std::unique_ptr<Framebuffer>> maps;  // first-pass maps, one per patch view (reused)
+  uint64_t first_pass_serial = 0;  // counts the first passes rendered (FrameCache::maps_serial)
   std::vector<int> map_side;  // per map slot: the longer side its last first pass rendered (MapPass::side)
   std::vector<std::unique_ptr<CubeTarget>> cubes;  // envmap cubes, one per element
   std::vector<MeshBuffers> element_meshes;     // per (element, patch) in pvrr mode; per element otherwise
@@ -560,6 +569,112 @@ struct Renderer::Impl {
     return o;
   }
 
+  // Whether the top-level patch view v of f needs its map: the observer sees the patch and the element is
+  // not dark at the depth limit.
+  bool topLevelVisible(const ElementFrame& f, size_t v) const {
+    const Observer& ob = scene.observer;
+    return f.views[v].in_view && mayBeInVolume(f.world_pos, ob.visibilityProjection() * ob.view()) && !beyondDepth(f);
+  }
+
+  // Map reuse (RendererOptions::map_reuse_margin_deg). Whether the top-level maps of the last first pass
+  // (cache.maps) serve this frame's views: the same slots; every view the observer sees was rendered, lies
+  // inside its map's frustum (frustumContains), needs at most 15 % more texel density than the map has
+  // (and at least half), its viewpoint moved by under a quarter of the map's smallest texel angle as seen
+  // from its nearest hit point (parallax), and no other element reaches into the map's volume (nothing to
+  // nest; an element is never drawn in its own maps). If so each seen view takes its map's volume and its
+  // texture coordinates are projected through it; `note` says by what margin. Otherwise `note` says why not.
+  bool reuseMaps(std::vector<ElementFrame>& frames, const FrameCache& cache, std::string* note) const {
+    size_t slots = 0;
+    for (const ElementFrame& f : frames) slots += f.views.size();
+    if (cache.maps.empty() || cache.maps_owner != this || cache.maps_serial != first_pass_serial) {
+      *note = "no reusable maps (the last first pass was not widened, or had nested passes)";
+      return false;
+    }
+    if (cache.maps.size() != slots) {
+      *note = "the patches changed";
+      return false;
+    }
+    double worst_parallax = 0, worst_move = 0;
+    size_t slot = 0;
+    for (const ElementFrame& f : frames)
+      for (size_t v = 0; v < f.views.size(); ++v, ++slot) {
+        const FrameCache::Map& m = cache.maps[slot];
+        if (m.element != f.element || m.view != v) {
+          *note = "the patches changed";
+          return false;
+        }
+        if (!topLevelVisible(f, v)) continue;
+        const PatchView& pv = f.views[v];
+        const ViewVolume &W = m.volume, &V = pv.volume;
+        if (!m.rendered || V.backward || W.backward) {
+          *note = !m.rendered ? "a patch came into view" : "a reversed (zooming) map is not reused";
+          return false;
+        }
+        if (!frustumContains(W, V)) {
+          *note = "a view left its map's margin";
+          return false;
+        }
+        const double need = topLevelMapSide(scene, f, pv, options) / longerExtentTan(V),
+                     have = m.side / longerExtentTan(W);
+        if (have < need / 1.15 || have > 2 * need) {
+          *note = "the texel density needed changed";
+          return false;
+        }
+        double nearest = kInf;
+        const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
+        for (const auto& channel : f.rays)
+          for (uint32_t vi : gp.vertices)
+            if ((f.in_view.empty() || f.in_view[vi]) && channel[vi].status == VertexStatus::Hit)
+              nearest = std::min(nearest, glm::length(channel[vi].hit - V.eye));
+        const double move = glm::length(V.eye - W.eye), parallax = move / nearest / minTexelAngle(W, m.side);
+        if (!(parallax <= 0.25)) {
+          *note = "the viewpoint moved too far (parallax " + num(parallax, 2) + " texel)";
+          return false;
+        }
+        const Mat4 map_clip = W.projection * W.view;
+        for (const ElementFrame& b : frames)
+          if (b.element != f.element && mayBeInVolume(b.world_pos, map_clip)) {
+            *note = "an element reaches into a map's volume";
+            return false;
+          }
+        worst_parallax = std::max(worst_parallax, parallax);
+        worst_move = std::max(worst_move, move);
+      }
+    slot = 0;
+    for (ElementFrame& f : frames)
+      for (size_t v = 0; v < f.views.size(); ++v, ++slot)
+        if (topLevelVisible(f, v)) {
+          f.views[v].volume = cache.maps[slot].volume;
+          projectPatchMap(f, f.views[v]);
+        }
+    *note = "map reuse: every view lies inside the maps drawn " + std::to_string(cache.maps_age + 1) +
+            " frame(s) ago with a " + num(options.map_reuse_margin_deg, 3) + " deg margin; viewpoints moved <= " +
+            num(1e3 * worst_move, 3) + " mm (parallax <= " + num(worst_parallax, 3) + " texel)";
+    return true;
+  }
+
+  // Widens every top-level forward view by the reuse margin (widenViewVolume) at the texel density it needs
+  // (its side scaled by the wider extent) in a texture 25 % larger than patchMapSize, and projects its
+  // texture coordinates through the wider volume. Returns each slot's texture size and side.
+  std::vector<std::array<int, 2>> widenMaps(std::vector<ElementFrame>& frames) const {
+    std::vector<std::array<int, 2>> out;
+    for (ElementFrame& f : frames)
+      for (PatchView& pv : f.views) {
+        const int base = patchMapSize(options.map_size, std::max<size_t>(1, inView(f)));
+        const int size = 32 * int(std::ceil(1.25 * base / 32.0)), side = topLevelMapSide(scene, f, pv, options);
+        if (pv.volume.backward) {
+          out.push_back({size, side});
+          continue;
+        }
+        const ViewVolume narrow = pv.volume;
+        pv.volume = widenViewVolume(narrow, radians(options.map_reuse_margin_deg));
+        const double wider = longerExtentTan(pv.volume) / longerExtentTan(narrow);
+        out.push_back({size, std::min(size, 32 * int(std::ceil(side * wider / 32.0)))});
+        projectPatchMap(f, pv);
+      }
+    return out;
+  }
+
   MeshBuffers& meshSlot() {
     if (element_meshes.size() <= next_mesh) element_meshes.resize(next_mesh + 1);
     return element_meshes[next_mesh++];
@@ -615,25 +730,26 @@ struct Renderer::Impl {
   // viewpoint with its own maps appended to the list, down to the scene's depth limit. Children always
   // follow their parent, so rendering the list backwards renders every map before the pass that reads it.
   // Returns the number of nested passes; `dark` counts elements drawn dark at the depth limit or budget.
+  // `top_size_side`: the texture size and rendered side of each top-level slot (widened maps); default
+  // patchMapSize and topLevelMapSide.
   size_t planPasses(const std::vector<ElementFrame>& frames, const std::vector<VertexStageOptions>& opts,
-                    size_t* dark, bool* budget_hit) {
+                    size_t* dark, bool* budget_hit, const std::vector<std::array<int, 2>>* top_size_side = nullptr) {
     passes.clear();
     nested_frames.clear();
     *dark = 0;
     *budget_hit = false;
     size_t slot = 0;
     for (const ElementFrame& f : frames)
-      for (size_t v = 0; v < f.views.size(); ++v)
-        passes.push_back({&f, v, interfaces(scene.elements[size_t(f.element)]), slot++,
-                          patchMapSize(options.map_size, std::max<size_t>(1, inView(f))),
-                          topLevelMapSide(scene, f, f.views[v], options), true, {}});
+      for (size_t v = 0; v < f.views.size(); ++v) {
+        const bool given = top_size_side && slot < top_size_side->size();
+        passes.push_back({&f, v, interfaces(scene.elements[size_t(f.element)]), slot,
+                          given ? (*top_size_side)[slot][0] : patchMapSize(options.map_size, std::max<size_t>(1, inView(f))),
+                          given ? (*top_size_side)[slot][1] : topLevelMapSide(scene, f, f.views[v], options), true, {}});
+        ++slot;
+      }
     const size_t top = passes.size();
     // A top-level element outside the observer's view needs no map (its second-pass triangles are clipped).
-    const Observer& ob = scene.observer;
-    const Mat4 eye_clip = ob.visibilityProjection() * ob.view();
-    for (MapPass& mp : passes)
-      mp.visible = mp.owner->views[mp.view].in_view && mayBeInVolume(mp.owner->world_pos, eye_clip) &&
-                   !beyondDepth(*mp.owner);
+    for (MapPass& mp : passes) mp.visible = topLevelVisible(*mp.owner, mp.view);
     const int max_depth = scene.render.max_depth;
     for (size_t i = 0; i < passes.size(); ++i) {
       if (!passes[i].visible) continue;
@@ -854,6 +970,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   std::vector<ElementFrame> frames;
   std::vector<VertexStageOptions> opts;
   bool skip_first_pass = false;
+  bool continuing = false;  // a cache that holds an earlier frame: maps are widened for reuse
   if (mode == RasterMode::Pvrr && n_el > 0) {
     frames.resize(n_el);
     // Each element's views are fitted to what the observer sees of it.
@@ -932,13 +1049,13 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       out.stages.skipped("colour-channels", has_lens ? "dispersion off: one colour pass" : "no lens: one colour pass");
     }
     skip_first_pass = nothing_moved;
+    continuing = cache && cache->valid;
     if (cache) {
       cache->element_to_eye.resize(n_el);
       for (size_t e = 0; e < n_el; ++e) cache->element_to_eye[e] = view * scene.elements[e].local_to_world;
       cache->view = view;
       cache->projection = observer_projection;
-      cache->elements = frames;
-      cache->valid = true;
+      cache->valid = true;  // cache->elements: below, with the volumes the maps are drawn with
     }
   } else {
     const std::string why = n_el == 0 ? "no mirror or lens in the scene"
@@ -960,14 +1077,25 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       slot += frames[e].views.size();
     }
   }
+  // Map reuse (RendererOptions::map_reuse_margin_deg): a frame that follows another draws from the maps of
+  // an earlier one while its views stay inside them; otherwise its maps are drawn widened by the margin.
+  const bool reuse_on = mode == RasterMode::Pvrr && !frames.empty() && options.map_reuse_margin_deg > 0 && continuing;
+  std::string reuse_note;
+  if (reuse_on && !skip_first_pass && !cache->environment_changed && reuseMaps(frames, *cache, &reuse_note)) {
+    skip_first_pass = true;
+    ++cache->maps_age;
+  }
   if (mode == RasterMode::Pvrr && !frames.empty() && skip_first_pass) {
-    const std::string why = "eye-fixed cache: neither the elements nor the environment moved relative to the eye";
+    const std::string why = !reuse_note.empty() ? reuse_note
+                                                : "eye-fixed cache: neither the elements nor the environment moved relative to the eye";
     out.stages.skipped("first-pass", why);
     out.stages.skipped("nested-passes", why);
   } else if (mode == RasterMode::Pvrr && !frames.empty()) {
     size_t dark = 0;
     bool budget_hit = false;
-    const size_t nested = planPasses(frames, opts, &dark, &budget_hit);
+    std::vector<std::array<int, 2>> widened;  // per top-level slot: texture size, rendered side
+    if (reuse_on) widened = widenMaps(frames);
+    const size_t nested = planPasses(frames, opts, &dark, &budget_hit, reuse_on ? &widened : nullptr);
     const double plan_ms = msSince(t0);
     int deepest = 0, rendered = 0;
     for (const MapPass& mp : passes) {
@@ -977,6 +1105,19 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     const auto t1 = Clock::now();
     renderPasses(frames);
     glFinish();
+    ++first_pass_serial;
+    if (cache) {
+      cache->maps.clear();
+      if (reuse_on && nested == 0 && dark == 0) {
+        for (size_t i = 0; i < widened.size(); ++i) {
+          const MapPass& mp = passes[i];
+          cache->maps.push_back({mp.owner->element, mp.view, mp.owner->views[mp.view].volume, mp.side, mp.visible});
+        }
+        cache->maps_owner = this;
+        cache->maps_serial = first_pass_serial;
+        cache->maps_age = 0;
+      }
+    }
     // The note: how many maps of which size (and which are R, G, B planes), and what was not rendered.
     std::map<std::array<int, 3>, int, std::greater<std::array<int, 3>>> sizes;
     for (const MapPass& mp : passes)
@@ -988,6 +1129,9 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     for (const auto& [texels, n] : sizes)
       note += (note.empty() ? "" : ", ") + std::to_string(n) + " x " + std::to_string(texels[0]) + "x" +
               std::to_string(texels[1]) + (texels[2] ? " RGB planes" : "");
+    if (reuse_on)
+      note += "; widened " + num(options.map_reuse_margin_deg, 3) + " deg for reuse (" +
+              (reuse_note.empty() ? std::string("the environment changed") : reuse_note) + ")";
     if (rendered != int(passes.size()))
       note += (note.empty() ? "" : "; ") + std::to_string(passes.size() - size_t(rendered)) +
               " map(s) of elements outside the observer's view or beyond the depth limit not rendered";
@@ -1029,6 +1173,8 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     out.stages.skipped("first-pass", n_el == 0 ? "no mirror or lens in the scene" : "mode raster");
     out.stages.skipped("nested-passes", n_el == 0 ? "no mirror or lens in the scene" : "mode raster");
   }
+
+  if (cache && mode == RasterMode::Pvrr && n_el > 0) cache->elements = frames;  // with the volumes of the maps
 
   // --- second pass ---
   t0 = Clock::now();

@@ -53,6 +53,12 @@ struct RendererOptions {
   // mode: -1 the fit channel (the middle one with dispersion, else the only one); c >= 0 channel c (clamped
   // to the last channel), e.g. 0 and 2 give red's and blue's seen points on a dispersive lens.
   int seen_channel = -1;
+  // Map reuse across frames (Scene render.map_reuse_margin_deg), with a FrameCache only: once a frame
+  // follows another, each top-level map is rendered this much wider on each side (at the same texel
+  // density), and later frames whose views still lie inside it, from a viewpoint that moved by under a
+  // quarter texel of parallax, draw from it without a first pass (stage "first-pass" says why, or why not).
+  // 0: every frame that moved renders its maps.
+  double map_reuse_margin_deg = 2;
 };
 
 // Reuse across frames (paper section 5, eye-fixed caching): when an element has not moved relative to the
@@ -65,6 +71,20 @@ struct FrameCache {
   Mat4 projection{1.0};              // and its projection: what it sees of each element (ElementFrame::in_view)
   std::vector<ElementFrame> elements;
   bool environment_changed = true;
+  // Map reuse (RendererOptions::map_reuse_margin_deg): the top-level maps the renderer last rendered, in map
+  // slot order, with the (widened) volume and the longer side each was rendered with. Empty when that
+  // first pass cannot be reused (it had nested passes or elements drawn dark, or was not widened).
+  struct Map {
+    int element = -1;
+    size_t view = 0;
+    ViewVolume volume;
+    int side = 0;
+    bool rendered = false;  // false: the patch was out of view, its map not drawn
+  };
+  std::vector<Map> maps;
+  const void* maps_owner = nullptr;  // the renderer that holds them
+  uint64_t maps_serial = 0;          // and its first pass that drew them
+  int maps_age = 0;                  // frames drawn from them since
 };
 
 // The map size (longer side, texels) of each of an element's top-level patches when `patches_in_view` of them

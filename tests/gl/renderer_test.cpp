@@ -234,6 +234,134 @@ TEST_P(RendererTest, EyeFixedCacheMatchesAFreshFrame) {
   EXPECT_LE(cached_err, 1.1 * fresh_err + 0.02) << "cached " << cached_err << "', fresh " << fresh_err << "'";
 }
 
+// Mean absolute colour difference (linear, averaged over RGB) between two images over the pixels where
+// `ref` sees an element.
+double meanColourDifference(const TracedFrame& ref, const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+  double sum = 0;
+  size_t n = 0;
+  for (size_t i = 0; i < ref.element.size(); ++i)
+    if (ref.element[i] >= 0) {
+      const Vec3 d = glm::abs(a[i] - b[i]);
+      sum += (d.x + d.y + d.z) / 3;
+      ++n;
+    }
+  return n ? sum / double(n) : 1e9;
+}
+
+// The first pass's stage record of a frame: whether it ran, and its note or reason.
+std::string firstPass(const gl::RasterFrame& f, bool* ran) {
+  const StageTiming* t = f.stages.find("first-pass");
+  *ran = t && t->ran;
+  return t ? t->note + t->reason : "";
+}
+
+// Map reuse (render.map_reuse_margin_deg): while the head turns with the spectacles attached, a frame that
+// follows another renders its maps 2 deg wider; the next frames whose views stay inside them draw without a
+// first pass, as accurate against the reference as a fresh frame and within a small colour difference of
+// it. A turn past the margin, a changed environment, and margin 0 render the maps again.
+TEST_P(RendererTest, MapReuseWithinTheMarginMatchesAFreshFrame) {
+  auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  SceneDesc desc = loadScene(PVRR_SOURCE_DIR "/models/spectacle-lens.json", {"observer.image_size=[320,240]"});
+  Scene s = buildScene(desc);
+  RayScene rays(s);
+  gl::FrameCache cache;
+  const Vec3 e = s.observer.eye, target0 = s.observer.target;
+  auto turnTo = [&](double deg) {
+    s.observer.target = e + Vec3(glm::rotate(Mat4(1.0), radians(deg), Vec3(0, 1, 0)) * Vec4(target0 - e, 0.0));
+    updateAttachedElements(s, desc);
+    rays.updateElementPoses();
+    cache.environment_changed = false;
+  };
+  gl::Renderer cached(s, rays, gl::RendererOptions{});
+  bool ran = false;
+  cached.render(gl::RasterMode::Pvrr, &cache);
+  cache.environment_changed = false;
+  EXPECT_NE(firstPass(cached.render(gl::RasterMode::Pvrr, &cache), &ran).find("eye-fixed cache"), std::string::npos);
+  EXPECT_FALSE(ran) << "nothing moved: the first frame's maps stay";
+  turnTo(0.5);
+  std::string note = firstPass(cached.render(gl::RasterMode::Pvrr, &cache), &ran);
+  EXPECT_TRUE(ran);
+  EXPECT_NE(note.find("widened 2 deg"), std::string::npos) << note;
+  turnTo(2.0);  // 1.5 deg on: inside the margin
+  const gl::RasterFrame reused = cached.render(gl::RasterMode::Pvrr, &cache);
+  note = firstPass(reused, &ran);
+  EXPECT_FALSE(ran);
+  EXPECT_NE(note.find("map reuse"), std::string::npos) << note;
+  for (const char* stage : {"vertex-rays", "viewpoint-fit"}) EXPECT_FALSE(reused.stages.find(stage)->ran) << stage;
+  gl::Renderer fresh_renderer(s, rays, gl::RendererOptions{});
+  const gl::RasterFrame fresh = fresh_renderer.render(gl::RasterMode::Pvrr);
+  const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
+  const double reused_err = medianArcmin(ref, reused), fresh_err = medianArcmin(ref, fresh);
+  EXPECT_LE(reused_err, 1.0);
+  EXPECT_LE(reused_err, 1.1 * fresh_err + 0.02) << "reused " << reused_err << "', fresh " << fresh_err << "'";
+  // Colour against the reference: the reused map samples the scene on another texel grid than a fresh one
+  // would (like a fresh map of another size), so its error may differ slightly either way, not grow.
+  const double reused_colour = meanColourDifference(ref, reused.color, ref.color),
+               fresh_colour = meanColourDifference(ref, fresh.color, ref.color);
+  std::printf("map reuse: median %.4f' (fresh %.4f'); mean colour error %.5f (fresh %.5f), between them %.5f\n",
+              reused_err, fresh_err, reused_colour, fresh_colour, meanColourDifference(ref, reused.color, fresh.color));
+  EXPECT_LE(reused_colour, 1.15 * fresh_colour);  // measured 1.05x at 320 x 240
+  turnTo(3.0);  // 2.5 deg from the maps' view: past the margin
+  note = firstPass(cached.render(gl::RasterMode::Pvrr, &cache), &ran);
+  EXPECT_TRUE(ran);
+  EXPECT_NE(note.find("left its map's margin"), std::string::npos) << note;
+  turnTo(3.1);
+  note = firstPass(cached.render(gl::RasterMode::Pvrr, &cache), &ran);
+  EXPECT_FALSE(ran) << note;
+  turnTo(3.2);
+  cache.environment_changed = true;
+  note = firstPass(cached.render(gl::RasterMode::Pvrr, &cache), &ran);
+  EXPECT_TRUE(ran);
+  EXPECT_NE(note.find("the environment changed"), std::string::npos) << note;
+  // Margin 0: every frame that moved renders its maps, unwidened.
+  gl::RendererOptions off;
+  off.map_reuse_margin_deg = 0;
+  gl::Renderer plain(s, rays, off);
+  gl::FrameCache plain_cache;
+  plain.render(gl::RasterMode::Pvrr, &plain_cache);
+  for (const double deg : {3.3, 3.4}) {
+    turnTo(deg);
+    plain_cache.environment_changed = false;
+    note = firstPass(plain.render(gl::RasterMode::Pvrr, &plain_cache), &ran);
+    EXPECT_TRUE(ran);
+    EXPECT_EQ(note.find("widened"), std::string::npos) << note;
+  }
+}
+
+// Map reuse for a mirror that does not move with the head: turning about the eye leaves the car mirror's
+// viewpoint where it was, so its maps are reused (after the vertex stages rerun); moving the eye by 1 cm
+// moves the viewpoint by about as much, a parallax of many texels over the street, and the maps are drawn
+// again.
+TEST_P(RendererTest, MapReuseFollowsTheViewpoint) {
+  auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/car-mirror.json", {"observer.image_size=[160,120]"}));
+  RayScene rays(s);
+  gl::Renderer r(s, rays, gl::RendererOptions{});
+  gl::FrameCache cache;
+  const Vec3 e = s.observer.eye, target0 = s.observer.target;
+  auto pose = [&](double deg, const Vec3& eye) {
+    s.observer.eye = eye;
+    s.observer.target = eye + Vec3(glm::rotate(Mat4(1.0), radians(deg), Vec3(0, 1, 0)) * Vec4(target0 - e, 0.0));
+    cache.environment_changed = false;
+    bool ran = false;
+    const gl::RasterFrame f = r.render(gl::RasterMode::Pvrr, &cache);
+    const std::string note = firstPass(f, &ran);
+    EXPECT_TRUE(f.stages.find("vertex-rays")->ran);
+    return std::make_pair(ran, note);
+  };
+  pose(0.0, e);
+  EXPECT_TRUE(pose(0.3, e).first);  // widened
+  const auto turned = pose(0.6, e);
+  EXPECT_FALSE(turned.first) << turned.second;
+  EXPECT_NE(turned.second.find("parallax <= 0 texel"), std::string::npos) << turned.second;
+  const Vec3 side = glm::normalize(glm::cross(target0 - e, Vec3(0, 1, 0)));
+  const auto moved = pose(0.6, e + 0.01 * side);
+  EXPECT_TRUE(moved.first);
+  EXPECT_NE(moved.second.find("the viewpoint moved too far"), std::string::npos) << moved.second;
+}
+
 // The spectacle lens (issue 6): median angular error over lens pixels <= 1 arcmin at the default
 // tessellation; the reading lens with RGB dispersion renders three channels from one shared first pass.
 TEST_P(RendererTest, LensAccuracyAndDispersion) {

@@ -350,6 +350,7 @@ TEST(SceneJson, DefaultsAreFilledIn) {
   EXPECT_EQ(s.render.mode, RenderDesc::Mode::Pvrr);
   EXPECT_EQ(s.render.map_size, 1024);
   EXPECT_EQ(s.render.map_texels_per_pixel, 4.0);
+  EXPECT_EQ(s.render.map_reuse_margin_deg, 2.0);
   EXPECT_EQ(s.render.max_depth, 4);
   EXPECT_EQ(s.render.output, "out/test.png");
   EXPECT_TRUE(s.elements[1].attached_to_observer);
@@ -559,6 +560,8 @@ TEST(SceneJson, OverridesAreValidatedLikeTheFile) {
   expectContains(errorOf(kBase, {"observer.target=[0,1.2,0]"}), "observer.target: expected a point different");
   EXPECT_EQ(parse(kBase, {"render.map_texels_per_pixel=0"}).render.map_texels_per_pixel, 0.0);
   expectContains(errorOf(kBase, {"render.map_texels_per_pixel=-1"}), "render.map_texels_per_pixel: expected a number in [0, 10000]");
+  EXPECT_EQ(parse(kBase, {"render.map_reuse_margin_deg=0"}).render.map_reuse_margin_deg, 0.0);
+  expectContains(errorOf(kBase, {"render.map_reuse_margin_deg=11"}), "render.map_reuse_margin_deg: expected a number in [0, 10]");
 }
 
 TEST(SceneJson, OverrideOfAnUnknownPathFailsNamingIt) {

@@ -223,6 +223,64 @@ TEST(ViewVolume, MapSideForPixels) {
   EXPECT_GE(double(t[0]) * t[1], 40000);
 }
 
+// Map reuse: a widened volume turns each side out by the margin (angles from forward), keeps eye, frame and
+// near, pushes far out, and contains the view turned by less than the margin about the eye, not by more.
+TEST(ViewVolume, WidenedVolumeContainsTheViewTurnedByLessThanTheMargin) {
+  ViewVolumeOptions opt;
+  opt.margin = 0;
+  const ViewVolume v = buildViewVolume(Vec3(0), fan({-30, 0, 30}, {-10, 10}), opt);
+  const ViewVolume w = widenViewVolume(v, radians(2.0));
+  EXPECT_NEAR(degrees(std::atan(w.left / w.near_m)), -32.0, 1e-9);
+  EXPECT_NEAR(degrees(std::atan(w.right_ / w.near_m)), 32.0, 1e-9);
+  EXPECT_NEAR(degrees(std::atan(w.bottom / w.near_m)), -12.0, 1e-9);
+  EXPECT_NEAR(degrees(std::atan(w.top / w.near_m)), 12.0, 1e-9);
+  EXPECT_NEAR(w.fov_x_rad, radians(64.0), 1e-12);
+  EXPECT_EQ(w.near_m, v.near_m);
+  EXPECT_NEAR(w.far_m, 1.1 * v.far_m, kRounding);
+  EXPECT_EQ(w.eye, v.eye);
+  EXPECT_EQ(w.forward, v.forward);
+  EXPECT_TRUE(frustumContains(w, v));
+  EXPECT_FALSE(frustumContains(v, w));
+  EXPECT_TRUE(frustumContains(v, v));
+  // The same view turned about the vertical through the eye: its right side lies at 30 + angle deg.
+  auto turned = [&](double deg) {
+    std::vector<ViewpointRay> rays = fan({-30, 0, 30}, {-10, 10});
+    const Mat4 r = glm::rotate(Mat4(1.0), radians(deg), Vec3(0, 1, 0));
+    for (ViewpointRay& ray : rays) {
+      ray.origin = Vec3(r * Vec4(ray.origin, 1.0));
+      ray.direction = Vec3(r * Vec4(ray.direction, 0.0));
+      ray.hit = Vec3(r * Vec4(ray.hit, 1.0));
+    }
+    return buildViewVolume(Vec3(0), rays, opt);
+  };
+  EXPECT_TRUE(frustumContains(w, turned(1.9)));
+  EXPECT_TRUE(frustumContains(w, turned(-1.9)));
+  EXPECT_FALSE(frustumContains(w, turned(2.1)));
+  EXPECT_FALSE(frustumContains(w, turned(-2.1)));
+  // A side at the field-of-view limit stays there.
+  const ViewVolume limited = widenViewVolume(v, radians(2.0), radians(62.0));
+  EXPECT_NEAR(degrees(std::atan(limited.right_ / limited.near_m)), 31.0, 1e-9);
+  EXPECT_NEAR(degrees(std::atan(limited.top / limited.near_m)), 12.0, 1e-9);
+  // A reversed volume is not widened (its far plane clips the mirror).
+  ViewVolume backward = v;
+  backward.backward = true;
+  EXPECT_EQ(widenViewVolume(backward, radians(2.0)).right_, v.right_);
+}
+
+// Texel angles: a 90 x 90 deg frustum of 100 x 100 texels has texels of 0.02 in tangent; at its corner
+// (tan^2 = 2 from the axis) one spans 0.02 / 3 rad.
+TEST(ViewVolume, MinTexelAngleAtTheFrustumCorner) {
+  ViewVolumeOptions opt;
+  opt.margin = 0;
+  const ViewVolume v = buildViewVolume(Vec3(0), fan({-45, 45}, {-45, 45}), opt);
+  EXPECT_NEAR(longerExtentTan(v), 2.0, 1e-9);
+  EXPECT_NEAR(minTexelAngle(v, 100), 0.02 / 3, 1e-9);
+  const ViewVolume wide = buildViewVolume(Vec3(0), fan({-30, 0, 30}, {-10, 10}), opt);
+  const double t30 = std::tan(radians(30.0)), t10 = std::tan(radians(10.0));
+  EXPECT_NEAR(longerExtentTan(wide), 2 * t30, 1e-9);
+  EXPECT_NEAR(minTexelAngle(wide, 1000), 2 * t30 / 1000 / (1 + t30 * t30 + t10 * t10), 1e-12);
+}
+
 TEST(ViewVolume, UpHintIsHonoured) {
   const Vec3 eye(0.25, 0.1, 1.0);
   const auto rays = sphereMirror(eye, 1.2, true, 0.1, 7, 1.0, 25.0);
