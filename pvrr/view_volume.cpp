@@ -329,8 +329,7 @@ ViewVolume widenViewVolume(const ViewVolume& vv, double margin_rad, double max_f
   w.bottom = side(vv.bottom, -margin_rad);
   w.top = side(vv.top, margin_rad);
   w.far_m = vv.far_m * std::max(1.0, far_factor);
-  finish(w);
-  w.hits_outside = 0;  // the hits of vv lie inside its sides, and so inside these
+  finish(w);  // hits_outside: vv's count, an upper bound (a side clamped at the limit stays there)
   return w;
 }
 

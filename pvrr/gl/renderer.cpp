@@ -4,6 +4,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -218,8 +219,12 @@ struct PassCamera {
   bool planes = false;   // the target is a lens map in R, G and B planes (shaders/outputs.glsl PLANES)
 };
 
-// Whether any part of the convex hull of `points` can be inside the view volume: false only when every
-// point lies outside one and the same clip plane (homogeneous outcodes; exact for a convex hull).
+// A serial number for every first pass rendered in the process (FrameCache::maps_serial).
+uint64_t nextFirstPassSerial() {
+  static std::atomic<uint64_t> serial{0};
+  return ++serial;
+}
+
 // x with `digits` significant digits, for notes.
 std::string num(double x, int digits) {
   char buf[40];
@@ -227,6 +232,8 @@ std::string num(double x, int digits) {
   return buf;
 }
 
+// Whether any part of the convex hull of `points` can be inside the view volume: false only when every
+// point lies outside one and the same clip plane (homogeneous outcodes; exact for a convex hull).
 bool mayBeInVolume(const std::vector<Vec3>& points, const Mat4& m) {
   unsigned all = 0x3f;
   for (const Vec3& p : points) {
@@ -305,7 +312,9 @@ struct Renderer::Impl {
   std::vector<Texture> textures;  // environment textures, in Scene::textures order
   std::unique_ptr<Framebuffer> frame_target;      // the second pass: colour, seen point, surface point
   std::vector<std::unique_ptr<Framebuffer>> maps;  // first-pass maps, one per patch view (reused)
-  uint64_t first_pass_serial = 0;  // counts the first passes rendered (FrameCache::maps_serial)
+  // The serial of the first pass whose maps this renderer holds (FrameCache::maps_serial): unique in the
+  // process (nextFirstPassSerial), so a cache filled by another renderer never matches.
+  uint64_t first_pass_serial = 0;
   std::vector<int> map_side;  // per map slot: the longer side its last first pass rendered (MapPass::side)
   std::vector<std::unique_ptr<CubeTarget>> cubes;  // envmap cubes, one per element
   std::vector<MeshBuffers> element_meshes;     // per (element, patch) in pvrr mode; per element otherwise
@@ -586,8 +595,10 @@ struct Renderer::Impl {
   bool reuseMaps(std::vector<ElementFrame>& frames, const FrameCache& cache, std::string* note) const {
     size_t slots = 0;
     for (const ElementFrame& f : frames) slots += f.views.size();
-    if (cache.maps.empty() || cache.maps_owner != this || cache.maps_serial != first_pass_serial) {
-      *note = "no reusable maps (the last first pass was not widened, or had nested passes)";
+    if (cache.maps.empty() || cache.maps_serial != first_pass_serial) {
+      *note = cache.maps_serial != first_pass_serial && !cache.maps.empty()
+                  ? "this renderer drew other maps since"
+                  : "no reusable maps (the last first pass was not widened: a first frame, or nested passes)";
       return false;
     }
     if (cache.maps.size() != slots) {
@@ -610,6 +621,11 @@ struct Renderer::Impl {
           *note = !m.rendered ? "a patch came into view" : "a reversed (zooming) map is not reused";
           return false;
         }
+        const bool planes = slot < maps.size() && maps[slot] && maps[slot]->colorFormat(0) == ColorFormat::R32F;
+        if (planes != rgbLens(scene.elements[size_t(f.element)], f)) {
+          *note = "the colour channels changed";
+          return false;
+        }
         if (!frustumContains(W, V)) {
           *note = "a view left its map's margin";
           return false;
@@ -626,6 +642,10 @@ struct Renderer::Impl {
           for (uint32_t vi : gp.vertices)
             if ((f.in_view.empty() || f.in_view[vi]) && channel[vi].status == VertexStatus::Hit)
               nearest = std::min(nearest, glm::length(channel[vi].hit - V.eye));
+        if (!std::isfinite(nearest)) {  // every ray escaped or was flagged: nothing bounds the parallax
+          *note = "no hit point bounds the parallax";
+          return false;
+        }
         const double move = glm::length(V.eye - W.eye), parallax = move / nearest / minTexelAngle(W, m.side);
         if (!(parallax <= 0.25)) {
           *note = "the viewpoint moved too far (parallax " + num(parallax, 2) + " texel)";
@@ -648,14 +668,17 @@ struct Renderer::Impl {
           projectPatchMap(f, f.views[v]);
         }
     *note = "map reuse: every view lies inside the maps drawn " + std::to_string(cache.maps_age + 1) +
-            " frame(s) ago with a " + num(options.map_reuse_margin_deg, 3) + " deg margin; viewpoints moved <= " +
+            " frame(s) ago with margins of up to " + num(options.map_reuse_margin_deg, 3) + " deg; viewpoints moved <= " +
             num(1e3 * worst_move, 3) + " mm (parallax <= " + num(worst_parallax, 3) + " texel)";
     return true;
   }
 
   // Widens every top-level forward view by the reuse margin (widenViewVolume) at the texel density it needs
   // (its side scaled by the wider extent) in a texture 25 % larger than patchMapSize, and projects its
-  // texture coordinates through the wider volume. Returns each slot's texture size and side.
+  // texture coordinates through the wider volume. A narrow view gets a smaller margin, so that its longer
+  // extent grows by at most kMaxWidening and its density is kept within that texture. Returns each slot's
+  // texture size and side.
+  static constexpr double kMaxWidening = 1.2;
   std::vector<std::array<int, 2>> widenMaps(std::vector<ElementFrame>& frames) const {
     std::vector<std::array<int, 2>> out;
     for (ElementFrame& f : frames)
@@ -667,8 +690,14 @@ struct Renderer::Impl {
           continue;
         }
         const ViewVolume narrow = pv.volume;
-        pv.volume = widenViewVolume(narrow, radians(options.map_reuse_margin_deg));
-        const double wider = longerExtentTan(pv.volume) / longerExtentTan(narrow);
+        double margin = radians(options.map_reuse_margin_deg);
+        pv.volume = widenViewVolume(narrow, margin);
+        double wider = longerExtentTan(pv.volume) / longerExtentTan(narrow);
+        for (int i = 0; i < 8 && wider > kMaxWidening; ++i) {  // the extent grows about linearly with the margin
+          margin *= 0.98 * (kMaxWidening - 1) / (wider - 1);
+          pv.volume = widenViewVolume(narrow, margin);
+          wider = longerExtentTan(pv.volume) / longerExtentTan(narrow);
+        }
         out.push_back({size, std::min(size, 32 * int(std::ceil(side * wider / 32.0)))});
         projectPatchMap(f, pv);
       }
@@ -1050,13 +1079,6 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     }
     skip_first_pass = nothing_moved;
     continuing = cache && cache->valid;
-    if (cache) {
-      cache->element_to_eye.resize(n_el);
-      for (size_t e = 0; e < n_el; ++e) cache->element_to_eye[e] = view * scene.elements[e].local_to_world;
-      cache->view = view;
-      cache->projection = observer_projection;
-      cache->valid = true;  // cache->elements: below, with the volumes the maps are drawn with
-    }
   } else {
     const std::string why = n_el == 0 ? "no mirror or lens in the scene"
                                       : std::string("mode ") + (mode == RasterMode::Raster ? "raster" : "envmap");
@@ -1084,7 +1106,11 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   if (reuse_on && !skip_first_pass && !cache->environment_changed && reuseMaps(frames, *cache, &reuse_note)) {
     skip_first_pass = true;
     ++cache->maps_age;
+  } else if (reuse_on && skip_first_pass && !cache->maps.empty()) {
+    ++cache->maps_age;  // nothing moved: the same maps, one frame older
   }
+  // Maps are widened for reuse unless the last first pass could not be kept (nested passes, dark elements).
+  const bool widen = reuse_on && !cache->last_plan_nested;
   if (mode == RasterMode::Pvrr && !frames.empty() && skip_first_pass) {
     const std::string why = !reuse_note.empty() ? reuse_note
                                                 : "eye-fixed cache: neither the elements nor the environment moved relative to the eye";
@@ -1094,8 +1120,8 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     size_t dark = 0;
     bool budget_hit = false;
     std::vector<std::array<int, 2>> widened;  // per top-level slot: texture size, rendered side
-    if (reuse_on) widened = widenMaps(frames);
-    const size_t nested = planPasses(frames, opts, &dark, &budget_hit, reuse_on ? &widened : nullptr);
+    if (widen) widened = widenMaps(frames);
+    const size_t nested = planPasses(frames, opts, &dark, &budget_hit, widen ? &widened : nullptr);
     const double plan_ms = msSince(t0);
     int deepest = 0, rendered = 0;
     for (const MapPass& mp : passes) {
@@ -1103,17 +1129,18 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       rendered += mp.visible;
     }
     const auto t1 = Clock::now();
+    // The maps change from here: any cache's record of them is void, even if a pass fails.
+    first_pass_serial = nextFirstPassSerial();
+    if (cache) cache->maps.clear();
     renderPasses(frames);
     glFinish();
-    ++first_pass_serial;
     if (cache) {
-      cache->maps.clear();
-      if (reuse_on && nested == 0 && dark == 0) {
+      cache->last_plan_nested = nested > 0 || dark > 0;
+      if (widen && !cache->last_plan_nested) {
         for (size_t i = 0; i < widened.size(); ++i) {
           const MapPass& mp = passes[i];
           cache->maps.push_back({mp.owner->element, mp.view, mp.owner->views[mp.view].volume, mp.side, mp.visible});
         }
-        cache->maps_owner = this;
         cache->maps_serial = first_pass_serial;
         cache->maps_age = 0;
       }
@@ -1129,9 +1156,11 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     for (const auto& [texels, n] : sizes)
       note += (note.empty() ? "" : ", ") + std::to_string(n) + " x " + std::to_string(texels[0]) + "x" +
               std::to_string(texels[1]) + (texels[2] ? " RGB planes" : "");
-    if (reuse_on)
-      note += "; widened " + num(options.map_reuse_margin_deg, 3) + " deg for reuse (" +
+    if (widen)
+      note += "; widened up to " + num(options.map_reuse_margin_deg, 3) + " deg for reuse (" +
               (reuse_note.empty() ? std::string("the environment changed") : reuse_note) + ")";
+    else if (reuse_on)
+      note += "; not widened for reuse: the last first pass had nested passes or elements drawn dark";
     if (rendered != int(passes.size()))
       note += (note.empty() ? "" : "; ") + std::to_string(passes.size() - size_t(rendered)) +
               " map(s) of elements outside the observer's view or beyond the depth limit not rendered";
@@ -1174,7 +1203,17 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     out.stages.skipped("nested-passes", n_el == 0 ? "no mirror or lens in the scene" : "mode raster");
   }
 
-  if (cache && mode == RasterMode::Pvrr && n_el > 0) cache->elements = frames;  // with the volumes of the maps
+  // The cache takes this frame whole, once its maps are drawn: the poses, and the elements with the volumes
+  // and texture coordinates of the maps now held.
+  if (cache && mode == RasterMode::Pvrr && n_el > 0) {
+    const Mat4 view = ob.view();
+    cache->element_to_eye.resize(n_el);
+    for (size_t e = 0; e < n_el; ++e) cache->element_to_eye[e] = view * scene.elements[e].local_to_world;
+    cache->view = view;
+    cache->projection = ob.visibilityProjection();
+    cache->elements = frames;
+    cache->valid = true;
+  }
 
   // --- second pass ---
   t0 = Clock::now();

@@ -82,9 +82,11 @@ struct FrameCache {
     bool rendered = false;  // false: the patch was out of view, its map not drawn
   };
   std::vector<Map> maps;
-  const void* maps_owner = nullptr;  // the renderer that holds them
-  uint64_t maps_serial = 0;          // and its first pass that drew them
-  int maps_age = 0;                  // frames drawn from them since
+  uint64_t maps_serial = 0;  // the first pass that drew them (unique in the process; the renderer that holds
+                             // maps of another serial drew over them)
+  int maps_age = 0;          // frames drawn from them since
+  bool last_plan_nested = false;  // the last first pass had nested passes or dark elements: the next one is
+                                  // not widened (its maps could not be kept)
 };
 
 // The map size (longer side, texels) of each of an element's top-level patches when `patches_in_view` of them
