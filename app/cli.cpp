@@ -29,7 +29,9 @@ const std::map<std::string, Command>& commands() {
         "  Renders SCENE (default models/car-mirror.json) and prints the output path and the frame time.\n"
         "  --stats writes {\"frame_ms\", \"stages\":[{\"name\",\"ms\",\"ran\",\"reason\"}], \"elements\":[...]}.\n"
         "  --frames N renders N frames (the observer turning by --orbit DEG in total about the vertical axis\n"
-        "  through the eye; elements attached to the observer turn with it) and reports per-stage counts.\n"
+        "  through the eye; elements attached to the observer turn with it) and reports per-stage counts,\n"
+        "  the median frame time (frame_ms), the mean (frame_ms_mean) and the slowest (frame_ms_max). Frames\n"
+        "  after the first reuse their maps while the view stays inside them (render.map_reuse_margin_deg).\n"
         "  The stats' \"memory\" holds the resident memory after frame 100 (the first frame when N < 100), at\n"
         "  the end, their difference (rss_growth_mb), the peak, and 20 samples over the run."}},
       {"gl-info",

@@ -266,6 +266,14 @@ RenderedFrame renderFrame(LoadedScene& ls, const std::string& mode, const std::s
   return out;
 }
 
+namespace {
+std::string fixedMs(double ms) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3f", ms);
+  return buf;
+}
+}  // namespace
+
 int cmdRender(const std::vector<std::string>& argv) {
   Args a("render", argv, {"mode", "size", "out", "gl", "set", "stats", "frames", "orbit"}, {}, {"set"});
   if (a.positional().size() > 1) usageError("render", "expected at most one scene file");
@@ -326,12 +334,22 @@ int cmdRender(const std::vector<std::string>& argv) {
   const size_t bad = writeLinearPng(out_path, last.width, last.height, last.color);
   if (bad) std::fprintf(stderr, "pvrr render: warning: %zu non-finite pixels written as black\n", bad);
   const double frame_ms = median(frame_times);
+  double mean_ms = 0;
+  for (double t : frame_times) mean_ms += t;
+  mean_ms /= double(frame_times.size());
+  const double max_ms = *std::max_element(frame_times.begin(), frame_times.end());
   std::printf("%s\n", out_path.c_str());
+  // With several frames the mean and the slowest too: a frame that renders its maps again (map reuse) or
+  // re-traces its vertices stands out from the median.
+  const std::string spread = frames > 1 ? ", median of " + std::to_string(frames) + " frames; mean " + fixedMs(mean_ms) +
+                                              " ms, slowest " + fixedMs(max_ms) + " ms"
+                                        : "";
   std::printf("frame time: %.3f ms (%s, %dx%d, mode %s%s)\n", frame_ms, last.gl_backend.c_str(), last.width, last.height,
-              mode.c_str(), frames > 1 ? (", median of " + std::to_string(frames) + " frames").c_str() : "");
+              mode.c_str(), spread.c_str());
   if (auto stats = a.get("stats")) {
     json j = {{"scene", scene_path}, {"mode", mode}, {"size", {last.width, last.height}}, {"gl", last.gl_backend},
-              {"frame_ms", frame_ms}, {"frames", frames}, {"stages", stagesJson(last.stages)},
+              {"frame_ms", frame_ms}, {"frame_ms_mean", mean_ms}, {"frame_ms_max", max_ms}, {"frames", frames},
+              {"stages", stagesJson(last.stages)},
               {"elements", last.elements}, {"peak_rss_mb", peakRssMb()}};
     // Resident memory (MB) after frame `after_frame` and after the last frame, before the PNG is written.
     j["memory"] = {{"after_frame", rss_frame},
