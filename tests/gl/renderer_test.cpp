@@ -248,6 +248,34 @@ double meanColourDifference(const TracedFrame& ref, const std::vector<Vec3>& a, 
   return n ? sum / double(n) : 1e9;
 }
 
+// The observer's target after the head (at eye0, looking at target0) turns by `deg` about the vertical axis
+// through the eye and the eye moves to `eye`.
+Vec3 turnedTarget(const Vec3& eye0, const Vec3& target0, double deg, const Vec3& eye) {
+  return eye + Vec3(glm::rotate(Mat4(1.0), radians(deg), Vec3(0, 1, 0)) * Vec4(target0 - eye0, 0.0));
+}
+
+// A scene (no element attached to the observer) rendered at 160 x 120 with one renderer and one frame cache
+// while the observer moves: frame(deg, eye) turns the head by deg from its start and puts the eye at `eye`.
+struct MovingObserver {
+  Scene s;
+  RayScene rays;
+  gl::Renderer renderer;
+  gl::FrameCache cache;
+  Vec3 eye0, target0;
+  explicit MovingObserver(const std::string& scene)
+      : s(buildScene(loadScene(scene, {"observer.image_size=[160,120]"}))),
+        rays(s),
+        renderer(s, rays, gl::RendererOptions{}),
+        eye0(s.observer.eye),
+        target0(s.observer.target) {}
+  gl::RasterFrame frame(double deg, const Vec3& eye) {
+    s.observer.eye = eye;
+    s.observer.target = turnedTarget(eye0, target0, deg, eye);
+    cache.environment_changed = false;
+    return renderer.render(gl::RasterMode::Pvrr, &cache);
+  }
+};
+
 // The first pass's stage record of a frame: whether it ran, and its note or reason.
 std::string firstPass(const gl::RasterFrame& f, bool* ran) {
   const StageTiming* t = f.stages.find("first-pass");
@@ -268,7 +296,7 @@ TEST_P(RendererTest, MapReuseWithinTheMarginMatchesAFreshFrame) {
   gl::FrameCache cache;
   const Vec3 e = s.observer.eye, target0 = s.observer.target;
   auto turnTo = [&](double deg) {
-    s.observer.target = e + Vec3(glm::rotate(Mat4(1.0), radians(deg), Vec3(0, 1, 0)) * Vec4(target0 - e, 0.0));
+    s.observer.target = turnedTarget(e, target0, deg, e);
     updateAttachedElements(s, desc);
     rays.updateElementPoses();
     cache.environment_changed = false;
@@ -342,17 +370,11 @@ TEST_P(RendererTest, MapReuseWithinTheMarginMatchesAFreshFrame) {
 TEST_P(RendererTest, MapReuseFollowsTheViewpoint) {
   auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
-  Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/car-mirror.json", {"observer.image_size=[160,120]"}));
-  RayScene rays(s);
-  gl::Renderer r(s, rays, gl::RendererOptions{});
-  gl::FrameCache cache;
-  const Vec3 e = s.observer.eye, target0 = s.observer.target;
+  MovingObserver run(PVRR_SOURCE_DIR "/models/car-mirror.json");
+  const Vec3 e = run.eye0;
   auto pose = [&](double deg, const Vec3& eye) {
-    s.observer.eye = eye;
-    s.observer.target = eye + Vec3(glm::rotate(Mat4(1.0), radians(deg), Vec3(0, 1, 0)) * Vec4(target0 - e, 0.0));
-    cache.environment_changed = false;
+    const gl::RasterFrame f = run.frame(deg, eye);
     bool ran = false;
-    const gl::RasterFrame f = r.render(gl::RasterMode::Pvrr, &cache);
     const std::string note = firstPass(f, &ran);
     EXPECT_TRUE(f.stages.find("vertex-rays")->ran);
     return std::make_pair(ran, note);
@@ -362,7 +384,7 @@ TEST_P(RendererTest, MapReuseFollowsTheViewpoint) {
   const auto turned = pose(0.6, e);
   EXPECT_FALSE(turned.first) << turned.second;
   EXPECT_NE(turned.second.find("parallax <= 0 texel"), std::string::npos) << turned.second;
-  const Vec3 side = glm::normalize(glm::cross(target0 - e, Vec3(0, 1, 0)));
+  const Vec3 side = glm::normalize(glm::cross(run.target0 - e, Vec3(0, 1, 0)));
   const auto moved = pose(0.6, e + 0.01 * side);
   EXPECT_TRUE(moved.first);
   EXPECT_NE(moved.second.find("the viewpoint moved too far"), std::string::npos) << moved.second;
@@ -373,15 +395,9 @@ TEST_P(RendererTest, MapReuseFollowsTheViewpoint) {
 TEST_P(RendererTest, MapReuseSkipsNestedPasses) {
   auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
-  Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/mirror-pair.json", {"observer.image_size=[160,120]"}));
-  RayScene rays(s);
-  gl::Renderer r(s, rays, gl::RendererOptions{});
-  gl::FrameCache cache;
-  const Vec3 e = s.observer.eye, target0 = s.observer.target;
+  MovingObserver run(PVRR_SOURCE_DIR "/models/mirror-pair.json");
   for (const double deg : {0.0, 0.2, 0.4}) {
-    s.observer.target = e + Vec3(glm::rotate(Mat4(1.0), radians(deg), Vec3(0, 1, 0)) * Vec4(target0 - e, 0.0));
-    cache.environment_changed = false;
-    const gl::RasterFrame f = r.render(gl::RasterMode::Pvrr, &cache);
+    const gl::RasterFrame f = run.frame(deg, run.eye0);
     ASSERT_TRUE(f.stages.find("nested-passes")->ran);
     bool ran = false;
     const std::string note = firstPass(f, &ran);
@@ -389,7 +405,7 @@ TEST_P(RendererTest, MapReuseSkipsNestedPasses) {
     if (deg > 0) {
       EXPECT_NE(note.find("not widened for reuse"), std::string::npos) << note;
     }
-    EXPECT_TRUE(cache.maps.empty());
+    EXPECT_TRUE(run.cache.maps.empty());
   }
 }
 
