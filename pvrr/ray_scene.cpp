@@ -393,15 +393,22 @@ RayHit RayScene::intersectElementSurface(int element, int surface, const Vec3& o
   // Candidate: the nearest hit on this surface's own tessellation.
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
-  RTCRayHit rh = rayHit1(floatRay(o, d, im.anchor, t_min, t_max, 0.0f));
-  rtcIntersect1(im.element_scenes[size_t(element)][size_t(surface)], &ctx, &rh);
-  Vec2 uv{0};
-  double t = -1;  // no candidate: the direct solve in refineElementHit
-  if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
-    t = rh.ray.tfar;
-    uv = candidateParams(im.scene, g, unsigned(gid), rh.hit.primID, rh.hit.u, rh.hit.v);
+  double from = t_min;
+  for (int attempt = 0; attempt < 4; ++attempt) {
+    RTCRayHit rh = rayHit1(floatRay(o, d, im.anchor, from, t_max, 0.0f));
+    rtcIntersect1(im.element_scenes[size_t(element)][size_t(surface)], &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)  // no candidate: the direct solve, unless one was refuted
+      return attempt == 0 ? refineElementHit(element, surface, o, d, t_min, t_max, Vec2(0), -1, within_outline) : RayHit{};
+    const double t = rh.ray.tfar;
+    const Vec2 uv = candidateParams(im.scene, g, unsigned(gid), rh.hit.primID, rh.hit.u, rh.hit.v);
+    const RayHit hit = refineElementHit(element, surface, o, d, t_min, t_max, uv, t, within_outline);
+    if (hit.hit()) return hit;
+    // The candidate refined to nothing beyond t_min: typically the ray's own start on this surface (a ray
+    // totally reflected inside a lens, whose float start lies a hair behind the tessellation). Look on
+    // along the ray for the next candidate.
+    from = t + 2 * floatSlack(o - im.anchor) + 1e-9 * std::abs(t);  // floatRay widens back by one slack
   }
-  return refineElementHit(element, surface, o, d, t_min, t_max, uv, t, within_outline);
+  return RayHit{};
 }
 
 RayHit RayScene::refineElementHit(int element, int surface, const Vec3& o, const Vec3& d, double t_min,

@@ -8,6 +8,7 @@
 #include "cad/error.h"
 #include "pvrr/optics.h"
 #include "pvrr/spectrum.h"
+#include "pvrr/tracer.h"
 
 namespace pvrr {
 
@@ -48,6 +49,27 @@ std::vector<ChannelSpec> dispersionChannels(const Scene& scene, int element) {
 }
 
 // Both traceVertexRays: the incoming ray of vertex i starts at (*origins)[i], or at `eye` when null.
+// The reference tracer for the vertices whose rays are totally reflected inside a lens (VertexRay::traced):
+// none for a mirror or without a depth budget.
+static std::optional<Tracer> tirTracer(const RayScene& rays, const ElementFrame& f) {
+  if (f.tir_trace_depth <= 0 || rays.scene().elements[size_t(f.element)].type != ElementType::Lens) return std::nullopt;
+  TraceOptions to;
+  to.max_depth = f.tir_trace_depth;
+  return Tracer(rays, to);
+}
+
+// What the tracer shows along a vertex's incoming ray (direction d_in, meeting lens `element` at its vertex
+// p) at wavelength wl: traced from 0.1 mm before the vertex, so that its first event is the lens there. A
+// rim vertex's ray may graze past the outline and miss the lens: then dark, its seen point the far point
+// along the flagged ray (vr.hit), as the tracer absorbs the light that leaves through the edge band.
+static void traceTir(const Tracer& tracer, int element, VertexRay& vr, const Vec3& p, const Vec3& d_in, double wl) {
+  const TraceResult t = tracer.trace(p - 1e-4 * d_in, d_in, wl);
+  vr.traced = true;
+  const bool entered = t.first_element == element;
+  vr.traced_color = entered ? t.color : Vec3(0.0);
+  vr.traced_seen = entered ? t.seen : vr.hit;
+}
+
 static void traceVertexRaysFrom(const RayScene& rays, ElementFrame& f, const Vec3& eye,
                                 const std::vector<Vec3>* origins, const VertexStageOptions& opt);
 
@@ -95,7 +117,9 @@ static void traceVertexRaysFrom(const RayScene& rays, ElementFrame& f, const Vec
   const double far = scene.render.far_distance_m;
   f.eye = eye;
   f.channels = opt.channels;
+  f.tir_trace_depth = opt.tir_trace_depth;
   f.rays.assign(opt.channels.size(), std::vector<VertexRay>(f.world_pos.size()));
+  const std::optional<Tracer> tracer = tirTracer(rays, f);
   for (size_t c = 0; c < opt.channels.size(); ++c) {
     const double wl = opt.channels[c].wavelength_nm > 0 ? opt.channels[c].wavelength_nm : kLineD_nm;
     // Vertices are independent: one task per block of vertices.
@@ -126,11 +150,15 @@ static void traceVertexRaysFrom(const RayScene& rays, ElementFrame& f, const Vec
         // (a lens blank), then its second-order Taylor continuation.
         if (!back.hit()) back = rays.intersectElementSurface(f.element, 1, p, in.direction, eps, kInf, false);
         if (!back.hit()) {
-          // The internal ray leaves through the edge band: no back point. Treated like TIR: flagged.
+          // The internal ray leaves through the edge band: no back point. Treated like TIR: flagged, no
+          // light through the back (the tracer absorbs at the edge band), and with a depth budget the
+          // tracer's answer for the vertex's ray.
           vr.status = VertexStatus::Tir;
           vr.origin = p;
           vr.dir = in.direction;
           vr.hit = p + far * in.direction;
+          vr.transmittance = Vec3(0.0);
+          if (tracer) traceTir(*tracer, f.element, vr, p, d_in, wl);
           return;
         }
         vr.back_point = back.point;
@@ -146,6 +174,7 @@ static void traceVertexRaysFrom(const RayScene& rays, ElementFrame& f, const Vec
           vr.status = VertexStatus::Tir;
           vr.dir = reflect(in.direction, back.normal);
           vr.hit = back.point + far * vr.dir;
+          if (tracer) traceTir(*tracer, f.element, vr, p, d_in, wl);
           return;
         }
         vr.dir = out.direction;
@@ -454,6 +483,7 @@ void moveRigidly(ElementFrame& f, const Mat4& motion) {
       dir(r.internal_dir);
       point(r.back_point);
       dir(r.back_normal);
+      point(r.traced_seen);
     }
   for (PatchView& pv : f.views) {
     point(pv.fit.eye);
@@ -465,17 +495,23 @@ void updateTextureCoordinates(const RayScene& rays, ElementFrame& f) {
   auto t0 = std::chrono::steady_clock::now();
   const Scene& scene = rays.scene();
   const double eps = rays.epsilon(), far = scene.render.far_distance_m;
-  for (auto& channel : f.rays)
+  const std::optional<Tracer> tracer = tirTracer(rays, f);
+  for (size_t c = 0; c < f.rays.size(); ++c) {
+    std::vector<VertexRay>& channel = f.rays[c];
+    const double wl = c < f.channels.size() && f.channels[c].wavelength_nm > 0 ? f.channels[c].wavelength_nm : kLineD_nm;
     tbb::parallel_for(size_t(0), channel.size(), [&](size_t i) {
       VertexRay& r = channel[i];
       if (r.status == VertexStatus::Tir) {
         r.hit = r.origin + far * r.dir;
+        // The same incoming ray in the lens's frame; what lies beyond it has moved.
+        if (r.traced && tracer) traceTir(*tracer, f.element, r, f.world_pos[i], glm::normalize(f.world_pos[i] - f.eye), wl);
         return;
       }
       const RayHit h = rays.intersect(r.origin, r.dir, eps);
       r.status = h.hit() ? VertexStatus::Hit : VertexStatus::Escape;
       r.hit = h.hit() ? h.point : r.origin + far * r.dir;
     });
+  }
   const Element& el = scene.elements[size_t(f.element)];
   for (PatchView& pv : f.views) buildSeenPatchMap(scene, f, el, pv);
   f.rays_ms = msSince(t0);

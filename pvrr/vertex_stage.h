@@ -26,6 +26,13 @@ struct VertexRay {
   // Lenses: the direction inside the glass, the back-surface point and its unit normal.
   Vec3 internal_dir{0}, back_point{0}, back_normal{0};
   Vec3 transmittance{1.0};  // lens: Fresnel transmittance of both interfaces (per RGB channel)
+  // A lens vertex whose internal ray is totally reflected at the back surface (status Tir; transmittance 0)
+  // when VertexStageOptions::tir_trace_depth > 0: what the reference tracer shows along the vertex's
+  // incoming ray at this channel's wavelength (the light reflected inside the lens and leaving through the
+  // front or beyond), its colour and seen point. The second pass draws it there, interpolated towards the
+  // neighbouring vertices' map colours, in place of dark.
+  bool traced = false;
+  Vec3 traced_color{0}, traced_seen{0};
 };
 
 // One patch's virtual camera. With dispersion the channels share the viewpoint and the first pass (fitted
@@ -102,6 +109,11 @@ struct VertexStageOptions {
   // the eye spans ~150 deg, of which a 50 deg view sees about a third across. The viewpoint is still fitted
   // to all the patch's rays. Unset: all.
   std::optional<Mat4> viewer_clip;
+  // Events the reference tracer may still take from a vertex's incoming ray (the scene's render.max_depth
+  // for the observer's view, less the events before it for an element seen in another's map). > 0: a lens
+  // vertex whose ray is totally reflected inside the lens gets the tracer's answer (VertexRay::traced);
+  // 0: it stays dark.
+  int tir_trace_depth = 0;
 };
 
 struct ElementFrame {
@@ -121,6 +133,7 @@ struct ElementFrame {
   // seen in part). Vertices of triangles the viewer cannot see get texture coordinates too, but they shape
   // no pixel.
   std::vector<char> in_view;
+  int tir_trace_depth = 0;  // VertexStageOptions::tir_trace_depth the rays were traced with
 };
 
 // Tessellates the element (its tess_u x tess_v grid) in local and world coordinates.

@@ -22,6 +22,8 @@ in vec3 v_w0;
 in vec3 v_w1;
 in vec3 v_w2;
 in vec3 v_st_seen;
+in vec4 v_tir;        // PVRR lens: the tracer's colour of totally reflected channels (their map weight is 0)
+in vec3 v_tir_seen;
 uniform vec3 u_view_origin;      // where the viewing rays start, relative to the camera origin
 uniform float u_element_id;      // index + 1
 uniform bool u_metal;
@@ -94,10 +96,13 @@ void main() {
   c += v_w1 * texture(u_map, mapST(v_st1)).rgb + v_w2 * texture(u_map, mapST(v_st2)).rgb;
 #endif
 #endif
+  c += v_tir.rgb;  // zero but near a totally reflected vertex: what the tracer shows there, interpolated
 #if defined(NO_SEEN_POINTS)
   vec4 seen = vec4(0.0);
 #else
   vec4 seen = texture(u_seen_map, mapST(v_st_seen));
+  // Nearer a totally reflected vertex than the others: its traced seen point (relative to this camera).
+  if (v_tir.a > 0.5) seen = vec4(v_tir_seen - u_seen_offset, 1.0);
 #endif
 #else
 #if defined(LENS)

@@ -13,6 +13,8 @@ layout(location = 5) in vec3 a_w0;
 layout(location = 6) in vec3 a_w1;
 layout(location = 7) in vec3 a_w2;
 layout(location = 8) in vec3 a_st_seen;
+layout(location = 9) in vec4 a_tir;       // rgb: the traced colour of totally reflected channels; a: 1 where the
+layout(location = 10) in vec3 a_tir_seen; // seen channel is, with its traced seen point (relative to the anchor)
 uniform mat4 u_view_proj;
 uniform vec3 u_offset;                  // element anchor - camera origin
 out vec3 v_pos;
@@ -24,6 +26,8 @@ out vec3 v_w0;
 out vec3 v_w1;
 out vec3 v_w2;
 out vec3 v_st_seen;
+out vec4 v_tir;
+out vec3 v_tir_seen;   // relative to the camera origin
 // The channel sets of one patch are drawn one after the other with the same vertices (additively, depth
 // test LEQUAL): their depths must be bit-identical.
 invariant gl_Position;
@@ -37,5 +41,7 @@ void main() {
   v_w1 = a_w1;
   v_w2 = a_w2;
   v_st_seen = a_st_seen;
+  v_tir = a_tir;
+  v_tir_seen = a_tir_seen + u_offset;
   gl_Position = u_view_proj * vec4(v_pos, 1.0);
 }

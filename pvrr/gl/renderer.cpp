@@ -169,8 +169,11 @@ Program makeProgram(const std::string& vert, const std::string& frag, const std:
 
 // The element vertex layout (shaders/element.vert): position, normal, three texture-coordinate sets, three
 // weights, the seen point's texture coordinates.
-const std::vector<int> kElementLayout = {3, 3, 3, 3, 3, 3, 3, 3, 3};
-constexpr size_t kElementFloats = 27;
+// Element vertices (shaders/element.vert): position, normal, three texture-coordinate sets, three weights,
+// the seen point's coordinates, the traced colour of totally reflected vertices (rgb, and 1 where the seen
+// channel's is) and their traced seen point.
+const std::vector<int> kElementLayout = {3, 3, 3, 3, 3, 3, 3, 3, 3, 4, 3};
+constexpr size_t kElementFloats = 34;
 
 // At most this many first passes per frame (top-level and nested): each holds a size^2 colour, seen-point
 // and depth target. Elements that would need more are drawn dark in their map, and the stats say so.
@@ -465,7 +468,7 @@ struct Renderer::Impl {
       const glm::vec3 d = has_rays ? glm::vec3(f.rays[0][i].dir) : glm::vec3(0, 0, 1);
       const glm::vec3 tr = has_rays ? glm::vec3(f.rays[0][i].transmittance) : glm::vec3(1);
       data.insert(data.end(), {p.x, p.y, p.z, n.x, n.y, n.z, d.x, d.y, d.z, 0, 0, 1, 0, 0, 1, tr.x, tr.y, tr.z,
-                               0, 0, 0, 0, 0, 0, 0, 0, 1});
+                               0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0});
     }
     std::vector<uint32_t> idx;
     for (const auto& t : f.grid.triangles) idx.insert(idx.end(), {t.x, t.y, t.z});
@@ -499,6 +502,17 @@ struct Renderer::Impl {
       }
       const Vec2 st = pv.st[seen_channel][k];
       data.insert(data.end(), {float(st.x * q), float(st.y * q), float(q)});
+      // Totally reflected channels: their map weight is 0 and the tracer's colour takes its place, added in
+      // the draw of their set; the seen point follows the seen channel (first draw).
+      Vec3 traced(0.0);
+      for (size_t j = 0; j < 3 && 3 * set + j < channels; ++j) {
+        const VertexRay& r = f.rays[3 * set + j][vi];
+        if (r.traced) traced += weight[j] * r.traced_color;
+      }
+      const VertexRay& seen_ray = f.rays[seen_channel][vi];
+      const bool seen_traced = set == 0 && seen_ray.traced;
+      const glm::vec3 ts = seen_traced ? glm::vec3(seen_ray.traced_seen - anchor) : glm::vec3(0.0f);
+      data.insert(data.end(), {float(traced.x), float(traced.y), float(traced.z), seen_traced ? 1.0f : 0.0f, ts.x, ts.y, ts.z});
     }
     std::vector<uint32_t> idx;
     for (const auto& t : gp.triangles) idx.insert(idx.end(), {t.x, t.y, t.z});
@@ -575,6 +589,7 @@ struct Renderer::Impl {
   VertexStageOptions optionsFor(size_t e) const {
     VertexStageOptions o = options.vertex;
     if (o.channels.empty()) o.channels = dispersionChannels(scene, int(e));
+    o.tir_trace_depth = scene.render.max_depth;  // as seen from the eye: the tracer's whole budget
     return o;
   }
 
@@ -810,6 +825,7 @@ struct Renderer::Impl {
         nf->patches_v = el.patches_v;
         VertexStageOptions nested_opt = opts[b];
         nested_opt.viewer_clip = pv.volume.projection * pv.volume.view;  // seen by the owner's map camera
+        nested_opt.tir_trace_depth = max_depth - depth;  // the events before this element are spent
         traceVertexRays(rays, *nf, pv.volume.eye, rayOrigins(owner, pv, nf->world_pos), nested_opt);
         fitPatchViews(scene, *nf, nested_opt);
         if (visiblePasses() + inView(*nf) > kMaxFirstPasses) {  // an automatic split needed more maps

@@ -36,15 +36,16 @@ struct LensCase {
   bool inverted;
 };
 
-Scene lensScene(const LensCase& c) {
+// The room seen through a lens with outline `disc` 0.5 m in front of the eye (n = 1.5, no dispersion).
+Scene lensScene(const char* name, cad::SagSurfacePtr front, cad::SagSurfacePtr back, double thickness,
+                const cad::Outline& disc) {
   const Vec3 eye(0, 0, 2.5), lens_pos(0, 0, 2.0);
   Scene s = test::roomScene(eye, Vec3(0, 0, -3), 160, 120);
   s.observer.fov_y_rad = radians(8);
-  const cad::Outline disc = cad::Outline::circle(0.04);
   Element e;
-  e.name = c.name;
+  e.name = name;
   e.type = ElementType::Lens;
-  e.lens = cad::makeLens(cad::makeSphere(c.r_front, disc), cad::makeSphere(c.r_back, disc), disc, c.thickness, 0.0, c.name);
+  e.lens = cad::makeLens(front, back, disc, thickness, 0.0, name);
   e.outline = disc;
   e.local_to_world = test::pose(lens_pos, Vec3(0, 0, 1));
   e.world_to_local = glm::inverse(e.local_to_world);
@@ -53,6 +54,11 @@ Scene lensScene(const LensCase& c) {
   s.elements.push_back(e);
   s.updateBounds();
   return s;
+}
+
+Scene lensScene(const LensCase& c) {
+  const cad::Outline disc = cad::Outline::circle(0.04);
+  return lensScene(c.name, cad::makeSphere(c.r_front, disc), cad::makeSphere(c.r_back, disc), c.thickness, disc);
 }
 
 class LensTypesTest : public ::testing::TestWithParam<gl::GlBackend> {};
@@ -123,6 +129,61 @@ TEST_P(LensTypesTest, LensBeyondTheDepthLimitIsDarkLikeTheReference) {
   const StageTiming* fp = f.stages.find("first-pass");
   ASSERT_NE(fp, nullptr);
   EXPECT_EQ(fp->count, 0) << fp->note;  // no map rendered for a lens drawn dark
+}
+
+// Total internal reflection (issue 6, item 1: the lens shows there what the reference shows). A plano-convex
+// lens 36 mm across, 12 mm thick, back radius 20 mm, flat side to the eye: a ray entering near the axis meets
+// the back at sin(angle) = h / R, beyond the critical angle (1 / 1.5) for h > 13.3 mm, so a ring of the lens
+// reflects the light back inside. The tracer follows it (reflected again across the lens, it leaves through
+// the front towards the wall behind the eye); pvrr's vertices there are flagged tir and take the tracer's
+// colour and seen point for their ray (VertexRay::traced), interpolated towards the map's colours of their
+// neighbours. Compared in the ring 14.9 to 16.3 mm from the axis (whole triangles of flagged vertices, the
+// rings lie at 13.4, 14.9 and 16.4 mm; clear of the onset of TIR and of the band beyond 16.4 mm where the
+// light leaves through the edge, dark in the reference): the mean colour error is a small fraction of the
+// colour there (dark, as pvrr drew it before, would be an error of all of it).
+TEST_P(LensTypesTest, TotalInternalReflectionShowsWhatTheReferenceShows) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  const cad::Outline disc = cad::Outline::circle(0.036);  // diameter
+  Scene s = lensScene("plano-convex", cad::makePlane(disc), cad::makeSphere(-0.02, disc), 0.012, disc);
+  RayScene rays(s);
+  TraceOptions to;
+  to.max_depth = s.render.max_depth;
+  const TracedFrame ref = Tracer(rays, to).render();
+  gl::Renderer r(s, rays, gl::RendererOptions{});
+  const gl::RasterFrame f = r.render(gl::RasterMode::Pvrr);
+  ASSERT_EQ(f.elements.size(), 1u);
+  size_t tir = 0, traced = 0;
+  for (const VertexRay& v : f.elements[0].rays[0]) {
+    tir += v.status == VertexStatus::Tir;
+    traced += v.traced;
+  }
+  EXPECT_GT(tir, 50u);
+  EXPECT_GT(traced, 50u);
+  const Vec3 axis_point(0, 0, 2.0);
+  double err = 0, ref_sum = 0;
+  std::vector<double> angles;
+  size_t n = 0;
+  for (size_t i = 0; i < ref.color.size(); ++i) {
+    if (ref.element[i] < 0 || f.element[i] < 0) continue;
+    const double h = glm::length(Vec2(ref.element_point[i] - axis_point));
+    if (h < 0.0149 || h > 0.0163) continue;
+    ++n;
+    const Vec3 d = glm::abs(f.color[i] - ref.color[i]);
+    err += (d.x + d.y + d.z) / 3;
+    ref_sum += (ref.color[i].x + ref.color[i].y + ref.color[i].z) / 3;
+    angles.push_back(arcminutes(angleBetween(ref.seen[i] - ref.element_point[i], f.seen[i] - ref.element_point[i])));
+  }
+  ASSERT_GT(n, 300u);
+  std::sort(angles.begin(), angles.end());
+  std::cout << "[ measured ] TIR ring on " << gl::glBackendName(GetParam()) << ": " << n << " pixels, mean colour "
+            << ref_sum / double(n) << " (reference), mean error " << err / double(n) << ", seen-point median "
+            << angles[angles.size() / 2] << " arcmin\n";
+  EXPECT_GT(ref_sum / double(n), 0.02) << "the reference is not dark there: the test compares something";
+  // Measured: 5.4 % of the colour (the wall behind the eye, reflected twice inside the lens). The seen points
+  // are exact at the vertices but sweep ~0.6 m of wall per millimetre of lens here, which the 1.5 mm triangles
+  // interpolate poorly (median ~930'): reported, not bounded.
+  EXPECT_LE(err, 0.15 * ref_sum);
 }
 
 PVRR_GL_BACKENDS(LensTypesTest);

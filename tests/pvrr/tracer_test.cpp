@@ -217,6 +217,32 @@ void checkLaws(const std::vector<PathSegment>& path, const std::string& where) {
   }
 }
 
+// Light totally reflected inside a lens crosses it and meets the back surface again: a plano-convex lens
+// (flat front to the light, back R = 20 mm, 36 mm across, 12 mm thick) reflects a ray entering parallel to
+// the axis 13.5 to 15.5 mm off it (sin i = h / R, beyond 1 / 1.5) across the lens to the far side of the
+// back, where the chord meets it at the same angle: reflected again, it leaves through the front back
+// towards the light (a retro-reflection, as in a Porro prism). The lens's own surface search must step past
+// the ray's start on the back surface: it once found only that and reported the ray leaving through the edge.
+TEST(Tracer, TotallyReflectedLightCrossesTheLensAndLeavesThroughTheFront) {
+  Scene s = test::roomScene(Vec3(0, 0, 1), Vec3(0, 0, 0));
+  const cad::Outline disc = cad::Outline::circle(0.036);
+  addLens(s, cad::makePlane(disc), cad::makeSphere(-0.02, disc), disc, 0.012, 1.5, test::pose(Vec3(0), Vec3(0, 0, 1)));
+  RayScene rays(s);
+  Tracer tracer(rays, TraceOptions{});
+  for (double h = 0.0135; h <= 0.01551; h += 0.0005) {
+    std::vector<PathSegment> path;
+    const TraceResult r = tracer.trace(Vec3(h, 0.001, 0.5), Vec3(0, 0, -1), 0, &path);
+    std::string events;
+    for (const PathSegment& p : path) events += p.event + " ";
+    ASSERT_EQ(events, "refract tir tir refract diffuse ") << "h = " << h;
+    EXPECT_LT(path[2].point.x, 0.0) << "the second reflection is on the far side";
+    EXPECT_GT(path[3].direction.z, 0.0) << "back towards the light";
+    EXPECT_GT(glm::length(r.color), 0.0);
+    checkLaws(path, "h = " + std::to_string(h));
+  }
+}
+
+
 TEST(Tracer, PathsInEveryDefaultSceneObeyTheLaws) {
   const std::filesystem::path models = std::filesystem::path(PVRR_SOURCE_DIR) / "models";
   int scenes = 0, specular = 0;
