@@ -293,7 +293,9 @@ int cmdRender(const std::vector<std::string>& argv) {
   frame_times.reserve(size_t(frames));
   std::map<std::string, std::pair<int, int>> stage_counts;  // name -> (ran, skipped)
   std::map<std::string, double> stage_ms_sum;  // running sums: the bookkeeping of a long run stays O(1) a frame
-  std::map<std::string, std::string> skip_reason;
+  // Per stage, its skip reasons by kind (the text before the first ':', e.g. "map reuse", "eye-fixed cache"):
+  // how many frames, and the last full text. Bounded by the kinds, not by the frames.
+  std::map<std::string, std::map<std::string, std::pair<int, std::string>>> skip_reasons;
   const Vec3 eye0 = ls.scene.observer.eye, target0 = ls.scene.observer.target;
   const bool any_attached = std::any_of(ls.scene.elements.begin(), ls.scene.elements.end(),
                                         [](const Element& e) { return e.attached_to_observer; });
@@ -327,7 +329,11 @@ int cmdRender(const std::vector<std::string>& argv) {
       auto& c = stage_counts[s.name];
       (s.ran ? c.first : c.second)++;
       if (s.ran) stage_ms_sum[s.name] += s.ms;
-      else skip_reason[s.name] = s.reason;
+      else {
+        auto& kind = skip_reasons[s.name][s.reason.substr(0, s.reason.find(':'))];
+        ++kind.first;
+        kind.second = s.reason;
+      }
     }
   }
   const double rss_end_mb = currentRssMb();
@@ -361,9 +367,17 @@ int cmdRender(const std::vector<std::string>& argv) {
     if (frames > 1) {
       json per = json::array();
       for (const auto& [name, c] : stage_counts) {
+        // "reason": the most frequent kind's last text; "reasons": every kind with its frames.
+        json reasons = json::array();
+        std::string reason;
+        int most = 0;
+        for (const auto& [kind, n_text] : skip_reasons[name]) {
+          reasons.push_back({{"frames", n_text.first}, {"reason", n_text.second}});
+          if (n_text.first > most) most = n_text.first, reason = n_text.second;
+        }
         per.push_back({{"name", name}, {"frames_ran", c.first}, {"frames_skipped", c.second},
                        {"mean_ms", c.first > 0 ? stage_ms_sum[name] / double(c.first) : 0.0},
-                       {"reason", c.second ? skip_reason[name] : ""}});
+                       {"reason", reason}, {"reasons", reasons}});
       }
       j["stage_frames"] = per;
       j["orbit_deg"] = orbit_deg;

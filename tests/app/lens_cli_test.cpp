@@ -59,6 +59,11 @@ TEST(LensCli, HeadTurningKeepsTheSpectacleLensCached) {
     for (const char* key : {"name", "frames_ran", "frames_skipped", "mean_ms", "reason"})
       ASSERT_TRUE(st.contains(key)) << key << " missing in " << st.dump();
     EXPECT_EQ(st["frames_ran"].get<int>() + st["frames_skipped"].get<int>(), kFrames) << st.dump();
+    // Every kind of skip reason with its frames: they add up to the skipped frames.
+    ASSERT_TRUE(st.contains("reasons")) << st.dump();
+    int reasoned = 0;
+    for (const auto& r : st["reasons"]) reasoned += r["frames"].get<int>();
+    EXPECT_EQ(reasoned, st["frames_skipped"].get<int>()) << st.dump();
     EXPECT_GE(st["mean_ms"].get<double>(), 0.0) << st.dump();
   }
   for (const char* name : {"vertex-rays", "refraction", "viewpoint-fit"}) {
