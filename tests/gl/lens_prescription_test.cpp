@@ -24,6 +24,7 @@
 #include "pvrr/scene_build.h"
 #include "pvrr/scene_json.h"
 #include "pvrr/tracer.h"
+#include "support/accuracy.h"
 #include "support/gl_backends.h"
 
 namespace pvrr {
@@ -210,19 +211,7 @@ TEST(LensPrescription, AsphereKeepsTheParaxialPowerAndChangesTheRim) {
   EXPECT_LT(turned, 2.0 * estimate);
 }
 
-// Median angular error over the pixels where the reference sees the lens (renderer_test.cpp's metric).
-double medianArcmin(const TracedFrame& ref, const gl::RasterFrame& f, size_t* pixels) {
-  std::vector<double> e;
-  for (size_t i = 0; i < ref.color.size(); ++i)
-    if (ref.element[i] >= 0) {
-      const double a = arcminutes(angleBetween(ref.seen[i] - ref.element_point[i], f.seen[i] - ref.element_point[i]));
-      EXPECT_TRUE(std::isfinite(a)) << "pixel " << i;
-      e.push_back(a);
-    }
-  *pixels = e.size();
-  std::sort(e.begin(), e.end());
-  return e.empty() ? 1e9 : e[e.size() / 2];
-}
+using test::medianArcmin;
 
 class LensPrescriptionTest : public ::testing::TestWithParam<gl::GlBackend> {};
 

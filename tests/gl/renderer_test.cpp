@@ -17,6 +17,7 @@
 #include "pvrr/spectrum.h"
 #include "pvrr/tracer.h"
 #include "support/test_scenes.h"
+#include "support/accuracy.h"
 #include "support/gl_backends.h"
 
 namespace pvrr {
@@ -49,18 +50,7 @@ std::vector<bool> awayFromDepthEdges(const TracedFrame& ref, const Vec3& eye) {
   return ok;
 }
 
-// Median angular error over the reference's element pixels for one pvrr / envmap frame.
-double medianArcmin(const TracedFrame& ref, const gl::RasterFrame& f) {
-  std::vector<double> e;
-  for (size_t i = 0; i < ref.color.size(); ++i)
-    if (ref.element[i] >= 0) {
-      const double a = arcminutes(angleBetween(ref.seen[i] - ref.element_point[i], f.seen[i] - ref.element_point[i]));
-      EXPECT_TRUE(std::isfinite(a)) << "pixel " << i;
-      e.push_back(a);
-    }
-  std::sort(e.begin(), e.end());
-  return e.empty() ? 1e9 : e[e.size() / 2];
-}
+using test::medianArcmin;
 
 class RendererTest : public ::testing::TestWithParam<gl::GlBackend> {};
 
