@@ -150,15 +150,16 @@ static void traceVertexRaysFrom(const RayScene& rays, ElementFrame& f, const Vec
         // (a lens blank), then its second-order Taylor continuation.
         if (!back.hit()) back = rays.intersectElementSurface(f.element, 1, p, in.direction, eps, kInf, false);
         if (!back.hit()) {
-          // The internal ray leaves through the edge band: no back point. Treated like TIR: flagged, no
-          // light through the back (the tracer absorbs at the edge band), and with a depth budget the
-          // tracer's answer for the vertex's ray.
+          // The internal ray leaves through the edge band: no back point. Treated like TIR: flagged, and
+          // with a depth budget it shows the tracer's answer for its ray (no map weight).
           vr.status = VertexStatus::Tir;
           vr.origin = p;
           vr.dir = in.direction;
           vr.hit = p + far * in.direction;
-          vr.transmittance = Vec3(0.0);
-          if (tracer) traceTir(*tracer, f.element, vr, p, d_in, wl);
+          if (tracer) {  // its own answer in place of the map's (whose far point says nothing here)
+            vr.transmittance = Vec3(0.0);
+            traceTir(*tracer, f.element, vr, p, d_in, wl);
+          }
           return;
         }
         vr.back_point = back.point;

@@ -102,7 +102,7 @@ void main() {
 #else
   vec4 seen = texture(u_seen_map, mapST(v_st_seen));
   // Nearer a totally reflected vertex than the others: its traced seen point (relative to this camera).
-  if (v_tir.a > 0.5) seen = vec4(v_tir_seen - u_seen_offset, 1.0);
+  if (v_tir.a > 0.5) seen = vec4(v_tir_seen / v_tir.a - u_seen_offset, 1.0);
 #endif
 #else
 #if defined(LENS)

@@ -27,7 +27,7 @@ out vec3 v_w1;
 out vec3 v_w2;
 out vec3 v_st_seen;
 out vec4 v_tir;
-out vec3 v_tir_seen;   // relative to the camera origin
+out vec3 v_tir_seen;   // a_tir.a * the traced seen point relative to the camera origin
 // The channel sets of one patch are drawn one after the other with the same vertices (additively, depth
 // test LEQUAL): their depths must be bit-identical.
 invariant gl_Position;
@@ -42,6 +42,8 @@ void main() {
   v_w2 = a_w2;
   v_st_seen = a_st_seen;
   v_tir = a_tir;
-  v_tir_seen = a_tir_seen + u_offset;
+  // Weighted by the traced flag: interpolated, v_tir_seen / v_tir.a is the mean of the traced vertices' seen
+  // points alone (the others carry 0), relative to the camera origin.
+  v_tir_seen = a_tir.a * (a_tir_seen + u_offset);
   gl_Position = u_view_proj * vec4(v_pos, 1.0);
 }

@@ -302,6 +302,15 @@ void Framebuffer::bindRegion(int width, int height) const {
   glViewport(0, 0, width, height);
 }
 
+void Framebuffer::bindRegionClearDepth(int width, int height, float depth) const {
+  bindRegion(width, height);
+  if (depth_texture_ == 0) return;
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(0, 0, width, height);
+  glClearBufferfv(GL_DEPTH, 0, &depth);
+  glDisable(GL_SCISSOR_TEST);
+}
+
 ColorFormat Framebuffer::colorFormat(int attachment) const {
   checkAttachment(attachment);
   return colors_[static_cast<std::size_t>(attachment)];

@@ -81,6 +81,9 @@ class Framebuffer {
   // Binds like bind(), with the viewport on the lower-left width x height pixels only (a map rendered into part
   // of its texture). Throws pvrr::Error when the region does not fit.
   void bindRegion(int width, int height) const;
+  // bindRegion, then clears the depth of that region only (a scissored clear): a map drawn into part of its
+  // texture need not clear the rest (llvmpipe clears every tile of a full clear: ~1 ms for 1024^2).
+  void bindRegionClearDepth(int width, int height, float depth) const;
 
   int width() const { return width_; }
   int height() const { return height_; }

@@ -167,8 +167,6 @@ Program makeProgram(const std::string& vert, const std::string& frag, const std:
                               defines);
 }
 
-// The element vertex layout (shaders/element.vert): position, normal, three texture-coordinate sets, three
-// weights, the seen point's texture coordinates.
 // Element vertices (shaders/element.vert): position, normal, three texture-coordinate sets, three weights,
 // the seen point's coordinates, the traced colour of totally reflected vertices (rgb, and 1 where the seen
 // channel's is) and their traced seen point.
@@ -589,7 +587,8 @@ struct Renderer::Impl {
   VertexStageOptions optionsFor(size_t e) const {
     VertexStageOptions o = options.vertex;
     if (o.channels.empty()) o.channels = dispersionChannels(scene, int(e));
-    o.tir_trace_depth = scene.render.max_depth;  // as seen from the eye: the tracer's whole budget
+    // As seen from the eye: the tracer's whole budget (none for a lens drawn dark at the depth limit).
+    o.tir_trace_depth = interfaces(scene.elements[e]) > scene.render.max_depth ? 0 : scene.render.max_depth;
     return o;
   }
 
@@ -969,8 +968,7 @@ struct Renderer::Impl {
       if (!mp.visible) continue;
       // No colour clear: the sky covers every texel nothing else does (drawEnvironment).
       const std::array<int, 2> region = mapTexels(pv.volume, mp.side);
-      t.clearDepth(pv.volume.backward ? 0.0f : 1.0f);
-      t.bindRegion(region[0], region[1]);
+      t.bindRegionClearDepth(region[0], region[1], pv.volume.backward ? 0.0f : 1.0f);
       // In a reversed (zooming) map the rays come from the mirror, not from the viewpoint.
       const Vec3 element_centre = Vec3(scene.elements[size_t(mp.owner->element)].local_to_world[3]);
       drawEnvironment(pv.volume.view, pv.volume.projection, pv.volume.eye, pv.volume.backward,
