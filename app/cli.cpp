@@ -30,10 +30,11 @@ const std::map<std::string, Command>& commands() {
         "  --stats writes {\"frame_ms\", \"stages\":[{\"name\",\"ms\",\"ran\",\"reason\"}], \"elements\":[...]}.\n"
         "  --frames N renders N frames (the observer turning by --orbit DEG in total about the vertical axis\n"
         "  through the eye; elements attached to the observer turn with it) and reports per-stage counts\n"
-        "  (stage_frames: frames_ran, frames_skipped, mean_ms, the commonest skip reason and every kind of\n"
-        "  reason with its frames),\n"
-        "  the median frame time (frame_ms), the mean (frame_ms_mean) and the slowest (frame_ms_max). Frames\n"
-        "  after the first reuse their maps while the view stays inside them (render.map_reuse_margin_deg).\n"
+        "  (stage_frames: name, frames_ran, frames_skipped, mean_ms, reason: the commonest skip reason, and\n"
+        "  reasons: [{frames, reason}] for every kind of reason),\n"
+        "  the median frame time (frame_ms), the mean (frame_ms_mean) and the slowest (frame_ms_max). From the\n"
+        "  second frame on, maps are drawn with a margin, and later frames reuse them while the view stays\n"
+        "  inside it (render.map_reuse_margin_deg).\n"
         "  The stats' \"memory\" holds the resident memory after frame 100 (the first frame when N < 100), at\n"
         "  the end, their difference (rss_growth_mb), the peak, and 20 samples over the run."}},
       {"gl-info",

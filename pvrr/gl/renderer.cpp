@@ -308,6 +308,7 @@ struct Renderer::Impl {
     return true;
   }
   GLuint empty_vao = 0;
+  int max_texture_size = 0;  // GL_MAX_TEXTURE_SIZE
   std::vector<MeshBuffers> env_meshes;
   std::vector<bool> env_faceted;  // per environment mesh: every triangle has one normal at its three corners
   std::vector<Texture> textures;  // environment textures, in Scene::textures order
@@ -322,6 +323,7 @@ struct Renderer::Impl {
 
   Impl(const Scene& s, const RayScene& r, RendererOptions o) : scene(s), rays(r), options(std::move(o)) {
     glGenVertexArrays(1, &empty_vao);
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture_size);
     for (const pvrr::Texture& t : scene.textures) {
       ImageRGB8 image;
       image.width = t.width;
@@ -698,7 +700,8 @@ struct Renderer::Impl {
     for (ElementFrame& f : frames)
       for (PatchView& pv : f.views) {
         const int base = patchMapSize(options.map_size, std::max<size_t>(1, inView(f)));
-        const int size = 32 * int(std::ceil(1.25 * base / 32.0)), side = topLevelMapSide(scene, f, pv, options);
+        const int size = std::min(32 * int(std::ceil(1.25 * base / 32.0)), std::max(base, max_texture_size)),
+                  side = topLevelMapSide(scene, f, pv, options);
         if (pv.volume.backward) {
           out.push_back({size, side});
           continue;
@@ -1039,7 +1042,9 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
                  sameChannels(cache->elements[e].channels, opts[e].channels) &&
                  same(cache->element_to_eye[e], view * scene.elements[e].local_to_world);
     const bool all_reused = std::all_of(reuse.begin(), reuse.end(), [](bool b) { return b; });
-    const bool nothing_moved = all_reused && same(motion, Mat4(1.0)) && !cache->environment_changed;
+    // Nothing moved, and the maps this renderer holds are the ones the cached frame was drawn with.
+    const bool nothing_moved = all_reused && same(motion, Mat4(1.0)) && !cache->environment_changed &&
+                               cache->frame_serial == first_pass_serial;
     const std::string cached = "eye-fixed cache: no element moved relative to the eye";
     auto t0 = Clock::now();
     double refraction_ms = 0, texcoord_ms = 0;
@@ -1123,8 +1128,12 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   } else if (reuse_on && skip_first_pass && !cache->maps.empty()) {
     ++cache->maps_age;  // nothing moved: the same maps, one frame older
   }
-  // Maps are widened for reuse unless the last first pass could not be kept (nested passes, dark elements).
-  const bool widen = reuse_on && !cache->last_plan_nested;
+  // Maps are widened for reuse unless the last first pass could not be kept (nested passes, dark elements)
+  // or no view can be (reversed maps are never widened nor reused).
+  const bool widen = reuse_on && !cache->last_plan_nested &&
+                     std::any_of(frames.begin(), frames.end(), [](const ElementFrame& f) {
+                       return std::any_of(f.views.begin(), f.views.end(), [](const PatchView& v) { return !v.volume.backward; });
+                     });
   if (mode == RasterMode::Pvrr && !frames.empty() && skip_first_pass) {
     const std::string why = !reuse_note.empty() ? reuse_note
                                                 : "eye-fixed cache: neither the elements nor the environment moved relative to the eye";
@@ -1226,6 +1235,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     cache->view = view;
     cache->projection = ob.visibilityProjection();
     cache->elements = frames;
+    cache->frame_serial = first_pass_serial;
     cache->valid = true;
   }
 

@@ -87,6 +87,8 @@ struct FrameCache {
   int maps_age = 0;          // frames drawn from them since
   bool last_plan_nested = false;  // the last first pass had nested passes or dark elements: the next one is
                                   // not widened (its maps could not be kept)
+  uint64_t frame_serial = 0;  // the first pass whose maps `elements` were drawn with (the renderer must still
+                              // hold them for a frame that skips its first pass)
 };
 
 // The map size (longer side, texels) of each of an element's top-level patches when `patches_in_view` of them

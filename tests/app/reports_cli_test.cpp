@@ -149,7 +149,8 @@ TEST(Reports, RenderFramesDoesNotGrowResidentMemory) {
     int vertex_runs, first_pass_max, first_pass_min;
   };
   for (const Run& run : {Run{"--orbit 20 --set render.map_reuse_margin_deg=0", 500, 500, 500},
-                         Run{"--orbit 20", 500, 10, 2}, Run{"", 1, 1, 1}}) {
+                         // Measured: 2 (the first frame, then the first widened one; the mirror stays in view).
+                         Run{"--orbit 20", 500, 3, 2}, Run{"", 1, 1, 1}}) {
     const auto r = runPvrr("render models/car-mirror.json --size 32x24 --frames 500 " + run.args +
                            " --gl osmesa --set render.map_size=64 --out '" + (dir / "f.png").string() + "' --stats '" +
                            (dir / "s.json").string() + "'");
@@ -161,7 +162,7 @@ TEST(Reports, RenderFramesDoesNotGrowResidentMemory) {
     EXPECT_GT(mem["rss_end_mb"].get<double>(), 10);
     EXPECT_LT(mem["rss_growth_mb"].get<double>(), kSoakGrowthMb) << run.args << ": " << mem.dump();
     EXPECT_EQ(mem["rss_samples"].size(), 20u);
-    // Median, mean and slowest frame: with reuse the few frames that render maps make the slowest.
+    // Median, mean and slowest frame are reported (their order is all that can be asserted of timings).
     EXPECT_GT(s["frame_ms"].get<double>(), 0);
     EXPECT_GE(s["frame_ms_max"].get<double>(), s["frame_ms"].get<double>());
     EXPECT_GE(s["frame_ms_max"].get<double>(), s["frame_ms_mean"].get<double>());

@@ -338,6 +338,11 @@ TEST_P(RendererTest, MapReuseWithinTheMarginMatchesAFreshFrame) {
   note = firstPass(cached.render(gl::RasterMode::Pvrr, &cache), &ran);
   EXPECT_TRUE(ran);
   EXPECT_NE(note.find("the environment changed"), std::string::npos) << note;
+  // Nothing moved, but another first pass drew over the maps (a frame without this cache): drawn again.
+  cached.render(gl::RasterMode::Pvrr);
+  cache.environment_changed = false;
+  firstPass(cached.render(gl::RasterMode::Pvrr, &cache), &ran);
+  EXPECT_TRUE(ran) << "the maps were overwritten by a frame drawn without this cache";
   // Margin 0: every frame that moved renders its maps, unwidened.
   gl::RendererOptions off;
   off.map_reuse_margin_deg = 0;
