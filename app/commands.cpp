@@ -17,6 +17,7 @@
 #include "app/report.h"
 #include "cad/error.h"
 #include "pvrr/gl/context.h"
+#include "pvrr/format.h"
 #include "pvrr/image.h"
 #include "pvrr/scene_json.h"
 #include "pvrr/spectrum.h"
@@ -266,14 +267,6 @@ RenderedFrame renderFrame(LoadedScene& ls, const std::string& mode, const std::s
   return out;
 }
 
-namespace {
-std::string fixedMs(double ms) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3f", ms);
-  return buf;
-}
-}  // namespace
-
 int cmdRender(const std::vector<std::string>& argv) {
   Args a("render", argv, {"mode", "size", "out", "gl", "set", "stats", "frames", "orbit"}, {}, {"set"});
   if (a.positional().size() > 1) usageError("render", "expected at most one scene file");
@@ -347,8 +340,8 @@ int cmdRender(const std::vector<std::string>& argv) {
   std::printf("%s\n", out_path.c_str());
   // With several frames the mean and the slowest too: a frame that renders its maps again (map reuse) or
   // re-traces its vertices stands out from the median.
-  const std::string spread = frames > 1 ? ", median of " + std::to_string(frames) + " frames; mean " + fixedMs(mean_ms) +
-                                              " ms, slowest " + fixedMs(max_ms) + " ms"
+  const std::string spread = frames > 1 ? ", median of " + std::to_string(frames) + " frames; mean " + fmt("%.3f", mean_ms) +
+                                              " ms, slowest " + fmt("%.3f", max_ms) + " ms"
                                         : "";
   std::printf("frame time: %.3f ms (%s, %dx%d, mode %s%s)\n", frame_ms, last.gl_backend.c_str(), last.width, last.height,
               mode.c_str(), spread.c_str());

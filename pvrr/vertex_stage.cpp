@@ -48,7 +48,6 @@ std::vector<ChannelSpec> dispersionChannels(const Scene& scene, int element) {
   return dispersionChannels(scene, element, scene.render.dispersion, scene.render.spectral_samples);
 }
 
-// Both traceVertexRays: the incoming ray of vertex i starts at (*origins)[i], or at `eye` when null.
 // The reference tracer for the vertices whose rays are totally reflected inside a lens (VertexRay::traced):
 // none for a mirror or without a depth budget.
 static std::optional<Tracer> tirTracer(const RayScene& rays, const ElementFrame& f) {
@@ -70,6 +69,7 @@ static void traceTir(const Tracer& tracer, int element, VertexRay& vr, const Vec
   vr.traced_seen = entered ? t.seen : vr.hit;
 }
 
+// Both traceVertexRays: the incoming ray of vertex i starts at (*origins)[i], or at `eye` when null.
 static void traceVertexRaysFrom(const RayScene& rays, ElementFrame& f, const Vec3& eye,
                                 const std::vector<Vec3>* origins, const VertexStageOptions& opt);
 

@@ -3,19 +3,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <sstream>
 
 #include "cad/error.h"
+#include "pvrr/format.h"
 
 namespace pvrr {
 namespace {
 
-std::string fmt(const char* f, double x) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, f, x);
-  return buf;
-}
 
 void appendNote(std::string& note, const std::string& s) { note += (note.empty() ? "" : "; ") + s; }
 

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <memory>
 #include <sstream>
 
@@ -15,6 +14,7 @@
 #include <tbb/partitioner.h>
 
 #include "cad/error.h"
+#include "pvrr/format.h"
 
 namespace pvrr {
 namespace {
@@ -25,11 +25,6 @@ using Eigen::Vector3d;
 Vector3d toEigen(const Vec3& v) { return {v.x, v.y, v.z}; }
 Vec3 toGlm(const Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
-std::string fmt(const char* f, double x) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, f, x);
-  return buf;
-}
 
 // The rays, re-centred on the origins' centroid c, so that large world coordinates do not cost precision in
 // the 3x3 algebra.

@@ -7,7 +7,6 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <functional>
 #include <map>
 
@@ -15,6 +14,7 @@
 #include "pvrr/gl/gl.h"
 #include "pvrr/gl/framebuffer.h"
 #include "pvrr/gl/program.h"
+#include "pvrr/format.h"
 #include "pvrr/spectrum.h"
 
 namespace pvrr::gl {
@@ -224,13 +224,6 @@ struct PassCamera {
 uint64_t nextFirstPassSerial() {
   static std::atomic<uint64_t> serial{0};
   return ++serial;
-}
-
-// x with `digits` significant digits, for notes.
-std::string num(double x, int digits) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.*g", digits, x);
-  return buf;
 }
 
 // Whether any part of the convex hull of `points` can be inside the view volume: false only when every
@@ -622,6 +615,7 @@ struct Renderer::Impl {
       return false;
     }
     double worst_parallax = 0, worst_move = 0;
+    std::vector<char> visible(slots, 0);  // per slot: the observer sees it (the views to check and to move)
     size_t slot = 0;
     for (const ElementFrame& f : frames)
       for (size_t v = 0; v < f.views.size(); ++v, ++slot) {
@@ -630,7 +624,8 @@ struct Renderer::Impl {
           *note = "the patches changed";
           return false;
         }
-        if (!topLevelVisible(f, v)) continue;
+        visible[slot] = topLevelVisible(f, v);
+        if (!visible[slot]) continue;
         const PatchView& pv = f.views[v];
         const ViewVolume &W = m.volume, &V = pv.volume;
         if (!m.rendered || V.backward || W.backward) {
@@ -664,7 +659,7 @@ struct Renderer::Impl {
         }
         const double move = glm::length(V.eye - W.eye), parallax = move / nearest / minTexelAngle(W, m.side);
         if (!(parallax <= 0.25)) {
-          *note = "the viewpoint moved too far (parallax " + num(parallax, 2) + " texel)";
+          *note = "the viewpoint moved too far (parallax " + fmt("%.2g", parallax) + " texel)";
           return false;
         }
         const Mat4 map_clip = W.projection * W.view;
@@ -679,13 +674,13 @@ struct Renderer::Impl {
     slot = 0;
     for (ElementFrame& f : frames)
       for (size_t v = 0; v < f.views.size(); ++v, ++slot)
-        if (topLevelVisible(f, v)) {
+        if (visible[slot]) {
           f.views[v].volume = cache.maps[slot].volume;
           projectPatchMap(f, f.views[v]);
         }
     *note = "map reuse: every view lies inside the maps drawn " + std::to_string(cache.maps_age + 1) +
-            " frame(s) ago with margins of up to " + num(options.map_reuse_margin_deg, 3) + " deg; viewpoints moved <= " +
-            num(1e3 * worst_move, 3) + " mm (parallax <= " + num(worst_parallax, 3) + " texel)";
+            " frame(s) ago with margins of up to " + fmt("%.3g", options.map_reuse_margin_deg) + " deg; viewpoints moved <= " +
+            fmt("%.3g", 1e3 * worst_move) + " mm (parallax <= " + fmt("%.3g", worst_parallax) + " texel)";
     return true;
   }
 
@@ -1130,10 +1125,10 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   }
   // Maps are widened for reuse unless the last first pass could not be kept (nested passes, dark elements)
   // or no view can be (reversed maps are never widened nor reused).
-  const bool widen = reuse_on && !cache->last_plan_nested &&
-                     std::any_of(frames.begin(), frames.end(), [](const ElementFrame& f) {
-                       return std::any_of(f.views.begin(), f.views.end(), [](const PatchView& v) { return !v.volume.backward; });
-                     });
+  const bool any_forward = std::any_of(frames.begin(), frames.end(), [](const ElementFrame& f) {
+    return std::any_of(f.views.begin(), f.views.end(), [](const PatchView& v) { return !v.volume.backward; });
+  });
+  const bool widen = reuse_on && !cache->last_plan_nested && any_forward;
   if (mode == RasterMode::Pvrr && !frames.empty() && skip_first_pass) {
     const std::string why = !reuse_note.empty() ? reuse_note
                                                 : "eye-fixed cache: neither the elements nor the environment moved relative to the eye";
@@ -1180,10 +1175,11 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       note += (note.empty() ? "" : ", ") + std::to_string(n) + " x " + std::to_string(texels[0]) + "x" +
               std::to_string(texels[1]) + (texels[2] ? " RGB planes" : "");
     if (widen)
-      note += "; widened up to " + num(options.map_reuse_margin_deg, 3) + " deg for reuse (" +
+      note += "; widened up to " + fmt("%.3g", options.map_reuse_margin_deg) + " deg for reuse (" +
               (reuse_note.empty() ? std::string("the environment changed") : reuse_note) + ")";
     else if (reuse_on)
-      note += "; not widened for reuse: the last first pass had nested passes or elements drawn dark";
+      note += any_forward ? "; not widened for reuse: the last first pass had nested passes or elements drawn dark"
+                          : "; not widened for reuse: reversed (zooming) maps are not reused";
     if (rendered != int(passes.size()))
       note += (note.empty() ? "" : "; ") + std::to_string(passes.size() - size_t(rendered)) +
               " map(s) of elements outside the observer's view or beyond the depth limit not rendered";
