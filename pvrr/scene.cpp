@@ -81,6 +81,7 @@ EnvMesh makeBoxMesh(const Vec3& centre, const Vec3& size, const Mat3& rotation, 
       appendQuad(m, centre + half[a] * n, n, up, w, h, uv_scale_m);
     }
   }
+  m.closed_convex = true;
   return m;
 }
 
@@ -105,6 +106,7 @@ EnvMesh makeSphereMesh(const Vec3& centre, double radius, int slices, int stacks
       if (i < stacks - 1) m.triangles.push_back({a + 1, b, b + 1});
     }
   }
+  m.closed_convex = true;
   return m;
 }
 

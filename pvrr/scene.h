@@ -37,6 +37,10 @@ struct EnvMesh {
   std::vector<glm::vec2> uvs;
   std::vector<glm::u32vec3> triangles;
   int material = 0;
+  // The triangles bound a convex solid and wind counter-clockwise seen from outside (makeBoxMesh,
+  // makeSphereMesh): where the whole solid lies beyond a pass's near plane, its back faces are hidden by its
+  // front faces, and the renderer culls them.
+  bool closed_convex = false;
 };
 
 struct Light {

@@ -328,6 +328,43 @@ ViewVolume widenViewVolume(const ViewVolume& vv, double margin_rad, double max_f
   return w;
 }
 
+bool nearClipCannotOpen(const Vec3& lo, const Vec3& hi, const Mat4& view_proj) {
+  bool beyond = true;
+  for (int c = 0; c < 8 && beyond; ++c) {
+    const Vec4 p = view_proj * Vec4(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z, 1.0);
+    beyond = p.z + p.w > 1e-6 * std::abs(p.w);
+  }
+  if (beyond) return true;
+  // The centre of projection: clip x = y = w = 0 (rows 0, 1 and 3).
+  const glm::dmat3 a = glm::transpose(glm::dmat3(glm::dvec3(view_proj[0][0], view_proj[1][0], view_proj[2][0]),
+                                                 glm::dvec3(view_proj[0][1], view_proj[1][1], view_proj[2][1]),
+                                                 glm::dvec3(view_proj[0][3], view_proj[1][3], view_proj[2][3])));
+  if (!(std::abs(glm::determinant(a)) > 0)) return false;
+  const Vec3 centre = -glm::inverse(a) * Vec3(view_proj[3][0], view_proj[3][1], view_proj[3][3]);
+  const Mat4 inv = glm::inverse(view_proj);
+  double reach = 0;  // the farthest corner of the near rectangle
+  for (int c = 0; c < 4; ++c) {
+    const Vec4 p = inv * Vec4(c & 1 ? 1.0 : -1.0, c & 2 ? 1.0 : -1.0, -1.0, 1.0);
+    reach = std::max(reach, glm::length(Vec3(p) / p.w - centre));
+  }
+  const double gap = glm::length(glm::max(glm::max(lo - centre, centre - hi), Vec3(0.0)));
+  return std::isfinite(reach) && gap > reach * (1 + 1e-6) + 1e-12 * glm::length(centre);
+}
+
+// A triangle counter-clockwise in NDC (x right, y up, as window space), unprojected onto the plane z_ndc = 0,
+// and a point unprojected from z_ndc = -1/2. Along every ray from the centre of projection z_ndc rises from
+// -infinity, so that point lies on the centre's side of the plane: the triangle faces the centre exactly
+// when its counter-clockwise normal points to that side.
+bool facingTrianglesWindCounterClockwise(const Mat4& view_proj) {
+  const Mat4 inv = glm::inverse(view_proj);
+  auto unproject = [&](double x, double y, double z) {
+    const Vec4 p = inv * Vec4(x, y, z, 1.0);
+    return Vec3(p) / p.w;
+  };
+  const Vec3 a = unproject(0, 0, 0), b = unproject(0.5, 0, 0), c = unproject(0, 0.5, 0), centre_side = unproject(0, 0, -0.5);
+  return glm::dot(glm::cross(b - a, c - a), centre_side - a) > 0;
+}
+
 bool frustumContains(const ViewVolume& outer, const ViewVolume& inner) {
   const Mat4 clip = outer.projection * outer.view;
   for (int k = 0; k < 8; ++k) {

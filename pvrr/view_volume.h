@@ -68,6 +68,17 @@ inline unsigned clipOutcode(const Vec4& c) {
          unsigned(c.z < -c.w) << 4 | unsigned(c.z > c.w) << 5;
 }
 
+// Whether near clipping by the perspective `view_proj` can cut open no convex solid inside the box [lo, hi]
+// within the view: the box lies wholly beyond the near plane, or farther from the centre of projection than
+// every point of the near plane's rectangle in the frustum. Then every ray from that centre meets such a solid
+// beyond the near plane. Margins of 1e-6 (relative) for float clipping; pass camera-relative coordinates
+// (the renderer's) or expect double round-off of the world coordinates' magnitude.
+bool nearClipCannotOpen(const Vec3& lo, const Vec3& hi, const Mat4& view_proj);
+
+// Whether a triangle whose counter-clockwise normal points to the centre of projection of `view_proj` appears
+// counter-clockwise in window space (GL_CCW front faces). False for a projection that mirrors the image.
+bool facingTrianglesWindCounterClockwise(const Mat4& view_proj);
+
 struct ViewVolume {
   Vec3 eye{0}, forward{0, 0, -1}, up{0, 1, 0}, right{1, 0, 0};  // orthonormal, right = forward x up
   double near_m = 0, far_m = 0;  // depths along forward, 0 < near_m < far_m

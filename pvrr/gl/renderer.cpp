@@ -304,6 +304,17 @@ struct Renderer::Impl {
   int max_texture_size = 0;  // GL_MAX_TEXTURE_SIZE
   std::vector<MeshBuffers> env_meshes;
   std::vector<bool> env_faceted;  // per environment mesh: every triangle has one normal at its three corners
+  // Per closed convex environment mesh (EnvMesh::closed_convex): its bounding box, world space.
+  std::vector<std::optional<std::array<Vec3, 2>>> env_cull_bounds;
+  // Closed convex meshes drawn and culled by drawEnvironment since the last cullNote(), for the stage notes.
+  mutable int closed_drawn = 0, closed_culled = 0;
+  std::string cullNote() const {
+    std::string note = closed_drawn == 0 ? "" : "back faces culled on " + std::to_string(closed_culled) + " of " +
+                                                    std::to_string(closed_drawn) + " closed-mesh draws";
+    if (closed_drawn > 0 && !options.cull_back_faces) note = "back faces not culled (off)";
+    closed_drawn = closed_culled = 0;
+    return note;
+  }
   std::vector<Texture> textures;  // environment textures, in Scene::textures order
   std::unique_ptr<Framebuffer> frame_target;      // the second pass: colour, seen point, surface point
   std::vector<std::unique_ptr<Framebuffer>> maps;  // first-pass maps, one per patch view (reused)
@@ -352,6 +363,15 @@ struct Renderer::Impl {
         const bool perpendicular = len == 0 || std::abs(glm::dot(face / len, Vec3(n))) >= 1 - 1e-6;
         return perpendicular && glm::length(mesh.normals[t.y] - n) <= 1e-6f && glm::length(mesh.normals[t.z] - n) <= 1e-6f;
       }));
+      env_cull_bounds.emplace_back();
+      if (mesh.closed_convex && !mesh.positions.empty()) {
+        Vec3 lo(mesh.positions[0]), hi(lo);
+        for (const glm::vec3& p : mesh.positions) {
+          lo = glm::min(lo, Vec3(p));
+          hi = glm::max(hi, Vec3(p));
+        }
+        env_cull_bounds.back() = {mesh.anchor + lo, mesh.anchor + hi};
+      }
     }
     checkGlError("uploading the environment");
   }
@@ -421,10 +441,28 @@ struct Renderer::Impl {
       setLights(*p, origin);
     }
     glActiveTexture(GL_TEXTURE0);
+    // Back faces of closed convex meshes that near clipping cannot cut open (RendererOptions::cull_back_faces,
+    // nearClipCannotOpen): a ray from the centre of projection to a back-face point first crosses a front face
+    // of the same solid, itself beyond the near plane, which the depth test keeps instead. Not with reversed
+    // depth, where the farther face wins.
+    const bool may_cull = options.cull_back_faces && !reversed_depth;
+    if (may_cull) {
+      glCullFace(GL_BACK);
+      glFrontFace(facingTrianglesWindCounterClockwise(vp) ? GL_CCW : GL_CW);
+    }
+    bool culling = false;
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
       const EnvMesh& mesh = scene.meshes[m];
       const DiffuseMaterial& mat = scene.materials[size_t(mesh.material)];
       const Program& p = env_faceted[m] ? faceted : smooth;
+      const auto& bounds = env_cull_bounds[m];
+      const bool cull = may_cull && bounds && nearClipCannotOpen((*bounds)[0] - origin, (*bounds)[1] - origin, vp);
+      closed_drawn += bounds.has_value();
+      closed_culled += cull;
+      if (cull != culling) {
+        cull ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
+        culling = cull;
+      }
       p.use();
       p.set("u_offset", glm::vec3(mesh.anchor - origin));
       p.set("u_albedo", glm::vec3(mat.color));
@@ -432,6 +470,8 @@ struct Renderer::Impl {
       if (mat.texture >= 0) glBindTexture(GL_TEXTURE_2D, textures[size_t(mat.texture)].name());
       draw(env_meshes[m]);
     }
+    glDisable(GL_CULL_FACE);
+    glFrontFace(GL_CCW);
     if (!reversed_depth) {  // the sky triangle lies at depth 1: it passes only where nothing was drawn
       glDepthFunc(GL_LEQUAL);
       glDepthMask(GL_FALSE);
@@ -1006,6 +1046,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
                                     [](const Element& e) { return e.type == ElementType::Lens; });
   const size_t n_el = scene.elements.size();
   next_mesh = 0;
+  cullNote();  // reset the counts
 
   // --- CPU stages (pvrr mode) ---
   std::vector<ElementFrame> frames;
@@ -1183,6 +1224,8 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     if (rendered != int(passes.size()))
       note += (note.empty() ? "" : "; ") + std::to_string(passes.size() - size_t(rendered)) +
               " map(s) of elements outside the observer's view or beyond the depth limit not rendered";
+    const std::string culled = cullNote();
+    if (!culled.empty()) note += (note.empty() ? "" : "; ") + culled;
     out.stages.ran("first-pass", msSince(t1), rendered, note);
     const std::string dark_note =
         dark == 0 ? "" : std::to_string(dark) + " element(s) in a map drawn dark (" +
@@ -1215,7 +1258,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       }
     }
     glFinish();
-    out.stages.ran("first-pass", msSince(t0));
+    out.stages.ran("first-pass", msSince(t0), -1, cullNote());
     out.stages.skipped("nested-passes", "mode envmap: other elements are absent from the cube maps");
   } else {
     out.stages.skipped("first-pass", n_el == 0 ? "no mirror or lens in the scene" : "mode raster");
@@ -1295,7 +1338,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   drawEnvironment(view, proj, ob.eye);
   glFinish();
   checkGlError("rendering a frame");
-  out.stages.ran("second-pass", msSince(t0));
+  out.stages.ran("second-pass", msSince(t0), -1, cullNote());
   if (options.seen_points)
     out.stages.ran("seen-points", 0, -1, "world-position attachments in every pass (for accuracy reports)");
   else

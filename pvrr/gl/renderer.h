@@ -59,6 +59,11 @@ struct RendererOptions {
   // quarter texel of parallax, draw from it without a first pass (stage "first-pass" says why, or why not).
   // 0: every frame that moved renders its maps.
   double map_reuse_margin_deg = 2;
+  // Cull the back faces of closed convex environment meshes (EnvMesh::closed_convex: boxes, spheres) in each
+  // pass where the whole mesh lies beyond the near plane and depth is not reversed. The picture is the same
+  // (the front faces hide the back faces), but for depth ties on silhouettes, where the front face now wins,
+  // as in the tracer; false draws every face, for the tests that compare.
+  bool cull_back_faces = true;
 };
 
 // Reuse across frames (paper section 5, eye-fixed caching): when an element has not moved relative to the
