@@ -304,8 +304,7 @@ struct Renderer::Impl {
   int max_texture_size = 0;  // GL_MAX_TEXTURE_SIZE
   std::vector<MeshBuffers> env_meshes;
   std::vector<bool> env_faceted;  // per environment mesh: every triangle has one normal at its three corners
-  // Per closed convex environment mesh (EnvMesh::closed_convex): its bounding box, world space.
-  std::vector<std::optional<std::array<Vec3, 2>>> env_cull_bounds;
+  std::vector<std::array<Vec3, 2>> env_bounds;  // per environment mesh: its bounding box, world space
   // Closed convex meshes drawn and culled by drawEnvironment since the last cullNote(), for the stage notes.
   mutable int closed_drawn = 0, closed_culled = 0;
   std::string cullNote() const {
@@ -363,15 +362,12 @@ struct Renderer::Impl {
         const bool perpendicular = len == 0 || std::abs(glm::dot(face / len, Vec3(n))) >= 1 - 1e-6;
         return perpendicular && glm::length(mesh.normals[t.y] - n) <= 1e-6f && glm::length(mesh.normals[t.z] - n) <= 1e-6f;
       }));
-      env_cull_bounds.emplace_back();
-      if (mesh.closed_convex && !mesh.positions.empty()) {
-        Vec3 lo(mesh.positions[0]), hi(lo);
-        for (const glm::vec3& p : mesh.positions) {
-          lo = glm::min(lo, Vec3(p));
-          hi = glm::max(hi, Vec3(p));
-        }
-        env_cull_bounds.back() = {mesh.anchor + lo, mesh.anchor + hi};
+      Vec3 lo(mesh.positions.empty() ? glm::vec3(0) : mesh.positions[0]), hi(lo);
+      for (const glm::vec3& p : mesh.positions) {
+        lo = glm::min(lo, Vec3(p));
+        hi = glm::max(hi, Vec3(p));
       }
+      env_bounds.push_back({mesh.anchor + lo, mesh.anchor + hi});
     }
     checkGlError("uploading the environment");
   }
@@ -455,9 +451,9 @@ struct Renderer::Impl {
       const EnvMesh& mesh = scene.meshes[m];
       const DiffuseMaterial& mat = scene.materials[size_t(mesh.material)];
       const Program& p = env_faceted[m] ? faceted : smooth;
-      const auto& bounds = env_cull_bounds[m];
-      const bool cull = may_cull && bounds && nearClipCannotOpen((*bounds)[0] - origin, (*bounds)[1] - origin, vp);
-      closed_drawn += bounds.has_value();
+      const Vec3 lo = env_bounds[m][0] - origin, hi = env_bounds[m][1] - origin;  // camera-relative
+      const bool cull = may_cull && mesh.closed_convex && nearClipCannotOpen(lo, hi, vp);
+      closed_drawn += mesh.closed_convex;
       closed_culled += cull;
       if (cull != culling) {
         cull ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
