@@ -26,12 +26,18 @@ Vector3d toEigen(const Vec3& v) { return {v.x, v.y, v.z}; }
 Vec3 toGlm(const Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
 
+// Rays a lane group of the vectorised evaluation (evaluateRange).
+constexpr size_t kLanes = 8;
+
 // The rays, re-centred on the origins' centroid c, so that large world coordinates do not cost precision in
 // the 3x3 algebra.
 struct Data {
   Vector3d centroid{0, 0, 0};
   Vector3d mean_dir{0, 0, 1};  // normalised mean of the directions
   std::vector<Vector3d> o, d, h;  // o and h relative to centroid, d unit
+  // h and d again, one array per coordinate, for the vectorised evaluation (evaluateRange), padded with
+  // kLanes rays of weight 0 (`live`: 1 for the rays, 0 for the padding) for a range's last lane group.
+  std::vector<double> hx, hy, hz, dx, dy, dz, live;
   double patch_radius_m = 0;   // max distance of an origin from the axis (centroid, mean_dir)
   double spread_rad = 0;       // max angle between a direction and mean_dir
   size_t size() const { return d.size(); }
@@ -79,6 +85,14 @@ Data prepare(const std::vector<ViewpointRay>& rays) {
     if (key > key_max) key_max = key, widest = i;
   }
   D.patch_radius_m = std::sqrt(radius2);
+  const size_t padded = n + kLanes;
+  for (auto* a : {&D.hx, &D.hy, &D.hz, &D.dx, &D.dy, &D.dz, &D.live}) a->assign(padded, 0.0);
+  for (size_t i = 0; i < padded; ++i) {
+    const size_t j = i < n ? i : 0;  // the padding repeats the first ray, with weight 0
+    D.hx[i] = D.h[j].x(), D.hy[i] = D.h[j].y(), D.hz[i] = D.h[j].z();
+    D.dx[i] = D.d[j].x(), D.dy[i] = D.d[j].y(), D.dz[i] = D.d[j].z();
+    D.live[i] = i < n ? 1.0 : 0.0;
+  }
   D.spread_rad = std::atan2(D.d[widest].cross(D.mean_dir).norm(), D.d[widest].dot(D.mean_dir));
   return D;
 }
@@ -132,36 +146,77 @@ struct Partial {
   }
 };
 
+// evaluateRange in lanes: kLanes rays at a time, each lane's terms computed branch-free (so that the
+// compiler vectorises the loops) and summed into its own accumulator; the lanes are added in a fixed order at
+// the end. Where the Cauchy argument x reaches 0.5, log1pFast's series gives way to std::log1p, lane by
+// lane. The same operations in the same order whatever the instruction set: x86-64 builds carry an AVX2
+// clone chosen at run time, with bit-identical results.
+// The terms of one ray: the data cost, then H's six entries and g's three.
+constexpr int kTerms = 10;
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define PVRR_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define PVRR_VECTOR_CLONES
+#endif
+
+// The series part of log1pFast for x in [0, 0.5) (its argument clamped there), lane-wise.
+inline double log1pSeries(double x) {
+  const double z = x / (2.0 + x), z2 = z * z;
+  double series = 1.0 / 21;
+  for (int k = 19; k >= 1; k -= 2) series = 1.0 / k + z2 * series;
+  return 2.0 * z * series;
+}
+
+PVRR_VECTOR_CLONES
 Partial evaluateRange(const Data& D, const Vector3d& e, double b, bool derivatives, size_t begin, size_t end) {
-  Partial P;
-  const double inv_b = b > 0 ? 1.0 / b : 0.0;
-  for (size_t i = begin; i < end; ++i) {
-    const Vector3d& d = D.d[i];
-    const double vx = D.h[i].x() - e.x(), vy = D.h[i].y() - e.y(), vz = D.h[i].z() - e.z();
-    const double n2 = vx * vx + vy * vy + vz * vz;
-    if (!(n2 > 0)) continue;  // hit point exactly at the eye: no direction, no residual
-    const double inv_n = 1.0 / std::sqrt(n2);
-    const double ux = vx * inv_n, uy = vy * inv_n, uz = vz * inv_n;
-    const double du = ux * d.x() + uy * d.y() + uz * d.z();
-    const double px = ux - du * d.x(), py = uy - du * d.y(), pz = uz - du * d.z();
-    const double s = px * px + py * py + pz * pz;
-    const double x = s * inv_b;
-    P.sum += b > 0 ? b * log1pFast(x) : s;
-    if (!derivatives) continue;
-    const double w = 1.0 / (1.0 + x);  // rho'
-    const double qx = d.x() - du * ux, qy = d.y() - du * uy, qz = d.z() - du * uz;
-    const double jx = -(px - s * ux) * inv_n, jy = -(py - s * uy) * inv_n, jz = -(pz - s * uz) * inv_n;  // J^T r
-    const double c = w * inv_n * inv_n;
-    double k = 0;  // coefficient of (J^T r)(J^T r)^T
-    if (b > 0 && s > 0) k = (std::max(w - 2.0 * x * w * w, 0.0) - w) / s;
-    P.hxx += c * (1 - ux * ux - qx * qx) + k * jx * jx;
-    P.hxy += c * (-ux * uy - qx * qy) + k * jx * jy;
-    P.hxz += c * (-ux * uz - qx * qz) + k * jx * jz;
-    P.hyy += c * (1 - uy * uy - qy * qy) + k * jy * jy;
-    P.hyz += c * (-uy * uz - qy * qz) + k * jy * jz;
-    P.hzz += c * (1 - uz * uz - qz * qz) + k * jz * jz;
-    P.gx += w * jx, P.gy += w * jy, P.gz += w * jz;
+  const double inv_b = b > 0 ? 1.0 / b : 0.0, ex = e.x(), ey = e.y(), ez = e.z();
+  const double* hx = D.hx.data(), *hy = D.hy.data(), *hz = D.hz.data();
+  const double* dx = D.dx.data(), *dy = D.dy.data(), *dz = D.dz.data(), *live = D.live.data();
+  double acc[kTerms][kLanes] = {};
+  for (size_t base = begin; base < end; base += kLanes) {  // lanes past `end` get weight 0
+    double t[kTerms][kLanes], xs[kLanes];
+    for (size_t l = 0; l < kLanes; ++l) {
+      const size_t i = base + l;
+      const double vx = hx[i] - ex, vy = hy[i] - ey, vz = hz[i] - ez;
+      const double n2 = vx * vx + vy * vy + vz * vz;
+      // A hit point exactly at the eye has no direction, and padding has weight 0: inv_n = 0 zeroes every term.
+      const double inv_n = (n2 > 0 && i < end ? live[i] : 0.0) / std::sqrt(n2 > 0 ? n2 : 1.0);
+      const double ux = vx * inv_n, uy = vy * inv_n, uz = vz * inv_n;
+      const double du = ux * dx[i] + uy * dy[i] + uz * dz[i];
+      const double px = ux - du * dx[i], py = uy - du * dy[i], pz = uz - du * dz[i];
+      const double s = px * px + py * py + pz * pz;
+      const double x = s * inv_b;
+      xs[l] = x;
+      t[0][l] = b > 0 ? b * log1pSeries(std::min(x, 0.5)) : s;
+      const double w = 1.0 / (1.0 + x);  // rho'
+      const double qx = dx[i] - du * ux, qy = dy[i] - du * uy, qz = dz[i] - du * uz;
+      const double jx = -(px - s * ux) * inv_n, jy = -(py - s * uy) * inv_n, jz = -(pz - s * uz) * inv_n;  // J^T r
+      const double c = w * inv_n * inv_n;
+      // coefficient of (J^T r)(J^T r)^T
+      const double k = (b > 0 && s > 0 ? 1.0 : 0.0) * ((std::max(w - 2.0 * x * w * w, 0.0) - w) / (s > 0 ? s : 1.0));
+      t[1][l] = c * (1 - ux * ux - qx * qx) + k * jx * jx;
+      t[2][l] = c * (-ux * uy - qx * qy) + k * jx * jy;
+      t[3][l] = c * (-ux * uz - qx * qz) + k * jx * jz;
+      t[4][l] = c * (1 - uy * uy - qy * qy) + k * jy * jy;
+      t[5][l] = c * (-uy * uz - qy * qz) + k * jy * jz;
+      t[6][l] = c * (1 - uz * uz - qz * qz) + k * jz * jz;
+      t[7][l] = w * jx, t[8][l] = w * jy, t[9][l] = w * jz;
+    }
+    if (b > 0)
+      for (size_t l = 0; l < kLanes; ++l)
+        if (!(xs[l] < 0.5)) t[0][l] = b * std::log1p(xs[l]);
+    const int terms = derivatives ? kTerms : 1;
+    for (int j = 0; j < terms; ++j)
+      for (size_t l = 0; l < kLanes; ++l) acc[j][l] += t[j][l];
   }
+  double sum[kTerms] = {};
+  for (int j = 0; j < kTerms; ++j)
+    for (size_t l = 0; l < kLanes; ++l) sum[j] += acc[j][l];
+  Partial P;
+  P.sum = sum[0];
+  P.hxx = sum[1], P.hxy = sum[2], P.hxz = sum[3], P.hyy = sum[4], P.hyz = sum[5], P.hzz = sum[6];
+  P.gx = sum[7], P.gy = sum[8], P.gz = sum[9];
   return P;
 }
 

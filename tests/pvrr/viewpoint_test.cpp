@@ -296,6 +296,35 @@ TEST(Viewpoint, ParallelEvaluationIsBitIdenticalToOneThread) {
   EXPECT_EQ(many.iterations, one.iterations);
 }
 
+// The cost is evaluated in lane groups of 8 (vectorised, with padding and parallel blocks of 512 rays): against
+// the definition evaluated ray by ray in long double, with and without the Cauchy loss, for sizes that end
+// mid-group, on a group, and across blocks, with one hit point exactly at the eye (it contributes nothing).
+TEST(Viewpoint, AngularCostMatchesTheDefinitionRayByRay) {
+  const Vec3 eye(0.3, 0.2, 1.0);
+  for (int grid : {2, 3, 4, 33, 45, 64}) {  // 4, 9, 16, 1089, 2025, 4096 rays
+    auto rays = sphereMirror(eye, Vec3(0), Vec3(0, 0, 1), 1.2, true, 0.12, grid, 2.0, 9.0);
+    const Vec3 probe = eye + Vec3(0.01, -0.02, 0.015);
+    rays.back().hit = probe;  // a hit point at the evaluated eye
+    for (double scale : {0.0, 0.002, 0.02}) {
+      long double expected = 0;
+      for (const ViewpointRay& r : rays) {
+        const Vec3 v = r.hit - probe;
+        const double len = glm::length(v);
+        if (!(len > 0)) continue;
+        const Vec3 u = v / len, d = glm::normalize(r.direction);
+        const Vec3 p = u - glm::dot(u, d) * d;
+        const long double sq = glm::dot(p, p);
+        const long double b = (long double)scale * scale;
+        expected += b > 0 ? b * std::log1p(sq / b) : sq;
+      }
+      expected *= 0.5L;
+      const double got = viewpointAngularCost(rays, probe, scale);
+      EXPECT_NEAR(got, double(expected), 1e-12 * double(expected) + 1e-300)
+          << rays.size() << " rays, scale " << scale;
+    }
+  }
+}
+
 TEST(Viewpoint, RobustLossDownWeightsEscapedRaysWithWrongFarPoints) {
   const Vec3 n(0, 0, 1), p0(0, 0, 0), eye(0.2, 0.1, 1.0);
   const Vec3 image = eye - 2.0 * glm::dot(eye - p0, n) * n;
