@@ -81,7 +81,12 @@ EnvMesh makeBoxMesh(const Vec3& centre, const Vec3& size, const Mat3& rotation, 
       appendQuad(m, centre + half[a] * n, n, up, w, h, uv_scale_m);
     }
   }
-  m.closed_convex = true;
+  // A closed solid only with a positive size (a negative one faces its quads inward) and orthonormal axes
+  // (each face builds its own frame from its normal, so a reflection still winds outward).
+  bool orthonormal = true;
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) orthonormal = orthonormal && std::abs(glm::dot(ax[a], ax[b]) - (a == b)) < 1e-9;
+  m.closed_convex = size.x > 0 && size.y > 0 && size.z > 0 && orthonormal;
   return m;
 }
 
@@ -106,7 +111,7 @@ EnvMesh makeSphereMesh(const Vec3& centre, double radius, int slices, int stacks
       if (i < stacks - 1) m.triangles.push_back({a + 1, b, b + 1});
     }
   }
-  m.closed_convex = true;
+  m.closed_convex = radius > 0 && slices >= 3 && stacks >= 2;
   return m;
 }
 

@@ -38,8 +38,8 @@ struct EnvMesh {
   std::vector<glm::u32vec3> triangles;
   int material = 0;
   // The triangles bound a convex solid and wind counter-clockwise seen from outside (makeBoxMesh,
-  // makeSphereMesh): where the whole solid lies beyond a pass's near plane, its back faces are hidden by its
-  // front faces, and the renderer culls them.
+  // makeSphereMesh): where near clipping cannot cut the solid open, its back faces are hidden by its front
+  // faces, and the renderer culls them (RendererOptions::cull_back_faces).
   bool closed_convex = false;
 };
 

@@ -328,27 +328,30 @@ ViewVolume widenViewVolume(const ViewVolume& vv, double margin_rad, double max_f
   return w;
 }
 
-bool nearClipCannotOpen(const Vec3& lo, const Vec3& hi, const Mat4& view_proj) {
+NearClip::NearClip(const Mat4& view_proj) : view_proj_(view_proj) {
+  const Mat4 inv = glm::inverse(view_proj);
+  const Vec4 c = inv * Vec4(0, 0, 1, 0);  // the centre of projection: clip x = y = w = 0
+  if (!(std::abs(c.w) > 0)) return;
+  centre_ = Vec3(c) / c.w;
+  double reach = 0;
+  for (int k = 0; k < 4; ++k) {
+    const Vec4 p = inv * Vec4(k & 1 ? 1.0 : -1.0, k & 2 ? 1.0 : -1.0, -1.0, 1.0);
+    reach = std::max(reach, glm::length(Vec3(p) / p.w - centre_));
+  }
+  if (isFinite(centre_) && std::isfinite(reach)) reach_ = reach;
+}
+
+bool NearClip::cannotOpen(const Vec3& lo, const Vec3& hi) const {
+  const double size = glm::length(hi - lo) + std::max(glm::length(lo), glm::length(hi));
   bool beyond = true;
   for (int c = 0; c < 8 && beyond; ++c) {
-    const Vec4 p = view_proj * Vec4(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z, 1.0);
-    beyond = p.z + p.w > 1e-6 * std::abs(p.w);
+    const Vec4 p = view_proj_ * Vec4(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z, 1.0);
+    beyond = p.z + p.w > 1e-6 * (std::abs(p.w) + size);
   }
   if (beyond) return true;
-  // The centre of projection: clip x = y = w = 0 (rows 0, 1 and 3).
-  const glm::dmat3 a = glm::transpose(glm::dmat3(glm::dvec3(view_proj[0][0], view_proj[1][0], view_proj[2][0]),
-                                                 glm::dvec3(view_proj[0][1], view_proj[1][1], view_proj[2][1]),
-                                                 glm::dvec3(view_proj[0][3], view_proj[1][3], view_proj[2][3])));
-  if (!(std::abs(glm::determinant(a)) > 0)) return false;
-  const Vec3 centre = -glm::inverse(a) * Vec3(view_proj[3][0], view_proj[3][1], view_proj[3][3]);
-  const Mat4 inv = glm::inverse(view_proj);
-  double reach = 0;  // the farthest corner of the near rectangle
-  for (int c = 0; c < 4; ++c) {
-    const Vec4 p = inv * Vec4(c & 1 ? 1.0 : -1.0, c & 2 ? 1.0 : -1.0, -1.0, 1.0);
-    reach = std::max(reach, glm::length(Vec3(p) / p.w - centre));
-  }
-  const double gap = glm::length(glm::max(glm::max(lo - centre, centre - hi), Vec3(0.0)));
-  return std::isfinite(reach) && gap > reach * (1 + 1e-6) + 1e-12 * glm::length(centre);
+  if (reach_ < 0) return false;
+  const double gap = glm::length(glm::max(glm::max(lo - centre_, centre_ - hi), Vec3(0.0)));
+  return gap > reach_ * (1 + 1e-6) + 1e-6 * size;
 }
 
 // A triangle counter-clockwise in NDC (x right, y up, as window space), unprojected onto the plane z_ndc = 0,

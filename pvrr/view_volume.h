@@ -68,12 +68,22 @@ inline unsigned clipOutcode(const Vec4& c) {
          unsigned(c.z < -c.w) << 4 | unsigned(c.z > c.w) << 5;
 }
 
-// Whether near clipping by the perspective `view_proj` can cut open no convex solid inside the box [lo, hi]
-// within the view: the box lies wholly beyond the near plane, or farther from the centre of projection than
-// every point of the near plane's rectangle in the frustum. Then every ray from that centre meets such a solid
-// beyond the near plane. Margins of 1e-6 (relative) for float clipping; pass camera-relative coordinates
-// (the renderer's) or expect double round-off of the world coordinates' magnitude.
-bool nearClipCannotOpen(const Vec3& lo, const Vec3& hi, const Mat4& view_proj);
+// Whether near clipping by the perspective `view_proj` can cut open a convex solid inside a box [lo, hi] within
+// the view. It cannot when the box lies wholly beyond the near plane, or farther from the centre of projection
+// than every point of the near plane's rectangle in the frustum: every ray from the centre then meets such a
+// solid, if at all, only beyond the near plane. Built once per pass. The margins (1e-6 of the distances and
+// of the box's size and place) cover float rounding on the GPU; pass camera-relative coordinates (the
+// renderer's).
+class NearClip {
+ public:
+  explicit NearClip(const Mat4& view_proj);
+  bool cannotOpen(const Vec3& lo, const Vec3& hi) const;
+
+ private:
+  Mat4 view_proj_;
+  Vec3 centre_{0};
+  double reach_ = -1;  // the near rectangle's farthest corner from the centre; < 0: no finite centre
+};
 
 // Whether a triangle whose counter-clockwise normal points to the centre of projection of `view_proj` appears
 // counter-clockwise in window space (GL_CCW front faces). False for a projection that mirrors the image.

@@ -304,7 +304,7 @@ struct Renderer::Impl {
   int max_texture_size = 0;  // GL_MAX_TEXTURE_SIZE
   std::vector<MeshBuffers> env_meshes;
   std::vector<bool> env_faceted;  // per environment mesh: every triangle has one normal at its three corners
-  std::vector<std::array<Vec3, 2>> env_bounds;  // per environment mesh: its bounding box, world space
+  std::vector<std::array<Vec3, 2>> env_bounds;  // per environment mesh: its bounding box, relative to its anchor
   // Closed convex meshes drawn and culled by drawEnvironment since the last cullNote(), for the stage notes.
   mutable int closed_drawn = 0, closed_culled = 0;
   std::string cullNote() const {
@@ -367,7 +367,7 @@ struct Renderer::Impl {
         lo = glm::min(lo, Vec3(p));
         hi = glm::max(hi, Vec3(p));
       }
-      env_bounds.push_back({mesh.anchor + lo, mesh.anchor + hi});
+      env_bounds.push_back({lo, hi});
     }
     checkGlError("uploading the environment");
   }
@@ -438,10 +438,12 @@ struct Renderer::Impl {
     }
     glActiveTexture(GL_TEXTURE0);
     // Back faces of closed convex meshes that near clipping cannot cut open (RendererOptions::cull_back_faces,
-    // nearClipCannotOpen): a ray from the centre of projection to a back-face point first crosses a front face
+    // NearClip): a ray from the centre of projection to a back-face point first crosses a front face
     // of the same solid, itself beyond the near plane, which the depth test keeps instead. Not with reversed
     // depth, where the farther face wins.
     const bool may_cull = options.cull_back_faces && !reversed_depth;
+    const NearClip near_clip(vp);
+    glDisable(GL_CULL_FACE);  // whatever an interrupted pass left
     if (may_cull) {
       glCullFace(GL_BACK);
       glFrontFace(facingTrianglesWindCounterClockwise(vp) ? GL_CCW : GL_CW);
@@ -451,8 +453,8 @@ struct Renderer::Impl {
       const EnvMesh& mesh = scene.meshes[m];
       const DiffuseMaterial& mat = scene.materials[size_t(mesh.material)];
       const Program& p = env_faceted[m] ? faceted : smooth;
-      const Vec3 lo = env_bounds[m][0] - origin, hi = env_bounds[m][1] - origin;  // camera-relative
-      const bool cull = may_cull && mesh.closed_convex && nearClipCannotOpen(lo, hi, vp);
+      const Vec3 lo = env_bounds[m][0] + (mesh.anchor - origin), hi = env_bounds[m][1] + (mesh.anchor - origin);  // camera-relative
+      const bool cull = may_cull && mesh.closed_convex && near_clip.cannotOpen(lo, hi);
       closed_drawn += mesh.closed_convex;
       closed_culled += cull;
       if (cull != culling) {

@@ -60,9 +60,11 @@ struct RendererOptions {
   // 0: every frame that moved renders its maps.
   double map_reuse_margin_deg = 2;
   // Cull the back faces of closed convex environment meshes (EnvMesh::closed_convex: boxes, spheres) in each
-  // pass where the whole mesh lies beyond the near plane and depth is not reversed. The picture is the same
-  // (the front faces hide the back faces), but for depth ties on silhouettes, where the front face now wins,
-  // as in the tracer; false draws every face, for the tests that compare.
+  // pass whose depth is not reversed, where near clipping cannot cut the mesh open (NearClip: wholly beyond
+  // the near plane, or out of the near rectangle's reach). The picture is the same, but where a back face tied
+  // with a front face in depth (on silhouettes, or over thin or distant solids that the depth buffer cannot
+  // separate): the front face now wins there, as in the tracer. false draws every face, for the tests that
+  // compare.
   bool cull_back_faces = true;
 };
 

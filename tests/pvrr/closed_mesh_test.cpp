@@ -2,7 +2,10 @@
 // tested here against closed forms: the builders' meshes are closed, convex and wound counter-clockwise seen
 // from outside; nearClipCannotOpen tells when near clipping can cut such a solid open; and
 // facingTrianglesWindCounterClockwise tells which window-space winding a triangle facing the camera has.
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <string>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
@@ -27,7 +30,7 @@ void expectClosedConvexOutward(const EnvMesh& m, double volume_m3, const std::st
     area_sum += 0.5 * n;
     volume += glm::dot(a, glm::cross(b, c)) / 6.0;
     const double len = glm::length(n);
-    if (len < 1e-12) continue;  // a pole's degenerate triangle
+    if (len < 1e-12) continue;  // none in these meshes; no plane to test against
     for (const glm::vec3& p : m.positions) behind_violations += glm::dot(Vec3(p) - a, n / len) > 1e-5 * scale;
   }
   EXPECT_LT(glm::length(area_sum), 1e-5 * scale * scale) << what << ": not closed";
@@ -46,6 +49,13 @@ TEST(ClosedConvexMesh, BoxesAndSpheresAreClosedConvexAndWoundOutward) {
     volume += glm::dot(Vec3(sphere.positions[t.x]), glm::cross(Vec3(sphere.positions[t.y]), Vec3(sphere.positions[t.z]))) / 6.0;
   EXPECT_GT(volume, 0.985 * 4.0 / 3.0 * kPi * std::pow(0.75, 3));
   expectClosedConvexOutward(sphere, volume, "sphere");
+  // Not solids to cull: inside out (a negative size), sheared axes, too few facets.
+  EXPECT_FALSE(makeBoxMesh(Vec3(0), Vec3(1, -1, 1), Mat3(1.0)).closed_convex);
+  EXPECT_FALSE(makeBoxMesh(Vec3(0), Vec3(1), Mat3(Vec3(1, 0, 0), Vec3(0.3, 1, 0), Vec3(0, 0, 1))).closed_convex);
+  EXPECT_TRUE(makeBoxMesh(Vec3(0), Vec3(1), Mat3(Vec3(-1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1))).closed_convex);
+  expectClosedConvexOutward(makeBoxMesh(Vec3(0), Vec3(1, 2, 3), Mat3(Vec3(-1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1))), 6,
+                            "mirrored axes");
+  EXPECT_FALSE(makeSphereMesh(Vec3(0), 1.0, 2, 24).closed_convex);
   // A quad (a ground, a sign) is two-sided: never culled.
   EXPECT_FALSE(makeQuadMesh(Vec3(0), Vec3(0, 1, 0), Vec3(0, 0, 1), 2, 2).closed_convex);
 }
@@ -56,25 +66,37 @@ Mat4 cameraAtOrigin(const Vec3& eye = Vec3(0)) {
   return glm::perspective(kPi / 2, 1.0, 0.1, 100.0) * glm::lookAt(eye, eye + Vec3(0, 0, -1), Vec3(0, 1, 0));
 }
 
-TEST(NearClipCannotOpen, WhollyBeyondTheNearPlaneOrBeyondTheNearRectanglesReach) {
-  const Mat4 vp = cameraAtOrigin();
-  // Wholly beyond the near plane (z < -0.1), even far off to the side and behind nothing.
-  EXPECT_TRUE(nearClipCannotOpen(Vec3(-1, -1, -3), Vec3(1, 1, -0.11), vp));
-  EXPECT_TRUE(nearClipCannotOpen(Vec3(50, -1, -3), Vec3(51, 1, -0.2), vp));
+TEST(NearClip, CannotOpenBoxesWhollyBeyondTheNearPlaneOrBeyondTheNearRectanglesReach) {
+  const NearClip clip(cameraAtOrigin());
+  // Wholly beyond the near plane (z < -0.1), even far off to the side.
+  EXPECT_TRUE(clip.cannotOpen(Vec3(-1, -1, -3), Vec3(1, 1, -0.11)));
+  EXPECT_TRUE(clip.cannotOpen(Vec3(50, -1, -3), Vec3(51, 1, -0.2)));
+  // Beyond it by less than the margin (1e-6 of the box's size and place): not counted as beyond, and within
+  // the rectangle's reach.
+  EXPECT_FALSE(clip.cannotOpen(Vec3(-1, -1, -3), Vec3(1, 1, -0.1 - 1e-9)));
   // Reaching in front of the near plane, but farther from the camera than the rectangle's corners (0.1732).
-  EXPECT_TRUE(nearClipCannotOpen(Vec3(0.18, -1, -1), Vec3(2, 1, 1), vp));
-  EXPECT_TRUE(nearClipCannotOpen(Vec3(-5, -5, 0.2), Vec3(5, 5, 1), vp));  // wholly behind the camera
+  EXPECT_TRUE(clip.cannotOpen(Vec3(0.18, -1, -1), Vec3(2, 1, 1)));
+  EXPECT_TRUE(clip.cannotOpen(Vec3(-5, -5, 0.2), Vec3(5, 5, 1)));  // wholly behind the camera
   // Within reach of the rectangle, while crossing the near plane: it may be cut open.
-  EXPECT_FALSE(nearClipCannotOpen(Vec3(0.15, -1, -1), Vec3(2, 1, 1), vp));
-  EXPECT_FALSE(nearClipCannotOpen(Vec3(0.05, 0.05, -0.5), Vec3(0.5, 0.5, -0.05), vp));
+  EXPECT_FALSE(clip.cannotOpen(Vec3(0.15, -1, -1), Vec3(2, 1, 1)));
+  EXPECT_FALSE(clip.cannotOpen(Vec3(0.05, 0.05, -0.5), Vec3(0.5, 0.5, -0.05)));
+  EXPECT_FALSE(clip.cannotOpen(Vec3(0.17, -1, -1), Vec3(2, 1, 1)));  // just inside the reach
   // The camera inside the box (a room): never.
-  EXPECT_FALSE(nearClipCannotOpen(Vec3(-3, -3, -3), Vec3(3, 3, 3), vp));
-  // The same, far from the origin (camera-relative care: the decision must not change at 1e6 m).
-  const Vec3 far(1e6, -2e6, 5e5);
-  const Mat4 vp_far = cameraAtOrigin(far);
-  EXPECT_TRUE(nearClipCannotOpen(far + Vec3(0.18, -1, -1), far + Vec3(2, 1, 1), vp_far));
-  EXPECT_FALSE(nearClipCannotOpen(far + Vec3(0.15, -1, -1), far + Vec3(2, 1, 1), vp_far));
-  EXPECT_FALSE(nearClipCannotOpen(far + Vec3(-3), far + Vec3(3), vp_far));
+  EXPECT_FALSE(clip.cannotOpen(Vec3(-3, -3, -3), Vec3(3, 3, 3)));
+  // An asymmetric frustum looking along another axis, from another place: the reach is that of its own
+  // near rectangle (corners at near 0.05 and the frustum's extents).
+  const Vec3 eye(1, 2, 3);
+  const Mat4 view = glm::lookAt(eye, Vec3(-4, 1, 0), Vec3(0, 1, 0));
+  const NearClip oblique(glm::frustum(-0.02, 0.3, 0.1, 0.25, 0.05, 80.0) * view);
+  const double reach = glm::length(Vec3(0.3, 0.25, 0.05));
+  const Vec3 back = Vec3(glm::inverse(view) * Vec4(0, 0, 1, 0));  // behind the camera
+  auto boxAlong = [&](double from, double to) {  // the box around the segment eye + [from, to] back
+    const Vec3 a = eye + from * back, b = eye + to * back;
+    return std::array<Vec3, 2>{glm::min(a, b) - Vec3(0.005), glm::max(a, b) + Vec3(0.005)};
+  };
+  const auto out_of_reach = boxAlong(reach + 0.02, reach + 0.5), within = boxAlong(reach - 0.01, reach + 0.5);
+  EXPECT_TRUE(oblique.cannotOpen(out_of_reach[0], out_of_reach[1]));
+  EXPECT_FALSE(oblique.cannotOpen(within[0], within[1]));
 }
 
 TEST(FacingTriangles, WindCounterClockwiseUnlessTheProjectionMirrors) {
