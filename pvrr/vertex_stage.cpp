@@ -201,6 +201,7 @@ std::vector<ViewpointRay> patchRays(const ElementFrame& f, const cad::GridPatch&
   const std::vector<VertexRay>& rs = f.rays[f.rays.size() / 2];  // the middle (green) channel, or the only one
   std::vector<ViewpointRay> kept, all;
   kept.reserve(gp.vertices.size());
+  all.reserve(gp.vertices.size());
   for (uint32_t vi : gp.vertices) {
     all.push_back(ViewpointRay{rs[vi].origin, rs[vi].dir, rs[vi].hit});
     if (rs[vi].status != VertexStatus::Tir) kept.push_back(all.back());
@@ -339,10 +340,12 @@ std::vector<PatchView::ViewEdgeSample> viewEdge(const cad::GridPatch& gp, const 
 // buildPatchMap with the rays of what the viewer sees (seenRays; all the patch's rays without a viewer).
 // A corner of a triangle seen in part whose hit lies behind the narrowed map camera would get a placeholder
 // texture coordinate and colour the seen part of its triangle: its own ray then goes into the volume too.
-void buildSeenPatchMap(const Scene& scene, const ElementFrame& f, const Element& el, PatchView& pv) {
+// `all_rays`: patchRays of the patch when the caller has them.
+void buildSeenPatchMap(const Scene& scene, const ElementFrame& f, const Element& el, PatchView& pv,
+                       const std::vector<ViewpointRay>* all_rays = nullptr) {
   const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
   pv.rays_out_of_view = 0;
-  if (f.in_view.empty()) return buildPatchMap(scene, f, el, pv, patchRays(f, gp, nullptr));
+  if (f.in_view.empty()) return buildPatchMap(scene, f, el, pv, all_rays ? *all_rays : patchRays(f, gp, nullptr));
   std::vector<ViewpointRay> rays = seenRays(f, gp, pv, &pv.rays_out_of_view);
   buildPatchMap(scene, f, el, pv, rays);
   const std::vector<VertexRay>& rs = f.rays[f.rays.size() / 2];
@@ -373,7 +376,7 @@ void fitOnePatch(const Scene& scene, const ElementFrame& f, size_t patch_index, 
                  return f.in_view[gp.vertices[t.x]] && f.in_view[gp.vertices[t.y]] && f.in_view[gp.vertices[t.z]];
                });
   pv.fit = fitViewpoint(all_rays, vopt);
-  buildSeenPatchMap(scene, f, el, pv);
+  buildSeenPatchMap(scene, f, el, pv, &all_rays);
 }
 
 // The automatic split stops where a patch would have fewer quads a side than this.
