@@ -207,7 +207,8 @@ std::vector<ViewpointRay> patchRays(const ElementFrame& f, const cad::GridPatch&
     if (rs[vi].status != VertexStatus::Tir) kept.push_back(all.back());
   }
   if (excluded) *excluded = int(all.size() - kept.size());
-  return kept.size() >= 3 ? kept : all;
+  if (kept.size() >= 3) return kept;
+  return all;
 }
 
 // The rays of what the viewer sees of a patch whose viewpoint pv.fit.eye is fitted (ElementFrame::in_view),
@@ -345,7 +346,8 @@ void buildSeenPatchMap(const Scene& scene, const ElementFrame& f, const Element&
                        const std::vector<ViewpointRay>* all_rays = nullptr) {
   const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
   pv.rays_out_of_view = 0;
-  if (f.in_view.empty()) return buildPatchMap(scene, f, el, pv, all_rays ? *all_rays : patchRays(f, gp, nullptr));
+  if (f.in_view.empty() && all_rays) return buildPatchMap(scene, f, el, pv, *all_rays);
+  if (f.in_view.empty()) return buildPatchMap(scene, f, el, pv, patchRays(f, gp, nullptr));
   std::vector<ViewpointRay> rays = seenRays(f, gp, pv, &pv.rays_out_of_view);
   buildPatchMap(scene, f, el, pv, rays);
   const std::vector<VertexRay>& rs = f.rays[f.rays.size() / 2];

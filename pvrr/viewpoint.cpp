@@ -26,7 +26,7 @@ Vector3d toEigen(const Vec3& v) { return {v.x, v.y, v.z}; }
 Vec3 toGlm(const Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
 
-// Rays a lane group of the vectorised evaluation (evaluateRange).
+// Rays per lane group of the vectorised evaluation (evaluateRange).
 constexpr size_t kLanes = 8;
 
 // The rays, re-centred on the origins' centroid c, so that large world coordinates do not cost precision in
@@ -86,7 +86,7 @@ Data prepare(const std::vector<ViewpointRay>& rays) {
   }
   D.patch_radius_m = std::sqrt(radius2);
   const size_t padded = n + kLanes;
-  for (auto* a : {&D.hx, &D.hy, &D.hz, &D.dx, &D.dy, &D.dz, &D.live}) a->assign(padded, 0.0);
+  for (auto* a : {&D.hx, &D.hy, &D.hz, &D.dx, &D.dy, &D.dz, &D.live}) a->resize(padded);
   for (size_t i = 0; i < padded; ++i) {
     const size_t j = i < n ? i : 0;  // the padding repeats the first ray, with weight 0
     D.hx[i] = D.h[j].x(), D.hy[i] = D.h[j].y(), D.hz[i] = D.h[j].z();
@@ -114,18 +114,6 @@ struct Prior {
 // skipping rho'' <= 0) overestimates that curvature and converges linearly: 16-24 iterations against 6-11 on
 // the test's convex caps.
 // Cauchy: rho(s) = b log(1 + s/b), rho' = 1/(1 + s/b), rho'' = -1/(b (1 + s/b)^2), b = scale^2; b = 0: rho(s) = s.
-// log(1 + x) for x >= 0: the series 2 (z + z^3/3 + ... + z^21/21), z = x / (2 + x), below x = 0.5 (z < 0.2,
-// truncation < z^22/23 ~ 2e-17 relative), std::log1p above. std::log1p was a third of the solver's time
-// (perf): with the robust scale at a multiple of the median residual, about half the residuals have x
-// above 0.1, so the series reaches to 0.5.
-inline double log1pFast(double x) {
-  if (x >= 0.5) return std::log1p(x);
-  const double z = x / (2.0 + x), z2 = z * z;
-  double series = 1.0 / 21;
-  for (int k = 19; k >= 1; k -= 2) series = 1.0 / k + z2 * series;
-  return 2.0 * z * series;
-}
-
 struct Eval {
   double F = 0;
   Matrix3d H = Matrix3d::Zero();
@@ -146,21 +134,20 @@ struct Partial {
   }
 };
 
-// evaluateRange in lanes: kLanes rays at a time, each lane's terms computed branch-free (so that the
-// compiler vectorises the loops) and summed into its own accumulator; the lanes are added in a fixed order at
-// the end. Where the Cauchy argument x reaches 0.5, log1pFast's series gives way to std::log1p, lane by
-// lane. The same operations in the same order whatever the instruction set: x86-64 builds carry an AVX2
-// clone chosen at run time, with bit-identical results.
-// The terms of one ray: the data cost, then H's six entries and g's three.
+// The terms of one ray in evaluateRange: the data cost, then H's six entries and g's three.
 constexpr int kTerms = 10;
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+// x86-64 with glibc (ifunc): an AVX2 clone of evaluateRange besides the baseline one, chosen at run time.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && defined(__linux__) && defined(__GLIBC__)
 #define PVRR_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
 #else
 #define PVRR_VECTOR_CLONES
 #endif
 
-// The series part of log1pFast for x in [0, 0.5) (its argument clamped there), lane-wise.
+// log(1 + x) for x in [0, 0.5): the series 2 (z + z^3/3 + ... + z^21/21), z = x / (2 + x) < 0.2, truncation
+// < z^22/23 ~ 2e-17 relative; evaluateRange takes std::log1p from x = 0.5 on. std::log1p for every ray was a
+// third of the solver's time (perf): with the robust scale at a multiple of the median residual, about half
+// the residuals have x above 0.1, so the series reaches to 0.5.
 inline double log1pSeries(double x) {
   const double z = x / (2.0 + x), z2 = z * z;
   double series = 1.0 / 21;
@@ -168,6 +155,11 @@ inline double log1pSeries(double x) {
   return 2.0 * z * series;
 }
 
+// The partial sums of rays [begin, end), kLanes at a time: each lane's terms computed branch-free and summed
+// into its own accumulator, the lanes added in a fixed order at the end; where the Cauchy argument x reaches
+// 0.5, std::log1p in place of the series, lane by lane. The AVX2 clone vectorises the lane loop (the baseline
+// SSE2 one only the sums); both do the same IEEE operations in the same order (no FMA: viewpoint.cpp is built
+// with -ffp-contract=off), so their results are bit-identical.
 PVRR_VECTOR_CLONES
 Partial evaluateRange(const Data& D, const Vector3d& e, double b, bool derivatives, size_t begin, size_t end) {
   const double inv_b = b > 0 ? 1.0 / b : 0.0, ex = e.x(), ey = e.y(), ez = e.z();
@@ -180,7 +172,8 @@ Partial evaluateRange(const Data& D, const Vector3d& e, double b, bool derivativ
       const size_t i = base + l;
       const double vx = hx[i] - ex, vy = hy[i] - ey, vz = hz[i] - ez;
       const double n2 = vx * vx + vy * vy + vz * vz;
-      // A hit point exactly at the eye has no direction, and padding has weight 0: inv_n = 0 zeroes every term.
+      // A hit point exactly at the eye has no direction, and lanes past `end` have weight 0: inv_n = 0 zeroes
+      // every term (for a finite eye and scale).
       const double inv_n = (n2 > 0 && i < end ? live[i] : 0.0) / std::sqrt(n2 > 0 ? n2 : 1.0);
       const double ux = vx * inv_n, uy = vy * inv_n, uz = vz * inv_n;
       const double du = ux * dx[i] + uy * dy[i] + uz * dz[i];
@@ -453,6 +446,19 @@ double viewpointAngularCost(const std::vector<ViewpointRay>& rays, const Vec3& e
   const Data D = prepare(rays);
   const double b = robust_scale_rad > 0 ? robust_scale_rad * robust_scale_rad : 0.0;
   return objective(D, toEigen(eye) - D.centroid, b, Prior{});
+}
+
+ViewpointCostDerivatives viewpointAngularCostDerivatives(const std::vector<ViewpointRay>& rays, const Vec3& eye,
+                                                         double robust_scale_rad) {
+  const Data D = prepare(rays);
+  const double b = robust_scale_rad > 0 ? robust_scale_rad * robust_scale_rad : 0.0;
+  const Eval E = evaluate(D, toEigen(eye) - D.centroid, b, Prior{}, true);
+  ViewpointCostDerivatives out;
+  out.cost = E.F;
+  out.gradient = toGlm(E.g);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) out.normal_matrix[c][r] = E.H(r, c);
+  return out;
 }
 
 static void validateOptions(const ViewpointOptions& opt) {

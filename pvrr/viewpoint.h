@@ -125,5 +125,14 @@ ViewpointFit fitViewpoint(const std::vector<ViewpointRay>& rays, const Viewpoint
 
 // The angular objective F (rad^2, definition above) without the prior: for tests and benchmarks.
 double viewpointAngularCost(const std::vector<ViewpointRay>& rays, const Vec3& eye, double robust_scale_rad);
+// The same F with the refinement's gradient g (exact, 1/m) and Newton-type matrix H (1/m^2; see
+// pvrr/viewpoint.cpp): what each Gauss-Newton step solves, for tests.
+struct ViewpointCostDerivatives {
+  double cost = 0;
+  Vec3 gradient{0};
+  Mat3 normal_matrix{0.0};
+};
+ViewpointCostDerivatives viewpointAngularCostDerivatives(const std::vector<ViewpointRay>& rays, const Vec3& eye,
+                                                         double robust_scale_rad);
 
 }  // namespace pvrr

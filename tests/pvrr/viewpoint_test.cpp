@@ -296,31 +296,69 @@ TEST(Viewpoint, ParallelEvaluationIsBitIdenticalToOneThread) {
   EXPECT_EQ(many.iterations, one.iterations);
 }
 
-// The cost is evaluated in lane groups of 8 (vectorised, with padding and parallel blocks of 512 rays): against
-// the definition evaluated ray by ray in long double, with and without the Cauchy loss, for sizes that end
-// mid-group, on a group, and across blocks, with one hit point exactly at the eye (it contributes nothing).
-TEST(Viewpoint, AngularCostMatchesTheDefinitionRayByRay) {
+// The cost, its gradient and the Gauss-Newton matrix are evaluated in lane groups of 8 (vectorised, with
+// padding and parallel blocks of 512 rays): against their definitions (pvrr/viewpoint.cpp) evaluated ray by
+// ray in long double, with and without the Cauchy loss, for sizes that end mid-group, on a group, and across
+// blocks whose ends are not multiples of 8 (2,025 rays), with one hit point exactly at the eye (it adds
+// nothing). The gradient also against central differences of the cost.
+TEST(Viewpoint, CostGradientAndMatrixMatchTheirDefinitionsRayByRay) {
+  using LD = long double;
   const Vec3 eye(0.3, 0.2, 1.0);
-  for (int grid : {2, 3, 4, 33, 45, 64}) {  // 4, 9, 16, 1089, 2025, 4096 rays
-    auto rays = sphereMirror(eye, Vec3(0), Vec3(0, 0, 1), 1.2, true, 0.12, grid, 2.0, 9.0);
+  for (int grid : {1, 2, 3, 4, 33, 45, 64}) {  // 1, 4, 9, 16, 1089, 2025, 4096 rays
+    auto rays = grid == 1 ? std::vector<ViewpointRay>{{Vec3(0.01, 0.02, 0), glm::normalize(Vec3(-0.1, 0.2, 1)), Vec3(0.5, 1, 4)}}
+                          : sphereMirror(eye, Vec3(0), Vec3(0, 0, 1), 1.2, true, 0.12, grid, 2.0, 9.0);
     const Vec3 probe = eye + Vec3(0.01, -0.02, 0.015);
-    rays.back().hit = probe;  // a hit point at the evaluated eye
+    if (rays.size() > 1) rays.back().hit = probe;  // a hit point at the evaluated eye
     for (double scale : {0.0, 0.002, 0.02}) {
-      long double expected = 0;
+      const LD b = LD(scale) * scale;
+      LD F = 0, g[3] = {0, 0, 0}, H[3][3] = {};
       for (const ViewpointRay& r : rays) {
-        const Vec3 v = r.hit - probe;
-        const double len = glm::length(v);
-        if (!(len > 0)) continue;
-        const Vec3 u = v / len, d = glm::normalize(r.direction);
-        const Vec3 p = u - glm::dot(u, d) * d;
-        const long double sq = glm::dot(p, p);
-        const long double b = (long double)scale * scale;
-        expected += b > 0 ? b * std::log1p(sq / b) : sq;
+        const LD v[3] = {LD(r.hit.x) - probe.x, LD(r.hit.y) - probe.y, LD(r.hit.z) - probe.z};
+        const LD n = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        if (!(n > 0)) continue;
+        const Vec3 dd = glm::normalize(r.direction);
+        const LD d[3] = {dd.x, dd.y, dd.z}, u[3] = {v[0] / n, v[1] / n, v[2] / n};
+        const LD du = u[0] * d[0] + u[1] * d[1] + u[2] * d[2];
+        LD p[3], q[3], jr[3];
+        for (int k = 0; k < 3; ++k) p[k] = u[k] - du * d[k], q[k] = d[k] - du * u[k];
+        const LD s = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
+        for (int k = 0; k < 3; ++k) jr[k] = -(p[k] - s * u[k]) / n;
+        // rho(s) = b log(1 + s/b) (b = 0: s); w = rho' = 1/(1 + s/b); c = max(rho' + 2 s rho'', 0).
+        const LD x = b > 0 ? s / b : 0, w = 1 / (1 + x);
+        F += b > 0 ? b * std::log1p(x) : s;
+        const LD c = std::max(w - 2 * x * w * w, LD(0));
+        const LD kk = b > 0 && s > 0 ? (c - w) / s : 0;
+        for (int i = 0; i < 3; ++i) {
+          g[i] += w * jr[i];
+          for (int j = 0; j < 3; ++j)
+            H[i][j] += w * ((i == j) - u[i] * u[j] - q[i] * q[j]) / (n * n) + kk * jr[i] * jr[j];
+        }
       }
-      expected *= 0.5L;
-      const double got = viewpointAngularCost(rays, probe, scale);
-      EXPECT_NEAR(got, double(expected), 1e-12 * double(expected) + 1e-300)
-          << rays.size() << " rays, scale " << scale;
+      F *= 0.5L;
+      const ViewpointCostDerivatives got = viewpointAngularCostDerivatives(rays, probe, scale);
+      const std::string what = std::to_string(rays.size()) + " rays, scale " + std::to_string(scale);
+      EXPECT_NEAR(got.cost, double(F), 1e-12 * double(F) + 1e-300) << what;
+      EXPECT_EQ(viewpointAngularCost(rays, probe, scale), got.cost) << what;
+      LD gnorm = 0, hnorm = 0;
+      for (int i = 0; i < 3; ++i) {
+        gnorm = std::max(gnorm, std::abs(g[i]));
+        for (int j = 0; j < 3; ++j) hnorm = std::max(hnorm, std::abs(H[i][j]));
+      }
+      for (int i = 0; i < 3; ++i) {
+        EXPECT_NEAR(got.gradient[i], double(g[i]), 1e-11 * double(gnorm) + 1e-300) << what << " g" << i;
+        for (int j = 0; j < 3; ++j)
+          EXPECT_NEAR(got.normal_matrix[j][i], double(H[i][j]), 1e-11 * double(hnorm)) << what << " H" << i << j;
+      }
+      // The gradient is F's: central differences (step 1e-5 m; error of order h^2 times F's third
+      // derivative, and the rounding of F over 2h).
+      const double h = 1e-5;
+      for (int i = 0; i < 3; ++i) {
+        Vec3 step(0);
+        step[i] = h;
+        const double fd =
+            (viewpointAngularCost(rays, probe + step, scale) - viewpointAngularCost(rays, probe - step, scale)) / (2 * h);
+        EXPECT_NEAR(got.gradient[i], fd, 1e-5 * double(gnorm) + 1e-12 * double(F) / h) << what << " dF/de" << i;
+      }
     }
   }
 }
