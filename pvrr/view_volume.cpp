@@ -364,7 +364,8 @@ bool facingTrianglesWindCounterClockwise(const Mat4& view_proj) {
     const Vec4 p = inv * Vec4(x, y, z, 1.0);
     return Vec3(p) / p.w;
   };
-  const Vec3 a = unproject(0, 0, 0), b = unproject(0.5, 0, 0), c = unproject(0, 0.5, 0), centre_side = unproject(0, 0, -0.5);
+  const Vec3 a = unproject(0, 0, 0), b = unproject(0.5, 0, 0), c = unproject(0, 0.5, 0);
+  const Vec3 centre_side = unproject(0, 0, -0.5);
   return glm::dot(glm::cross(b - a, c - a), centre_side - a) > 0;
 }
 

@@ -453,7 +453,8 @@ struct Renderer::Impl {
       const EnvMesh& mesh = scene.meshes[m];
       const DiffuseMaterial& mat = scene.materials[size_t(mesh.material)];
       const Program& p = env_faceted[m] ? faceted : smooth;
-      const Vec3 lo = env_bounds[m][0] + (mesh.anchor - origin), hi = env_bounds[m][1] + (mesh.anchor - origin);  // camera-relative
+      const Vec3 to_anchor = mesh.anchor - origin;  // camera-relative bounds
+      const Vec3 lo = env_bounds[m][0] + to_anchor, hi = env_bounds[m][1] + to_anchor;
       const bool cull = may_cull && mesh.closed_convex && near_clip.cannotOpen(lo, hi);
       closed_drawn += mesh.closed_convex;
       closed_culled += cull;

@@ -45,8 +45,10 @@ TEST(ClosedConvexMesh, BoxesAndSpheresAreClosedConvexAndWoundOutward) {
   // A sphere mesh of 48 x 24 facets is inscribed: its volume is below 4/3 pi r^3 by ~1.1 %.
   const EnvMesh sphere = makeSphereMesh(Vec3(2, 0, 0), 0.75);
   double volume = 0;
-  for (const auto& t : sphere.triangles)
-    volume += glm::dot(Vec3(sphere.positions[t.x]), glm::cross(Vec3(sphere.positions[t.y]), Vec3(sphere.positions[t.z]))) / 6.0;
+  for (const auto& t : sphere.triangles) {
+    const Vec3 a(sphere.positions[t.x]), b(sphere.positions[t.y]), c(sphere.positions[t.z]);
+    volume += glm::dot(a, glm::cross(b, c)) / 6.0;
+  }
   EXPECT_GT(volume, 0.985 * 4.0 / 3.0 * kPi * std::pow(0.75, 3));
   expectClosedConvexOutward(sphere, volume, "sphere");
   // Not solids to cull: inside out (a negative size), sheared axes, too few facets.

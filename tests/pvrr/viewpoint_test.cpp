@@ -305,7 +305,8 @@ TEST(Viewpoint, CostGradientAndMatrixMatchTheirDefinitionsRayByRay) {
   using LD = long double;
   const Vec3 eye(0.3, 0.2, 1.0);
   for (int grid : {1, 2, 3, 4, 33, 45, 64}) {  // 1, 4, 9, 16, 1089, 2025, 4096 rays
-    auto rays = grid == 1 ? std::vector<ViewpointRay>{{Vec3(0.01, 0.02, 0), glm::normalize(Vec3(-0.1, 0.2, 1)), Vec3(0.5, 1, 4)}}
+    const ViewpointRay single{Vec3(0.01, 0.02, 0), glm::normalize(Vec3(-0.1, 0.2, 1)), Vec3(0.5, 1, 4)};
+    auto rays = grid == 1 ? std::vector<ViewpointRay>{single}
                           : sphereMirror(eye, Vec3(0), Vec3(0, 0, 1), 1.2, true, 0.12, grid, 2.0, 9.0);
     const Vec3 probe = eye + Vec3(0.01, -0.02, 0.015);
     if (rays.size() > 1) rays.back().hit = probe;  // a hit point at the evaluated eye
@@ -355,8 +356,9 @@ TEST(Viewpoint, CostGradientAndMatrixMatchTheirDefinitionsRayByRay) {
       for (int i = 0; i < 3; ++i) {
         Vec3 step(0);
         step[i] = h;
-        const double fd =
-            (viewpointAngularCost(rays, probe + step, scale) - viewpointAngularCost(rays, probe - step, scale)) / (2 * h);
+        const double up = viewpointAngularCost(rays, probe + step, scale);
+        const double down = viewpointAngularCost(rays, probe - step, scale);
+        const double fd = (up - down) / (2 * h);
         EXPECT_NEAR(got.gradient[i], fd, 1e-5 * double(gnorm) + 1e-12 * double(F) / h) << what << " dF/de" << i;
       }
     }
