@@ -79,12 +79,39 @@ double msSince(std::chrono::steady_clock::time_point t0) {
 }
 }  // namespace
 
-ElementFrame prepareElement(const Scene& scene, int element) {
+namespace {
+cad::Tessellation tessellateElement(const Element& el) {
+  return cad::tessellateGrid(el.frontSurface(), el.tess_u, el.tess_v, el.has_outline ? &el.outline : nullptr,
+                             cad::TessellationOptions{true});
+}
+
+bool sameOutline(const cad::Outline& a, const cad::Outline& b) {
+  return a.shape() == b.shape() && a.width() == b.width() && a.height() == b.height() &&
+         a.cornerRadius() == b.cornerRadius() && a.centre() == b.centre() && a.loop() == b.loop();
+}
+}  // namespace
+
+const cad::Tessellation& ElementGridCache::get(const Scene& scene, int element) {
+  const Element& el = scene.elements.at(size_t(element));
+  if (entries_.size() <= size_t(element)) entries_.resize(size_t(element) + 1);
+  Entry& e = entries_[size_t(element)];
+  const cad::SurfacePtr surface = el.type == ElementType::Lens ? cad::SurfacePtr(el.lens.front) : el.surface;
+  if (!e.surface || e.surface != surface || e.tess_u != el.tess_u || e.tess_v != el.tess_v ||
+      e.has_outline != el.has_outline || (el.has_outline && !sameOutline(e.outline, el.outline))) {
+    e.grid = tessellateElement(el);
+    e.surface = surface;
+    e.tess_u = el.tess_u, e.tess_v = el.tess_v;
+    e.has_outline = el.has_outline;
+    e.outline = el.outline;
+  }
+  return e.grid;
+}
+
+ElementFrame prepareElement(const Scene& scene, int element, const cad::Tessellation* grid) {
   const Element& el = scene.elements[size_t(element)];
   ElementFrame f;
   f.element = element;
-  f.grid = cad::tessellateGrid(el.frontSurface(), el.tess_u, el.tess_v, el.has_outline ? &el.outline : nullptr,
-                               cad::TessellationOptions{true});
+  f.grid = grid ? *grid : tessellateElement(el);
   f.world_pos.resize(f.grid.vertexCount());
   f.world_normal.resize(f.grid.vertexCount());
   for (size_t i = 0; i < f.grid.vertexCount(); ++i) {
@@ -456,8 +483,9 @@ void projectPatchMap(const ElementFrame& f, PatchView& pv) {
   auto counts = [&](uint32_t vi) { return f.in_view.empty() || !pv.in_view || f.in_view[vi]; };
   pv.q.assign(gp.vertices.size(), 1.0);
   bool all_in_front = true;
+  const Mat4 world_to_clip = pv.volume.projection * pv.volume.view;
   for (size_t k = 0; k < gp.vertices.size(); ++k) {
-    const Vec4 clip = pv.volume.projection * pv.volume.view * Vec4(f.world_pos[gp.vertices[k]], 1.0);
+    const Vec4 clip = world_to_clip * Vec4(f.world_pos[gp.vertices[k]], 1.0);
     pv.q[k] = clip.w;
     if (counts(gp.vertices[k])) all_in_front = all_in_front && clip.w > 0;
     else if (!(clip.w > 0)) pv.q[k] = 1.0;

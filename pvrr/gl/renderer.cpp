@@ -323,6 +323,7 @@ struct Renderer::Impl {
   std::vector<int> map_side;  // per map slot: the longer side its last first pass rendered (MapPass::side)
   std::vector<std::unique_ptr<CubeTarget>> cubes;  // envmap cubes, one per element
   std::vector<MeshBuffers> element_meshes;     // per (element, patch) in pvrr mode; per element otherwise
+  ElementGridCache grid_cache;                 // the elements' tessellations, posed anew each frame
 
   Impl(const Scene& s, const RayScene& r, RendererOptions o) : scene(s), rays(r), options(std::move(o)) {
     glGenVertexArrays(1, &empty_vao);
@@ -1095,7 +1096,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
         }
         continue;
       }
-      frames[e] = prepareElement(scene, int(e));
+      frames[e] = prepareElement(scene, int(e), &grid_cache.get(scene, int(e)));
       traceVertexRays(rays, frames[e], ob.eye, opts[e]);
       if (scene.elements[e].type == ElementType::Lens) refraction_ms += frames[e].rays_ms;
     }
@@ -1307,7 +1308,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       if (beyondDepth(frames[e])) drawDarkElement(frames[e], eye_cam);
       else drawPvrrElement(frames[e], top_slot[e], eye_cam, options.seen_channel);
     } else {
-      ElementFrame f = prepareElement(scene, int(e));
+      ElementFrame f = prepareElement(scene, int(e), &grid_cache.get(scene, int(e)));
       if (lens && mode == RasterMode::Envmap) traceVertexRays(rays, f, ob.eye, VertexStageOptions{});
       const Program& p = mode == RasterMode::Raster ? plain_program : (lens ? lens_envmap_program : envmap_program);
       p.use();

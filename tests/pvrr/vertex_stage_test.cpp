@@ -46,6 +46,39 @@ TEST(VertexStage, PlaneMirrorViewpointIsTheMirrorImageOfTheEye) {
 // A plane rectangle facing the eye head-on projects to a rectangle: (w / (2 d tan(fov_y / 2) * aspect)) *
 // width by (h / (2 d tan(fov_y / 2))) * height pixels. Half of it out of the image counts half. Behind the
 // eye: nothing.
+// ElementGridCache keeps an element's tessellation while its surface, grid size and outline stay the same
+// (a rigid element moved, or the observer turned: the same grid, posed anew), and tessellates again when any
+// of them changes. A frame prepared from the kept grid equals a fresh one exactly.
+TEST(ElementGridCache, KeepsTheTessellationWhileTheElementKeepsItsShape) {
+  Scene s = test::roomScene(Vec3(0.4, 0.3, 1.8), Vec3(0, 0, 0));
+  const cad::Outline outline = cad::Outline::rectangle(0.6, 0.4, 0.05);
+  test::addMirror(s, cad::makeSphere(1.5, outline), outline, test::pose(Vec3(0.1, -0.05, 0), Vec3(0.2, 0, 1)), 9);
+  ElementGridCache cache;
+  auto samePositions = [](const cad::Tessellation& a, const cad::Tessellation& b) {
+    return a.positions == b.positions && a.normals == b.normals && a.triangles.size() == b.triangles.size();
+  };
+  const cad::Tessellation& first = cache.get(s, 0);
+  EXPECT_TRUE(samePositions(first, prepareElement(s, 0).grid));
+  const Vec3* kept = first.positions.data();
+  // Moved: the same grid (not tessellated again), and the frame from it equals a fresh one.
+  s.elements[0].local_to_world = test::pose(Vec3(-0.3, 0.2, 0.1), Vec3(-0.1, 0.3, 1));
+  s.elements[0].world_to_local = glm::inverse(s.elements[0].local_to_world);
+  EXPECT_EQ(cache.get(s, 0).positions.data(), kept);
+  const ElementFrame fresh = prepareElement(s, 0), from_cache = prepareElement(s, 0, &cache.get(s, 0));
+  EXPECT_EQ(fresh.world_pos, from_cache.world_pos);
+  EXPECT_EQ(fresh.world_normal, from_cache.world_normal);
+  // A finer grid, another outline, another surface: tessellated again, as prepareElement does.
+  s.elements[0].tess_u = 13;
+  EXPECT_EQ(cache.get(s, 0).vertexCount(), size_t(13 * 9));
+  EXPECT_TRUE(samePositions(cache.get(s, 0), prepareElement(s, 0).grid));
+  s.elements[0].outline = cad::Outline::ellipse(0.6, 0.4);
+  EXPECT_TRUE(samePositions(cache.get(s, 0), prepareElement(s, 0).grid));
+  s.elements[0].surface = cad::makeSphere(0.8, s.elements[0].outline);
+  EXPECT_TRUE(samePositions(cache.get(s, 0), prepareElement(s, 0).grid));
+  const Vec3* now = cache.get(s, 0).positions.data();
+  EXPECT_EQ(cache.get(s, 0).positions.data(), now);  // and kept again
+}
+
 TEST(VertexStage, PatchScreenPixelsOfAHeadOnRectangle) {
   Scene s = test::roomScene(Vec3(0, 0, 2), Vec3(0, 0, 0), 400, 300);
   const double w = 0.6, h = 0.4;
