@@ -157,6 +157,7 @@ class ElementGridCache {
   };
   std::vector<Entry> entries_;
 };
+
 // Stage "vertex-rays": traces every vertex's ray for every channel from `eye`.
 void traceVertexRays(const RayScene& rays, ElementFrame& f, const Vec3& eye, const VertexStageOptions& opt);
 // The same with one incoming-ray origin per vertex (multiple reflection: an element seen inside another's

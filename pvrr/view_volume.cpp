@@ -11,7 +11,6 @@
 namespace pvrr {
 namespace {
 
-
 void appendNote(std::string& note, const std::string& s) { note += (note.empty() ? "" : "; ") + s; }
 
 void validate(const char* who, const Vec3& eye, const std::vector<ViewpointRay>& rays) {

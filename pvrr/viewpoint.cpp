@@ -36,8 +36,8 @@ struct Data {
   Vector3d mean_dir{0, 0, 1};  // normalised mean of the directions
   std::vector<Vector3d> o, d, h;  // o and h relative to centroid, d unit
   // h and d again, one array per coordinate, for the vectorised evaluation (evaluateRange), padded with
-  // kLanes rays of weight 0 (`live`: 1 for the rays, 0 for the padding) for a range's last lane group.
-  std::vector<double> hx, hy, hz, dx, dy, dz, live;
+  // kLanes repeats of the first ray, read (and given weight 0) by a range's last lane group.
+  std::vector<double> hx, hy, hz, dx, dy, dz;
   double patch_radius_m = 0;   // max distance of an origin from the axis (centroid, mean_dir)
   double spread_rad = 0;       // max angle between a direction and mean_dir
   size_t size() const { return d.size(); }
@@ -86,12 +86,11 @@ Data prepare(const std::vector<ViewpointRay>& rays) {
   }
   D.patch_radius_m = std::sqrt(radius2);
   const size_t padded = n + kLanes;
-  for (auto* a : {&D.hx, &D.hy, &D.hz, &D.dx, &D.dy, &D.dz, &D.live}) a->resize(padded);
+  for (auto* a : {&D.hx, &D.hy, &D.hz, &D.dx, &D.dy, &D.dz}) a->resize(padded);
   for (size_t i = 0; i < padded; ++i) {
     const size_t j = i < n ? i : 0;  // the padding repeats the first ray, with weight 0
     D.hx[i] = D.h[j].x(), D.hy[i] = D.h[j].y(), D.hz[i] = D.h[j].z();
     D.dx[i] = D.d[j].x(), D.dy[i] = D.d[j].y(), D.dz[i] = D.d[j].z();
-    D.live[i] = i < n ? 1.0 : 0.0;
   }
   D.spread_rad = std::atan2(D.d[widest].cross(D.mean_dir).norm(), D.d[widest].dot(D.mean_dir));
   return D;
@@ -164,7 +163,7 @@ PVRR_VECTOR_CLONES
 Partial evaluateRange(const Data& D, const Vector3d& e, double b, bool derivatives, size_t begin, size_t end) {
   const double inv_b = b > 0 ? 1.0 / b : 0.0, ex = e.x(), ey = e.y(), ez = e.z();
   const double* hx = D.hx.data(), *hy = D.hy.data(), *hz = D.hz.data();
-  const double* dx = D.dx.data(), *dy = D.dy.data(), *dz = D.dz.data(), *live = D.live.data();
+  const double* dx = D.dx.data(), *dy = D.dy.data(), *dz = D.dz.data();
   double acc[kTerms][kLanes] = {};
   for (size_t base = begin; base < end; base += kLanes) {  // lanes past `end` get weight 0
     double t[kTerms][kLanes], xs[kLanes];
@@ -174,7 +173,7 @@ Partial evaluateRange(const Data& D, const Vector3d& e, double b, bool derivativ
       const double n2 = vx * vx + vy * vy + vz * vz;
       // A hit point exactly at the eye has no direction, and lanes past `end` have weight 0: inv_n = 0 zeroes
       // every term (for a finite eye and scale).
-      const double inv_n = (n2 > 0 && i < end ? live[i] : 0.0) / std::sqrt(n2 > 0 ? n2 : 1.0);
+      const double inv_n = (n2 > 0 && i < end ? 1.0 : 0.0) / std::sqrt(n2 > 0 ? n2 : 1.0);
       const double ux = vx * inv_n, uy = vy * inv_n, uz = vz * inv_n;
       const double du = ux * dx[i] + uy * dy[i] + uz * dz[i];
       const double px = ux - du * dx[i], py = uy - du * dy[i], pz = uz - du * dz[i];

@@ -305,14 +305,15 @@ struct Renderer::Impl {
   std::vector<MeshBuffers> env_meshes;
   std::vector<bool> env_faceted;  // per environment mesh: every triangle has one normal at its three corners
   std::vector<std::array<Vec3, 2>> env_bounds;  // per environment mesh: its bounding box, relative to its anchor
-  // Closed convex meshes drawn and culled by drawEnvironment since the last cullNote(), for the stage notes.
-  mutable int closed_drawn = 0, closed_culled = 0;
-  std::string cullNote() const {
-    std::string note = closed_drawn == 0 ? "" : "back faces culled on " + std::to_string(closed_culled) + " of " +
-                                                    std::to_string(closed_drawn) + " closed-mesh draws";
-    if (closed_drawn > 0 && !options.cull_back_faces) note = "back faces not culled (off)";
-    closed_drawn = closed_culled = 0;
-    return note;
+  // Closed convex meshes drawn and culled by drawEnvironment, summed over a stage's passes for its note.
+  struct CullCount {
+    int drawn = 0, culled = 0;
+    void add(const CullCount& o) { drawn += o.drawn, culled += o.culled; }
+  };
+  std::string cullNote(const CullCount& c) const {
+    if (c.drawn == 0) return "";
+    if (!options.cull_back_faces) return "back faces not culled (off)";
+    return "back faces culled on " + std::to_string(c.culled) + " of " + std::to_string(c.drawn) + " closed-mesh draws";
   }
   std::vector<Texture> textures;  // environment textures, in Scene::textures order
   std::unique_ptr<Framebuffer> frame_target;      // the second pass: colour, seen point, surface point
@@ -409,8 +410,9 @@ struct Renderer::Impl {
   // Forward passes (not reversed_depth) draw the sky last, where the depth buffer is still clear, so that
   // no pixel is shaded twice for it; what was drawn into the target before (the elements of the second
   // pass, drawn first so that the environment behind them fails the early depth test) stays.
-  void drawEnvironment(const Mat4& view, const Mat4& proj, const Vec3& origin, bool reversed_depth = false,
-                       const Vec3* rays_from = nullptr, bool planes = false) const {
+  // Returns how many closed convex meshes it drew and culled.
+  CullCount drawEnvironment(const Mat4& view, const Mat4& proj, const Vec3& origin, bool reversed_depth = false,
+                            const Vec3* rays_from = nullptr, bool planes = false) const {
     const Mat4 vp = relativeViewProj(proj, view, origin);
     const Program& sky = skyProgram(planes);
     auto drawSky = [&] {
@@ -450,6 +452,7 @@ struct Renderer::Impl {
       glFrontFace(facingTrianglesWindCounterClockwise(vp) ? GL_CCW : GL_CW);
     }
     bool culling = false;
+    CullCount count;
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
       const EnvMesh& mesh = scene.meshes[m];
       const DiffuseMaterial& mat = scene.materials[size_t(mesh.material)];
@@ -457,8 +460,8 @@ struct Renderer::Impl {
       const Vec3 to_anchor = mesh.anchor - origin;  // camera-relative bounds
       const Vec3 lo = env_bounds[m][0] + to_anchor, hi = env_bounds[m][1] + to_anchor;
       const bool cull = may_cull && mesh.closed_convex && near_clip.cannotOpen(lo, hi);
-      closed_drawn += mesh.closed_convex;
-      closed_culled += cull;
+      count.drawn += mesh.closed_convex;
+      count.culled += cull;
       if (cull != culling) {
         cull ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
         culling = cull;
@@ -479,6 +482,7 @@ struct Renderer::Impl {
       glDepthMask(GL_TRUE);
       glDepthFunc(GL_LESS);
     }
+    return count;
   }
 
   void setElementMaterial(const Program& p, const Element& el, int index) const {
@@ -996,8 +1000,9 @@ struct Renderer::Impl {
     draw(mb);
   }
 
-  // Renders the planned first passes, deepest first.
-  void renderPasses(const std::vector<ElementFrame>& frames) {
+  // Renders the planned first passes, deepest first; returns their cull counts.
+  CullCount renderPasses(const std::vector<ElementFrame>& frames) {
+    CullCount count;
     for (size_t i = passes.size(); i-- > 0;) {
       const MapPass& mp = passes[i];
       const PatchView& pv = mp.owner->views[mp.view];
@@ -1009,8 +1014,8 @@ struct Renderer::Impl {
       t.bindRegionClearDepth(region[0], region[1], pv.volume.backward ? 0.0f : 1.0f);
       // In a reversed (zooming) map the rays come from the mirror, not from the viewpoint.
       const Vec3 element_centre = Vec3(scene.elements[size_t(mp.owner->element)].local_to_world[3]);
-      drawEnvironment(pv.volume.view, pv.volume.projection, pv.volume.eye, pv.volume.backward,
-                      pv.volume.backward ? &element_centre : nullptr, planes);
+      count.add(drawEnvironment(pv.volume.view, pv.volume.projection, pv.volume.eye, pv.volume.backward,
+                                pv.volume.backward ? &element_centre : nullptr, planes));
       PassCamera cam;
       cam.planes = planes;
       cam.origin = pv.volume.eye;
@@ -1024,6 +1029,7 @@ struct Renderer::Impl {
       }
     }
     glDepthFunc(GL_LESS);
+    return count;
   }
 
   RasterFrame render(RasterMode mode, FrameCache* cache);
@@ -1046,7 +1052,6 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
                                     [](const Element& e) { return e.type == ElementType::Lens; });
   const size_t n_el = scene.elements.size();
   next_mesh = 0;
-  cullNote();  // reset the counts
 
   // --- CPU stages (pvrr mode) ---
   std::vector<ElementFrame> frames;
@@ -1191,7 +1196,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     // The maps change from here: any cache's record of them is void, even if a pass fails.
     first_pass_serial = nextFirstPassSerial();
     if (cache) cache->maps.clear();
-    renderPasses(frames);
+    const CullCount culled = renderPasses(frames);
     glFinish();
     if (cache) {
       cache->last_plan_nested = nested > 0 || dark > 0;
@@ -1224,8 +1229,8 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     if (rendered != int(passes.size()))
       note += (note.empty() ? "" : "; ") + std::to_string(passes.size() - size_t(rendered)) +
               " map(s) of elements outside the observer's view or beyond the depth limit not rendered";
-    const std::string culled = cullNote();
-    if (!culled.empty()) note += (note.empty() ? "" : "; ") + culled;
+    const std::string cull_note = cullNote(culled);
+    if (!cull_note.empty()) note += (note.empty() ? "" : "; ") + cull_note;
     out.stages.ran("first-pass", msSince(t1), rendered, note);
     const std::string dark_note =
         dark == 0 ? "" : std::to_string(dark) + " element(s) in a map drawn dark (" +
@@ -1243,6 +1248,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       out.stages.skipped("nested-passes", "no element is inside another element's view volume");
   } else if (mode == RasterMode::Envmap && n_el > 0) {
     while (cubes.size() < n_el) cubes.push_back(std::make_unique<CubeTarget>());
+    CullCount culled;
     for (size_t e = 0; e < n_el; ++e) {
       CubeTarget& c = *cubes[e];
       if (c.size != options.map_size) {
@@ -1254,11 +1260,11 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       const Mat4 proj = glm::perspective(kPi / 2, 1.0, near_m, far_m);
       for (int face = 0; face < 6; ++face) {
         c.selectFace(face);
-        drawEnvironment(glm::lookAt(centre, centre + kCubeDir[face], kCubeUp[face]), proj, centre);
+        culled.add(drawEnvironment(glm::lookAt(centre, centre + kCubeDir[face], kCubeUp[face]), proj, centre));
       }
     }
     glFinish();
-    out.stages.ran("first-pass", msSince(t0), -1, cullNote());
+    out.stages.ran("first-pass", msSince(t0), -1, cullNote(culled));
     out.stages.skipped("nested-passes", "mode envmap: other elements are absent from the cube maps");
   } else {
     out.stages.skipped("first-pass", n_el == 0 ? "no mirror or lens in the scene" : "mode raster");
@@ -1335,10 +1341,10 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   }
   // The environment after the elements: behind a lens or mirror it fails the early depth test, unshaded.
   frame_target->bind();
-  drawEnvironment(view, proj, ob.eye);
+  const CullCount culled = drawEnvironment(view, proj, ob.eye);
   glFinish();
   checkGlError("rendering a frame");
-  out.stages.ran("second-pass", msSince(t0), -1, cullNote());
+  out.stages.ran("second-pass", msSince(t0), -1, cullNote(culled));
   if (options.seen_points)
     out.stages.ran("seen-points", 0, -1, "world-position attachments in every pass (for accuracy reports)");
   else

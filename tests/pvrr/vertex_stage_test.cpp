@@ -43,9 +43,6 @@ TEST(VertexStage, PlaneMirrorViewpointIsTheMirrorImageOfTheEye) {
   }
 }
 
-// A plane rectangle facing the eye head-on projects to a rectangle: (w / (2 d tan(fov_y / 2) * aspect)) *
-// width by (h / (2 d tan(fov_y / 2))) * height pixels. Half of it out of the image counts half. Behind the
-// eye: nothing.
 // ElementGridCache keeps an element's tessellation while its surface, grid size and outline stay the same
 // (a rigid element moved, or the observer turned: the same grid, posed anew), and tessellates again when any
 // of them changes. A frame prepared from the kept grid equals a fresh one exactly.
@@ -79,6 +76,9 @@ TEST(ElementGridCache, KeepsTheTessellationWhileTheElementKeepsItsShape) {
   EXPECT_EQ(cache.get(s, 0).positions.data(), now);  // and kept again
 }
 
+// A plane rectangle facing the eye head-on projects to a rectangle: (w / (2 d tan(fov_y / 2) * aspect)) *
+// width by (h / (2 d tan(fov_y / 2))) * height pixels. Half of it out of the image counts half. Behind the
+// eye: nothing.
 TEST(VertexStage, PatchScreenPixelsOfAHeadOnRectangle) {
   Scene s = test::roomScene(Vec3(0, 0, 2), Vec3(0, 0, 0), 400, 300);
   const double w = 0.6, h = 0.4;
