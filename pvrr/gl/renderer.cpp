@@ -15,6 +15,7 @@
 #include "pvrr/gl/framebuffer.h"
 #include "pvrr/gl/program.h"
 #include "pvrr/format.h"
+#include "pvrr/map_footprint.h"
 #include "pvrr/spectrum.h"
 
 namespace pvrr::gl {
@@ -300,7 +301,9 @@ struct Renderer::Impl {
       if (channelWeight(f.channels, c) != Vec3(c == 0, c == 1, c == 2)) return false;
     return true;
   }
+  Program mask_program = makeProgram("map_mask.vert", "map_mask.frag");
   GLuint empty_vao = 0;
+  GLuint mask_vao = 0, mask_vbo = 0;  // closeUnreadTexels' quads
   int max_texture_size = 0;  // GL_MAX_TEXTURE_SIZE
   std::vector<MeshBuffers> env_meshes;
   std::vector<bool> env_faceted;  // per environment mesh: every triangle has one normal at its three corners
@@ -378,6 +381,8 @@ struct Renderer::Impl {
     for (auto& m : env_meshes) m.release();
     for (auto& m : element_meshes) m.release();
     if (empty_vao) glDeleteVertexArrays(1, &empty_vao);
+    if (mask_vbo) glDeleteBuffers(1, &mask_vbo);
+    if (mask_vao) glDeleteVertexArrays(1, &mask_vao);
   }
 
   // The uniforms of shaders/shading.glsl, for a pass whose camera origin is `origin`.
@@ -568,6 +573,9 @@ struct Renderer::Impl {
                                                 : std::vector<ColorFormat>{ColorFormat::RGBA32F};
       if (options.seen_points) formats.push_back(ColorFormat::RGBA32F);
       maps[i] = std::make_unique<Framebuffer>(size, size, formats, DepthFormat::Depth32F);
+      // Defined contents once: texels a pass leaves unshaded (closeUnreadTexels) keep what they hold, and a
+      // bilinear fetch beside the footprint may weigh one of them by zero, which must not be a NaN.
+      maps[i]->clear({0.0f, 0.0f, 0.0f, 0.0f});
       // Colour and seen points filter linearly: seen points are exact within a surface and blend only across
       // depth edges (nearest filtering would quantise every seen point by up to half a texel).
       for (int a = 0; a < maps[i]->colorCount(); ++a) {
@@ -1000,9 +1008,59 @@ struct Renderer::Impl {
     draw(mb);
   }
 
-  // Renders the planned first passes, deepest first; returns their cull counts.
-  CullCount renderPasses(const std::vector<ElementFrame>& frames) {
+  // Sets the depth of the texels of map pass mp's region (bound, depth cleared) that its element cannot fetch
+  // (MapFootprint of its patch's triangles at their texture coordinates, in every channel) to what no
+  // fragment of the pass passes: 0 with GL_LESS, 1 with a reversed pass's GL_GREATER. Returns their count.
+  int64_t closeUnreadTexels(const MapPass& mp, const std::array<int, 2>& region) {
+    const PatchView& pv = mp.owner->views[mp.view];
+    const MapFootprint fp = mapFootprint(pv.st, mp.owner->grid_patches[size_t(pv.patch)].triangles, region[0], region[1]);
+    if (fp.all) return 0;
+    std::vector<float> ndc;  // two triangles per closed run of a band
+    auto close = [&](int x0, int x1, int y0, int y1) {
+      if (x0 >= x1) return;
+      const float ax = 2.0f * float(x0) / float(region[0]) - 1.0f, bx = 2.0f * float(x1) / float(region[0]) - 1.0f;
+      const float ay = 2.0f * float(y0) / float(region[1]) - 1.0f, by = 2.0f * float(y1) / float(region[1]) - 1.0f;
+      ndc.insert(ndc.end(), {ax, ay, bx, ay, bx, by, ax, ay, bx, by, ax, by});
+    };
+    for (size_t b = 0; b < fp.spans.size(); ++b) {
+      const int y0 = int(b) * fp.band, y1 = std::min(y0 + fp.band, region[1]);
+      const std::array<int, 2>& s = fp.spans[b];
+      if (s[0] >= s[1]) {
+        close(0, region[0], y0, y1);
+      } else {
+        close(0, s[0], y0, y1);
+        close(s[1], region[0], y0, y1);
+      }
+    }
+    if (ndc.empty()) return 0;
+    if (!mask_vao) {
+      glGenVertexArrays(1, &mask_vao);
+      glGenBuffers(1, &mask_vbo);
+    }
+    glBindVertexArray(mask_vao);
+    glBindBuffer(GL_ARRAY_BUFFER, mask_vbo);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(ndc.size() * sizeof(float)), ndc.data(), GL_STREAM_DRAW);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
+    mask_program.use();
+    mask_program.set("u_ndc_z", pv.volume.backward ? 1.0f : -1.0f);  // window depth 1 or 0
+    glDisable(GL_CULL_FACE);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_ALWAYS);
+    glDepthMask(GL_TRUE);
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    glDrawArrays(GL_TRIANGLES, 0, GLsizei(ndc.size() / 2));
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glBindVertexArray(0);
+    return int64_t(region[0]) * region[1] - fp.openTexels();
+  }
+
+  // Renders the planned first passes, deepest first; returns their cull counts. Passes of slots below
+  // `whole_slots` (maps widened for reuse) draw every texel; the others skip what their element cannot read
+  // (RendererOptions::skip_unread_texels), counted in `skipped` of `texels`.
+  CullCount renderPasses(const std::vector<ElementFrame>& frames, size_t whole_slots, int64_t* skipped, int64_t* texels) {
     CullCount count;
+    *skipped = *texels = 0;
     for (size_t i = passes.size(); i-- > 0;) {
       const MapPass& mp = passes[i];
       const PatchView& pv = mp.owner->views[mp.view];
@@ -1012,6 +1070,8 @@ struct Renderer::Impl {
       // No colour clear: the sky covers every texel nothing else does (drawEnvironment).
       const std::array<int, 2> region = mapTexels(pv.volume, mp.side);
       t.bindRegionClearDepth(region[0], region[1], pv.volume.backward ? 0.0f : 1.0f);
+      *texels += int64_t(region[0]) * region[1];
+      if (options.skip_unread_texels && mp.slot >= whole_slots) *skipped += closeUnreadTexels(mp, region);
       // In a reversed (zooming) map the rays come from the mirror, not from the viewpoint.
       const Vec3 element_centre = Vec3(scene.elements[size_t(mp.owner->element)].local_to_world[3]);
       count.add(drawEnvironment(pv.volume.view, pv.volume.projection, pv.volume.eye, pv.volume.backward,
@@ -1196,7 +1256,8 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     // The maps change from here: any cache's record of them is void, even if a pass fails.
     first_pass_serial = nextFirstPassSerial();
     if (cache) cache->maps.clear();
-    const CullCount culled = renderPasses(frames);
+    int64_t unread = 0, texels = 0;
+    const CullCount culled = renderPasses(frames, widen ? widened.size() : 0, &unread, &texels);
     glFinish();
     if (cache) {
       cache->last_plan_nested = nested > 0 || dark > 0;
@@ -1229,6 +1290,9 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     if (rendered != int(passes.size()))
       note += (note.empty() ? "" : "; ") + std::to_string(passes.size() - size_t(rendered)) +
               " map(s) of elements outside the observer's view or beyond the depth limit not rendered";
+    if (unread > 0)
+      note += (note.empty() ? "" : "; ") + fmt("%.0f", 100.0 * double(unread) / double(texels)) +
+              " % of map texels left unshaded (no element reads them)";
     const std::string cull_note = cullNote(culled);
     if (!cull_note.empty()) note += (note.empty() ? "" : "; ") + cull_note;
     out.stages.ran("first-pass", msSince(t1), rendered, note);

@@ -66,6 +66,12 @@ struct RendererOptions {
   // separate): the front face now wins there, as in the tracer. false draws every face, for the tests that
   // compare.
   bool cull_back_faces = true;
+  // Leave unshaded the texels of each first-pass map that its reader cannot fetch (pvrr/map_footprint.h: the
+  // element's triangles at their texture coordinates, widened by the bilinear neighbourhood): the car mirror's
+  // warped image covers about three quarters of its map. Not for maps widened for reuse, whose later frames
+  // read elsewhere. The picture is the same texel for texel; false draws whole maps, for the tests that
+  // compare.
+  bool skip_unread_texels = true;
 };
 
 // Reuse across frames (paper section 5, eye-fixed caching): when an element has not moved relative to the
