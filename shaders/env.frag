@@ -5,8 +5,9 @@ in vec3 v_pos;
 in vec3 v_normal;
 in vec2 v_uv;
 uniform vec3 u_albedo;
-uniform bool u_has_texture;
+#if defined(TEXTURED)
 uniform sampler2D u_texture;   // GL_SRGB8: decoded to linear before filtering
+#endif
 uniform vec3 u_view_origin;    // the point rays come from (the camera, or the virtual viewpoint), relative
 #include "outputs.glsl"
 #include "shading.glsl"
@@ -16,7 +17,9 @@ flat in vec3 v_face_light;
 #endif
 void main() {
   vec3 albedo = u_albedo;
-  if (u_has_texture) albedo *= texture(u_texture, v_uv).rgb;
+#if defined(TEXTURED)
+  albedo *= texture(u_texture, v_uv).rgb;
+#endif
 #if defined(FACETED)
   o_color = vec4(albedo * (v_face_light + pointLights(v_pos, v_face_normal)), 1.0);
 #else

@@ -261,8 +261,6 @@ struct Renderer::Impl {
     if (!options.seen_points) d.push_back("#define NO_SEEN_POINTS");
     return d;
   }
-  Program env_program = makeProgram("env.vert", "env.frag", defines({}));
-  Program env_faceted_program = makeProgram("env.vert", "env.frag", defines({"#define FACETED"}));
   Program sky_program = makeProgram("sky.vert", "sky.frag", defines({}));
   Program plain_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_PLAIN"}));
   Program envmap_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_ENVMAP"}));
@@ -274,20 +272,28 @@ struct Renderer::Impl {
   // RGB dispersion: its maps are R, G and B planes.
   Program lens_rgb_program = makeProgram("element.vert", "element.frag",
                                          defines({"#define MODE_PVRR", "#define CHANNELS 3", "#define LENS", "#define RGB_CHANNELS"}));
-  // The variants that draw into a planes map (PLANES), built on first use: only scenes with a lens with RGB
-  // dispersion draw into one.
-  mutable std::map<std::string, std::unique_ptr<Program>> planes_programs;
-  const Program& planesVariant(const std::string& vert, const std::string& frag, std::vector<std::string> d) const {
-    d.push_back("#define PLANES");
+  // Programs built on first use, by sources and defines: the environment's kinds of mesh that a scene has, and
+  // the variants that draw into a planes map (PLANES), which only scenes with a lens with RGB dispersion need.
+  mutable std::map<std::string, std::unique_ptr<Program>> built_programs;
+  const Program& builtProgram(const std::string& vert, const std::string& frag, const std::vector<std::string>& d) const {
     std::string key = vert + " " + frag;
     for (const std::string& x : d) key += "|" + x;
-    std::unique_ptr<Program>& p = planes_programs[key];
+    std::unique_ptr<Program>& p = built_programs[key];
     if (!p) p = std::make_unique<Program>(makeProgram(vert, frag, defines(d)));
     return *p;
   }
-  const Program& envProgram(bool faceted, bool planes) const {
-    if (!planes) return faceted ? env_faceted_program : env_program;
-    return planesVariant("env.vert", "env.frag", faceted ? std::vector<std::string>{"#define FACETED"} : std::vector<std::string>{});
+  const Program& planesVariant(const std::string& vert, const std::string& frag, std::vector<std::string> d) const {
+    d.push_back("#define PLANES");
+    return builtProgram(vert, frag, d);
+  }
+  // Environment meshes (shaders/env.frag): FACETED (one normal per triangle), TEXTURED (a material with a
+  // texture; without, no texture is sampled: llvmpipe samples inside a uniform branch all the same).
+  const Program& envProgram(bool faceted, bool textured, bool planes) const {
+    std::vector<std::string> d;
+    if (faceted) d.push_back("#define FACETED");
+    if (textured) d.push_back("#define TEXTURED");
+    if (planes) d.push_back("#define PLANES");
+    return builtProgram("env.vert", "env.frag", d);
   }
   const Program& skyProgram(bool planes) const { return planes ? planesVariant("sky.vert", "sky.frag", {}) : sky_program; }
   const Program& plainProgram(bool planes) const {
@@ -436,12 +442,17 @@ struct Renderer::Impl {
     glEnable(GL_DEPTH_TEST);
     glDepthMask(GL_TRUE);
     glDepthFunc(reversed_depth ? GL_GREATER : GL_LESS);
-    const Program &faceted = envProgram(true, planes), &smooth = envProgram(false, planes);
-    for (const Program* p : {&faceted, &smooth}) {
+    // The programs of the kinds of mesh the scene has, [faceted][textured], set up for this pass.
+    const Program* programs[2][2] = {};
+    for (size_t m = 0; m < scene.meshes.size(); ++m) {
+      const bool faceted = env_faceted[m], textured = scene.materials[size_t(scene.meshes[m].material)].texture >= 0;
+      const Program*& p = programs[faceted][textured];
+      if (p) continue;
+      p = &envProgram(faceted, textured, planes);
       p->use();
       p->set("u_view_proj", toFloat(vp));
       p->set("u_view_origin", rays_from ? glm::vec3(*rays_from - origin) : glm::vec3(0.0f));
-      p->set("u_texture", 0);
+      if (textured) p->set("u_texture", 0);
       setLights(*p, origin);
     }
     glActiveTexture(GL_TEXTURE0);
@@ -461,7 +472,7 @@ struct Renderer::Impl {
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
       const EnvMesh& mesh = scene.meshes[m];
       const DiffuseMaterial& mat = scene.materials[size_t(mesh.material)];
-      const Program& p = env_faceted[m] ? faceted : smooth;
+      const Program& p = *programs[env_faceted[m]][mat.texture >= 0];
       const Vec3 to_anchor = mesh.anchor - origin;  // camera-relative bounds
       const Vec3 lo = env_bounds[m][0] + to_anchor, hi = env_bounds[m][1] + to_anchor;
       const bool cull = may_cull && mesh.closed_convex && near_clip.cannotOpen(lo, hi);
@@ -474,7 +485,6 @@ struct Renderer::Impl {
       p.use();
       p.set("u_offset", glm::vec3(mesh.anchor - origin));
       p.set("u_albedo", glm::vec3(mat.color));
-      p.set("u_has_texture", mat.texture >= 0 ? 1 : 0);
       if (mat.texture >= 0) glBindTexture(GL_TEXTURE_2D, textures[size_t(mat.texture)].name());
       draw(env_meshes[m]);
     }

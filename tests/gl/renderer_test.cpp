@@ -55,14 +55,25 @@ using test::medianArcmin;
 class RendererTest : public ::testing::TestWithParam<gl::GlBackend> {};
 
 // The room's quads and box are faceted (one normal per triangle): their ambient and directional light is
-// computed per vertex and passed flat, the point light per fragment (shaders/env.vert). Both lightings.
+// computed per vertex and passed flat, the point light per fragment (shaders/env.vert). Both lightings, and a
+// textured back wall beside the untextured walls and box (each kind of material has its own program).
 TEST_P(RendererTest, RasterEnvironmentMatchesTheTracer) {
   auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
   for (const bool point_light : {false, true}) {
-    SCOPED_TRACE(point_light ? "with a point light" : "ambient and directional");
+    SCOPED_TRACE(point_light ? "with a point light and a textured back wall" : "ambient and directional");
     Scene s = test::roomScene(Vec3(0.3, 0.2, 2.0), Vec3(0, -0.2, 0));
     if (point_light) {
+      // The back wall (material 5) takes a 4 x 4 texture of dark and bright squares, one texel each.
+      Texture t;
+      t.name = "squares";
+      t.width = t.height = 4;
+      for (int i = 0; i < 16; ++i) {
+        const uint8_t v = ((i % 4) + (i / 4)) % 2 ? 230 : 25;
+        t.rgb.insert(t.rgb.end(), {v, uint8_t(v / 2), uint8_t(255 - v)});
+      }
+      s.textures.push_back(t);
+      s.materials[5].texture = 0;
       Light lamp;
       lamp.type = Light::Type::Point;
       lamp.position = Vec3(-0.5, 0.7, -0.5);
