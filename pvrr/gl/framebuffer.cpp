@@ -114,20 +114,28 @@ void Texture::bind(int unit) const {
 Texture createTexture2D(const ImageRGB8& image, TextureEncoding encoding, bool mipmaps) {
   requireCurrentContext("createTexture2D");
   checkImage(image, "createTexture2D");
-  // GL's first row is the bottom one (t = 0): upload the image bottom row first.
-  const std::size_t row = 3 * static_cast<std::size_t>(image.width);
-  std::vector<std::uint8_t> flipped(image.rgb.size());
-  for (int y = 0; y < image.height; ++y) {
-    std::memcpy(&flipped[static_cast<std::size_t>(image.height - 1 - y) * row],
-                &image.rgb[static_cast<std::size_t>(y) * row], row);
+  // GL's first row is the bottom one (t = 0): upload the image bottom row first. Stored with an opaque alpha
+  // (SRGB8_ALPHA8 / RGBA8): the same values as a 3-byte format, but llvmpipe fetches 4-byte texels faster (the
+  // car-mirror frame at 1280 x 720 by 0.5-2.8 ms in three interleaved runs).
+  const std::size_t w = static_cast<std::size_t>(image.width), h = static_cast<std::size_t>(image.height);
+  std::vector<std::uint8_t> flipped(4 * w * h);
+  for (std::size_t y = 0; y < h; ++y) {
+    const std::uint8_t* src = &image.rgb[3 * y * w];
+    std::uint8_t* dst = &flipped[4 * (h - 1 - y) * w];
+    for (std::size_t x = 0; x < w; ++x) {
+      dst[4 * x] = src[3 * x];
+      dst[4 * x + 1] = src[3 * x + 1];
+      dst[4 * x + 2] = src[3 * x + 2];
+      dst[4 * x + 3] = 255;
+    }
   }
   GLuint name = 0;
   glGenTextures(1, &name);
   Texture texture(name, GL_TEXTURE_2D, GlContext::current());
   glBindTexture(GL_TEXTURE_2D, name);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);  // RGB8 rows are not 4-byte aligned in general
-  glTexImage2D(GL_TEXTURE_2D, 0, encoding == TextureEncoding::Srgb ? GL_SRGB8 : GL_RGB8, image.width, image.height,
-               0, GL_RGB, GL_UNSIGNED_BYTE, flipped.data());
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTexImage2D(GL_TEXTURE_2D, 0, encoding == TextureEncoding::Srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, image.width,
+               image.height, 0, GL_RGBA, GL_UNSIGNED_BYTE, flipped.data());
   if (mipmaps) glGenerateMipmap(GL_TEXTURE_2D);
   setSampling(GL_TEXTURE_2D, mipmaps);
   checkGlError("createTexture2D");
