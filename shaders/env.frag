@@ -6,7 +6,7 @@ in vec3 v_normal;
 in vec2 v_uv;
 uniform vec3 u_albedo;
 #if defined(TEXTURED)
-uniform sampler2D u_texture;   // GL_SRGB8: decoded to linear before filtering
+uniform sampler2D u_texture;   // GL_SRGB8_ALPHA8: decoded to linear before filtering
 #endif
 uniform vec3 u_view_origin;    // the point rays come from (the camera, or the virtual viewpoint), relative
 #include "outputs.glsl"

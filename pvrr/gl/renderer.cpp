@@ -272,8 +272,9 @@ struct Renderer::Impl {
   // RGB dispersion: its maps are R, G and B planes.
   Program lens_rgb_program = makeProgram("element.vert", "element.frag",
                                          defines({"#define MODE_PVRR", "#define CHANNELS 3", "#define LENS", "#define RGB_CHANNELS"}));
-  // Programs built on first use, by sources and defines: the environment's kinds of mesh that a scene has, and
-  // the variants that draw into a planes map (PLANES), which only scenes with a lens with RGB dispersion need.
+  // Programs built on demand, by sources and defines: the environment's kinds of mesh that a scene has (built
+  // with the renderer), and the variants that draw into a planes map (PLANES, on first use), which only scenes
+  // with a lens with RGB dispersion need.
   mutable std::map<std::string, std::unique_ptr<Program>> built_programs;
   const Program& builtProgram(const std::string& vert, const std::string& frag, const std::vector<std::string>& d) const {
     std::string key = vert + " " + frag;
@@ -379,6 +380,9 @@ struct Renderer::Impl {
         hi = glm::max(hi, Vec3(p));
       }
       env_bounds.push_back({lo, hi});
+      // Its program, built now (not in the first frame's first pass) so that its compile time and any
+      // compile error come with the renderer.
+      envProgram(env_faceted.back(), scene.materials[size_t(mesh.material)].texture >= 0, false);
     }
     checkGlError("uploading the environment");
   }
@@ -583,8 +587,9 @@ struct Renderer::Impl {
                                                 : std::vector<ColorFormat>{ColorFormat::RGBA32F};
       if (options.seen_points) formats.push_back(ColorFormat::RGBA32F);
       maps[i] = std::make_unique<Framebuffer>(size, size, formats, DepthFormat::Depth32F);
-      // Defined contents once: texels a pass leaves unshaded (closeUnreadTexels) keep what they hold, and a
-      // bilinear fetch beside the footprint may weigh one of them by zero, which must not be a NaN.
+      // Defined contents once: a pass renders only the lower-left region of the texture and may leave texels
+      // unshaded (closeUnreadTexels); a fetch clamped to the region's far edge (u_st_max) may still weigh the
+      // texel past it by a rounding residue, which must not meet a NaN.
       maps[i]->clear({0.0f, 0.0f, 0.0f, 0.0f});
       // Colour and seen points filter linearly: seen points are exact within a surface and blend only across
       // depth edges (nearest filtering would quantise every seen point by up to half a texel).
@@ -1301,7 +1306,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       note += (note.empty() ? "" : "; ") + std::to_string(passes.size() - size_t(rendered)) +
               " map(s) of elements outside the observer's view or beyond the depth limit not rendered";
     if (unread > 0)
-      note += (note.empty() ? "" : "; ") + fmt("%.0f", 100.0 * double(unread) / double(texels)) +
+      note += (note.empty() ? "" : "; ") + fmt("%.2g", 100.0 * double(unread) / double(texels)) +
               " % of map texels left unshaded (no element reads them)";
     const std::string cull_note = cullNote(culled);
     if (!cull_note.empty()) note += (note.empty() ? "" : "; ") + cull_note;

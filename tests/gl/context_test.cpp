@@ -441,7 +441,7 @@ TEST_F(GlFixture, FramebufferRejectsBadSizesAndAttachments) {
 }
 
 TEST_F(GlFixture, Texture2DIsUploadedBottomRowFirstWithMipmaps) {
-  ImageRGB8 image(3, 2);  // odd width: RGB8 rows of 9 bytes test the unpack alignment
+  ImageRGB8 image(3, 2);  // odd width: RGB8 rows of 9 bytes, stored as RGBA8
   for (std::size_t i = 0; i < image.rgb.size(); ++i) image.rgb[i] = static_cast<std::uint8_t>(10 * i + 1);
   Texture texture = createTexture2D(image, TextureEncoding::Linear, true);
   texture.bind(0);
