@@ -12,4 +12,9 @@ inline std::string fmt(const char* format, double x) {
   return buf;
 }
 
+// Appends `part` to a note of parts separated by "; " (nothing for an empty part).
+inline void appendNote(std::string& note, const std::string& part) {
+  if (!part.empty()) note += (note.empty() ? "" : "; ") + part;
+}
+
 }  // namespace pvrr

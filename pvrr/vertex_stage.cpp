@@ -6,6 +6,7 @@
 #include <chrono>
 
 #include "cad/error.h"
+#include "pvrr/format.h"
 #include "pvrr/optics.h"
 #include "pvrr/spectrum.h"
 #include "pvrr/tracer.h"
@@ -315,8 +316,8 @@ void buildPatchMap(const Scene& scene, const ElementFrame& f, const Element& el,
   if (2 * zooming > rays.size()) {
     pv.volume = buildReversedViewVolume(pv.fit.eye, rays, vo);
     if (zooming < rays.size())
-      pv.volume.note += (pv.volume.note.empty() ? "" : "; ") + std::to_string(rays.size() - zooming) +
-                        " hit(s) beyond the viewpoint are not in this reversed map";
+      appendNote(pv.volume.note,
+                 std::to_string(rays.size() - zooming) + " hit(s) beyond the viewpoint are not in this reversed map");
   }
   projectPatchMap(f, pv);
 }

@@ -11,8 +11,6 @@
 namespace pvrr {
 namespace {
 
-void appendNote(std::string& note, const std::string& s) { note += (note.empty() ? "" : "; ") + s; }
-
 void validate(const char* who, const Vec3& eye, const std::vector<ViewpointRay>& rays) {
   if (rays.empty()) throw Error(std::string(who) + ": no rays given; expected the vertex rays of a patch");
   if (!isFinite(eye)) throw Error(std::string(who) + ": the eye is not finite");

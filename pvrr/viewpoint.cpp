@@ -25,7 +25,6 @@ using Eigen::Vector3d;
 Vector3d toEigen(const Vec3& v) { return {v.x, v.y, v.z}; }
 Vec3 toGlm(const Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
-
 // Rays per lane group of the vectorised evaluation (evaluateRange).
 constexpr size_t kLanes = 8;
 

@@ -15,8 +15,8 @@ class GlContext;
 enum class ColorFormat { RGBA8, SRGB8A8, RGBA16F, RGBA32F, R32F };
 enum class DepthFormat { None, Depth24, Depth32F };
 
-// How texture data from 8-bit images is interpreted when sampled: Srgb stores GL_SRGB8_ALPHA8 (sampling returns linear
-// values), Linear stores GL_RGBA8 (sampling returns code / 255); alpha is 1.
+// How texture data from 8-bit images is interpreted when sampled: Srgb stores GL_SRGB8_ALPHA8 (sampling returns
+// linear values), Linear stores GL_RGBA8 (sampling returns code / 255); alpha is 1.
 enum class TextureEncoding { Srgb, Linear };
 
 // An owned GL texture name.

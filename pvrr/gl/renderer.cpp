@@ -314,6 +314,7 @@ struct Renderer::Impl {
   int max_texture_size = 0;  // GL_MAX_TEXTURE_SIZE
   std::vector<MeshBuffers> env_meshes;
   std::vector<bool> env_faceted;  // per environment mesh: every triangle has one normal at its three corners
+  std::vector<bool> env_textured;  // per environment mesh: its material has a texture
   std::vector<std::array<Vec3, 2>> env_bounds;  // per environment mesh: its bounding box, relative to its anchor
   // Closed convex meshes drawn and culled by drawEnvironment, summed over a stage's passes for its note.
   struct CullCount {
@@ -380,9 +381,10 @@ struct Renderer::Impl {
         hi = glm::max(hi, Vec3(p));
       }
       env_bounds.push_back({lo, hi});
+      env_textured.push_back(scene.materials[size_t(mesh.material)].texture >= 0);
       // Its program, built now (not in the first frame's first pass) so that its compile time and any
       // compile error come with the renderer.
-      envProgram(env_faceted.back(), scene.materials[size_t(mesh.material)].texture >= 0, false);
+      envProgram(env_faceted.back(), env_textured.back(), false);
     }
     checkGlError("uploading the environment");
   }
@@ -449,7 +451,7 @@ struct Renderer::Impl {
     // The programs of the kinds of mesh the scene has, [faceted][textured], set up for this pass.
     const Program* programs[2][2] = {};
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
-      const bool faceted = env_faceted[m], textured = scene.materials[size_t(scene.meshes[m].material)].texture >= 0;
+      const bool faceted = env_faceted[m], textured = env_textured[m];
       const Program*& p = programs[faceted][textured];
       if (p) continue;
       p = &envProgram(faceted, textured, planes);
@@ -476,7 +478,7 @@ struct Renderer::Impl {
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
       const EnvMesh& mesh = scene.meshes[m];
       const DiffuseMaterial& mat = scene.materials[size_t(mesh.material)];
-      const Program& p = *programs[env_faceted[m]][mat.texture >= 0];
+      const Program& p = *programs[env_faceted[m]][env_textured[m]];
       const Vec3 to_anchor = mesh.anchor - origin;  // camera-relative bounds
       const Vec3 lo = env_bounds[m][0] + to_anchor, hi = env_bounds[m][1] + to_anchor;
       const bool cull = may_cull && mesh.closed_convex && near_clip.cannotOpen(lo, hi);
@@ -1303,13 +1305,12 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       note += any_forward ? "; not widened for reuse: the last first pass had nested passes or elements drawn dark"
                           : "; not widened for reuse: reversed (zooming) maps are not reused";
     if (rendered != int(passes.size()))
-      note += (note.empty() ? "" : "; ") + std::to_string(passes.size() - size_t(rendered)) +
-              " map(s) of elements outside the observer's view or beyond the depth limit not rendered";
+      appendNote(note, std::to_string(passes.size() - size_t(rendered)) +
+                           " map(s) of elements outside the observer's view or beyond the depth limit not rendered");
     if (unread > 0)
-      note += (note.empty() ? "" : "; ") + fmt("%.2g", 100.0 * double(unread) / double(texels)) +
-              " % of map texels left unshaded (no element reads them)";
-    const std::string cull_note = cullNote(culled);
-    if (!cull_note.empty()) note += (note.empty() ? "" : "; ") + cull_note;
+      appendNote(note, fmt("%.2g", 100.0 * double(unread) / double(texels)) +
+                           " % of map texels left unshaded (no element reads them)");
+    appendNote(note, cullNote(culled));
     out.stages.ran("first-pass", msSince(t1), rendered, note);
     const std::string dark_note =
         dark == 0 ? "" : std::to_string(dark) + " element(s) in a map drawn dark (" +

@@ -242,7 +242,6 @@ TEST(Tracer, TotallyReflectedLightCrossesTheLensAndLeavesThroughTheFront) {
   }
 }
 
-
 TEST(Tracer, PathsInEveryDefaultSceneObeyTheLaws) {
   const std::filesystem::path models = std::filesystem::path(PVRR_SOURCE_DIR) / "models";
   int scenes = 0, specular = 0;
