@@ -89,6 +89,13 @@ class NearClip {
 // counter-clockwise in window space (GL_CCW front faces). False for a projection that mirrors the image.
 bool facingTrianglesWindCounterClockwise(const Mat4& view_proj);
 
+// The order in which to draw the solids inside the boxes [lo, hi] (relative to the centre of projection) so
+// that the early depth test rejects the fragments of hidden ones instead of shading them: nearest first, by
+// the distance to each box's nearest point (0 for a box around the centre), or with reversed depth (the
+// farther fragment wins) farthest first, by the distance to each box's farthest corner. Stable: boxes with
+// equal keys keep their given order. The picture changes only where two solids tie in depth.
+std::vector<size_t> depthSortedDrawOrder(const std::vector<std::array<Vec3, 2>>& boxes, bool reversed_depth);
+
 struct ViewVolume {
   Vec3 eye{0}, forward{0, 0, -1}, up{0, 1, 0}, right{1, 0, 0};  // orthonormal, right = forward x up
   double near_m = 0, far_m = 0;  // depths along forward, 0 < near_m < far_m

@@ -428,6 +428,20 @@ struct Renderer::Impl {
   // no pixel is shaded twice for it; what was drawn into the target before (the elements of the second
   // pass, drawn first so that the environment behind them fails the early depth test) stays.
   // Returns how many closed convex meshes it drew and culled.
+  // The environment meshes in scene order, or sorted by their bounds' distance from `origin`
+  // (RendererOptions::sort_environment).
+  std::vector<size_t> environmentDrawOrder(const Vec3& origin, bool reversed_depth) const {
+    std::vector<std::array<Vec3, 2>> boxes(scene.meshes.size());
+    for (size_t m = 0; m < scene.meshes.size(); ++m) {
+      const Vec3 to_anchor = scene.meshes[m].anchor - origin;
+      boxes[m] = {env_bounds[m][0] + to_anchor, env_bounds[m][1] + to_anchor};
+    }
+    if (options.sort_environment) return depthSortedDrawOrder(boxes, reversed_depth);
+    std::vector<size_t> order(boxes.size());
+    for (size_t m = 0; m < order.size(); ++m) order[m] = m;
+    return order;
+  }
+
   CullCount drawEnvironment(const Mat4& view, const Mat4& proj, const Vec3& origin, bool reversed_depth = false,
                             const Vec3* rays_from = nullptr, bool planes = false) const {
     const Mat4 vp = relativeViewProj(proj, view, origin);
@@ -475,7 +489,7 @@ struct Renderer::Impl {
     }
     bool culling = false;
     CullCount count;
-    for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    for (const size_t m : environmentDrawOrder(origin, reversed_depth)) {
       const EnvMesh& mesh = scene.meshes[m];
       const DiffuseMaterial& mat = scene.materials[size_t(mesh.material)];
       const Program& p = *programs[env_faceted[m]][env_textured[m]];

@@ -72,6 +72,11 @@ struct RendererOptions {
   // read elsewhere. The picture is the same texel for texel; false draws whole maps, for the tests that
   // compare.
   bool skip_unread_texels = true;
+  // Draw the environment meshes nearest first (farthest first in reversed-depth maps; depthSortedDrawOrder),
+  // so that what a nearer mesh hides fails the early depth test instead of being shaded and overwritten. The
+  // picture changes only where two meshes tie in depth; false keeps the scene's order, for the tests that
+  // compare.
+  bool sort_environment = true;
 };
 
 // Reuse across frames (paper section 5, eye-fixed caching): when an element has not moved relative to the

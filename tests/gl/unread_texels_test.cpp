@@ -14,10 +14,14 @@
 #include "pvrr/gl/renderer.h"
 #include "pvrr/scene_build.h"
 #include "pvrr/scene_json.h"
+#include "support/frames.h"
 #include "support/gl_backends.h"
 
 namespace pvrr {
 namespace {
+
+using test::differingPixels;
+using test::shippedScene;
 
 class UnreadTexelsTest : public ::testing::TestWithParam<gl::GlBackend> {};
 
@@ -29,21 +33,6 @@ int unshadedPercent(const gl::RasterFrame& f) {
   if (at == std::string::npos) return -1;
   const size_t from = s->note.rfind(' ', at - 1);
   return std::stoi(s->note.substr(from == std::string::npos ? 0 : from + 1, at - from));
-}
-
-// The number of pixels where any output of the two frames differs at all.
-size_t differingPixels(const gl::RasterFrame& a, const gl::RasterFrame& b) {
-  EXPECT_EQ(a.color.size(), b.color.size());
-  EXPECT_EQ(a.seen.size(), a.color.size()) << "seen points are needed for the comparison";
-  size_t n = 0;
-  for (size_t i = 0; i < a.color.size() && i < b.color.size(); ++i)
-    n += a.color[i] != b.color[i] || a.seen[i] != b.seen[i] || a.element[i] != b.element[i] ||
-         a.element_point[i] != b.element_point[i];
-  return n;
-}
-
-Scene shippedScene(const std::string& name) {
-  return buildScene(loadScene(std::string(PVRR_SOURCE_DIR) + "/models/" + name + ".json", {"observer.image_size=[160,120]"}));
 }
 
 TEST_P(UnreadTexelsTest, ShippedScenesAreTheSameBitForBit) {

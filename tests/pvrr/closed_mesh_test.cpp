@@ -2,6 +2,7 @@
 // tested here against closed forms: the builders' meshes are closed, convex and wound counter-clockwise seen
 // from outside; nearClipCannotOpen tells when near clipping can cut such a solid open; and
 // facingTrianglesWindCounterClockwise tells which window-space winding a triangle facing the camera has.
+// depthSortedDrawOrder, the renderer's environment draw order, is checked on boxes at known distances.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -132,6 +133,27 @@ TEST(FacingTriangles, WindCounterClockwiseUnlessTheProjectionMirrors) {
     const double area = (pb.x - pa.x) * (pc.y - pa.y) - (pc.x - pa.x) * (pb.y - pa.y);
     EXPECT_EQ(area > 0, facingTrianglesWindCounterClockwise(vp));
   }
+}
+
+// Boxes relative to the centre of projection, at known distances: nearest points 0 (around the centre),
+// 1 (a door beside the eye), 5 (a car), 0.5 below (a road plane under the eye, flat in y) and a far building.
+TEST(DepthSortedDrawOrder, NearestFirstOrFarthestFirstWithReversedDepth) {
+  const std::vector<std::array<Vec3, 2>> boxes = {
+      {Vec3(-1, -1, 4), Vec3(1, 1, 6)},         // 0: car, nearest 4 (z), farthest |(1,1,6)|
+      {Vec3(-100, -0.5, -100), Vec3(100, -0.5, 100)},  // 1: road, nearest 0.5, farthest |(100,0.5,100)|
+      {Vec3(1, -1, -1), Vec3(1.1, 1, 1)},       // 2: door, nearest 1, farthest |(1.1,1,1)|
+      {Vec3(-2, -2, -2), Vec3(2, 2, 2)},        // 3: a room around the eye, nearest 0
+      {Vec3(20, 0, 20), Vec3(30, 10, 40)},      // 4: building, nearest |(20,0,20)|
+  };
+  EXPECT_EQ(depthSortedDrawOrder(boxes, false), (std::vector<size_t>{3, 1, 2, 0, 4}));
+  // Farthest corners: road 141.4, building 50.99, car 6.16, room 3.46, door 1.73.
+  EXPECT_EQ(depthSortedDrawOrder(boxes, true), (std::vector<size_t>{1, 4, 0, 3, 2}));
+  // Equal keys keep the given order; no boxes, no order.
+  const std::vector<std::array<Vec3, 2>> twins = {{Vec3(0, 0, 3), Vec3(1, 1, 4)}, {Vec3(0, 0, 3), Vec3(1, 1, 4)},
+                                                   {Vec3(0, 0, 1), Vec3(1, 1, 2)}};
+  EXPECT_EQ(depthSortedDrawOrder(twins, false), (std::vector<size_t>{2, 0, 1}));
+  EXPECT_EQ(depthSortedDrawOrder(twins, true), (std::vector<size_t>{0, 1, 2}));
+  EXPECT_TRUE(depthSortedDrawOrder({}, false).empty());
 }
 
 }  // namespace
