@@ -6,14 +6,20 @@
 #include <array>
 #include <cstdio>
 #include <cstdlib>
+#include <mutex>
 #include <string>
 
 #include "cad/error.h"
 #include "cad/sag.h"
 
+#include <tbb/parallel_for.h>
+
 namespace pvrr {
 
 namespace {
+
+// Candidate vertices per bounding box in RayScene::tangentClearance.
+constexpr size_t kClearanceChunk = 32;
 
 void embreeError(void*, RTCError code, const char* message) {
   // Errors reach us through rtcGetDeviceError checks below; keep a trace on stderr for diagnosis.
@@ -93,7 +99,21 @@ struct RayScene::Impl {
   // `scene`, attached to both), for single-surface queries: one traversal of a small BVH instead of
   // stepping through every other hit along the ray in the whole scene.
   std::vector<std::array<RTCScene, 2>> element_scenes;
+  // Mirror element -> a scene with every geometry but that element's (the same Embree geometries under the
+  // same IDs), for intersectBeside; null for lenses.
+  std::vector<RTCScene> beside_scenes;
+  // Mirror element -> its candidate vertices (element-local) in chunks of kClearanceChunk with their bounding
+  // boxes, and the last tangentClearance() query and answer.
+  struct Clearance {
+    std::vector<std::array<Vec3, 2>> chunk_boxes;
+    std::vector<Vec3> points, normals;
+    std::shared_ptr<const RayScene::TangentClearance> answer;
+  };
+  std::vector<Clearance> clearance;
+  std::mutex clearance_mutex;
   ~Impl() {
+    for (RTCScene s : beside_scenes)
+      if (s) rtcReleaseScene(s);
     for (auto& pair : element_scenes)
       for (RTCScene s : pair)
         if (s) rtcReleaseScene(s);
@@ -201,6 +221,28 @@ RayScene::RayScene(const Scene& scene, RaySceneOptions options) : scene_(scene),
     }
   }
   rtcCommitScene(im.scene);
+  im.beside_scenes.assign(scene.elements.size(), nullptr);
+  im.clearance.resize(scene.elements.size());
+  for (size_t e = 0; e < scene.elements.size(); ++e) {
+    if (scene.elements[e].type != ElementType::Mirror) continue;
+    RTCScene beside = rtcNewScene(im.device);
+    im.beside_scenes[e] = beside;
+    rtcSetSceneBuildQuality(beside, moving ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_HIGH);
+    if (moving) rtcSetSceneFlags(beside, RTC_SCENE_FLAG_DYNAMIC);
+    for (size_t id = 0; id < im.geoms.size(); ++id)
+      if (im.geoms[id].kind != HitKind::None && !(im.geoms[id].kind == HitKind::Element && im.geoms[id].index == int(e)))
+        rtcAttachGeometryByID(beside, rtcGetGeometry(im.scene, unsigned(id)), unsigned(id));
+    rtcCommitScene(beside);
+    const std::vector<Vec3>& local = im.geoms[size_t(im.element_geoms[e][0])].local;
+    for (size_t from = 0; from < local.size(); from += kClearanceChunk) {
+      std::array<Vec3, 2> box{local[from], local[from]};
+      for (size_t j = from; j < std::min(local.size(), from + kClearanceChunk); ++j) {
+        box[0] = glm::min(box[0], local[j]);
+        box[1] = glm::max(box[1], local[j]);
+      }
+      im.clearance[e].chunk_boxes.push_back(box);
+    }
+  }
   RTCError err = rtcGetDeviceError(im.device);
   if (err != RTC_ERROR_NONE) throw Error("Embree: scene build failed (error " + std::to_string(int(err)) + ")");
 }
@@ -225,6 +267,8 @@ void RayScene::updateElementPoses() {
     rtcCommitGeometry(geom);
   }
   rtcCommitScene(im.scene);
+  for (RTCScene s : im.beside_scenes)
+    if (s) rtcCommitScene(s);
   for (auto& pair : im.element_scenes)
     for (RTCScene s : pair)
       if (s) rtcCommitScene(s);
@@ -314,9 +358,20 @@ bool RayScene::resolveCandidate(const Vec3& o, const Vec3& d, double t_min, doub
 }
 
 RayHit RayScene::intersect(const Vec3& o, const Vec3& d, double t_min, double t_max) const {
+  return intersectIn(-1, o, d, t_min, t_max);
+}
+
+RayHit RayScene::intersectBeside(int element, const Vec3& o, const Vec3& d, double t_min, double t_max) const {
+  PVRR_CHECK(element >= 0 && size_t(element) < impl_->beside_scenes.size() && impl_->beside_scenes[size_t(element)],
+             << "element " << element << " is not a mirror");
+  return intersectIn(element, o, d, t_min, t_max);
+}
+
+RayHit RayScene::intersectIn(int beside_element, const Vec3& o, const Vec3& d, double t_min, double t_max) const {
   // A ray that is not finite (degenerate input upstream) meets nothing; Embree asserts on it.
   if (!std::isfinite(o.x + o.y + o.z + d.x + d.y + d.z)) return RayHit{};
   const Impl& im = *impl_;
+  RTCScene scene = beside_element < 0 ? im.scene : im.beside_scenes[size_t(beside_element)];
   // After a rejected candidate the next query starts strictly beyond it (the float slack must not bring the
   // same triangle back).
   float past = 0.0f;
@@ -327,7 +382,7 @@ RayHit RayScene::intersect(const Vec3& o, const Vec3& d, double t_min, double t_
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRayHit rh = rayHit1(floatRay(o, d, im.anchor, t_min, t_max, past));
-    rtcIntersect1(im.scene, &ctx, &rh);
+    rtcIntersect1(scene, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return RayHit{};
     RayHit hit;
     if (resolveCandidate(o, d, t_min, t_max, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar, hit))
@@ -381,6 +436,74 @@ void RayScene::intersectPacket(const Vec3* o, const Vec3* d, int count, RayHit* 
                           rh.ray.tfar[i], out[i]))
       out[i] = intersect(o[i], d[i], t_min, t_max);
   }
+}
+
+std::shared_ptr<const RayScene::TangentClearance> RayScene::tangentClearance(int element,
+                                                                             const std::vector<Vec3>& points,
+                                                                             const std::vector<Vec3>& normals) const {
+  Impl& im = *impl_;
+  PVRR_CHECK(element >= 0 && size_t(element) < im.clearance.size(), << element);
+  PVRR_CHECK(points.size() == normals.size(), << points.size() << " points, " << normals.size() << " normals");
+  Impl::Clearance& c = im.clearance[size_t(element)];
+  std::lock_guard<std::mutex> lock(im.clearance_mutex);
+  if (c.answer && c.points == points && c.normals == normals) return c.answer;
+  auto out = std::make_shared<TangentClearance>();
+  if (c.chunk_boxes.empty()) return out;  // a lens
+  const std::vector<Vec3>& local = im.geoms[size_t(im.element_geoms[size_t(element)][0])].local;
+  Vec3 lo = c.chunk_boxes[0][0], hi = c.chunk_boxes[0][1];
+  for (const auto& b : c.chunk_boxes) lo = glm::min(lo, b[0]), hi = glm::max(hi, b[1]);
+  const double cap = kClearanceCap * std::max(glm::length(hi - lo), 1e-9);
+  const size_t chunks = c.chunk_boxes.size();
+  out->ahead.resize(points.size());
+  out->behind.resize(points.size());
+  // Branch and bound per point: each chunk's box bounds its vertices' distances; the chunk with the largest
+  // bound is searched first, then every other chunk whose bound exceeds the extreme so far, until the extreme
+  // passes the cap.
+  tbb::parallel_for(size_t(0), points.size(), [&](size_t i) {
+    const Vec3 p = points[i], n = glm::normalize(normals[i]);
+    const double pn = glm::dot(p, n);
+    std::vector<double> bound(chunks);
+    for (int side = 0; side < 2; ++side) {
+      const double sign = side == 0 ? 1.0 : -1.0;  // ahead: the largest of (x - p) . n; behind: of -(x - p) . n
+      const Vec3 m = sign * n;
+      size_t first = 0;
+      for (size_t k = 0; k < chunks; ++k) {
+        const auto& b = c.chunk_boxes[k];
+        bound[k] = std::max(b[0].x * m.x, b[1].x * m.x) + std::max(b[0].y * m.y, b[1].y * m.y) +
+                   std::max(b[0].z * m.z, b[1].z * m.z) - sign * pn;
+        if (bound[k] > bound[first]) first = k;
+      }
+      double best = -kInf;
+      const auto search = [&](size_t k) {
+        for (size_t j = k * kClearanceChunk; j < std::min(local.size(), (k + 1) * kClearanceChunk); ++j)
+          best = std::max(best, glm::dot(local[j] - p, m));
+      };
+      search(first);
+      for (size_t k = 0; k < chunks && best <= cap; ++k)
+        if (k != first && bound[k] > best) search(k);
+      const double value = best > cap ? kInf : best;
+      (side == 0 ? out->ahead[i] : out->behind[i]) = sign * value;
+    }
+  });
+  c.points = points;
+  c.normals = normals;
+  c.answer = out;
+  return out;
+}
+
+double RayScene::candidateRounding(int element) const {
+  const Impl& im = *impl_;
+  PVRR_CHECK(element >= 0 && size_t(element) < im.clearance.size(), << element);
+  const Impl::Clearance& c = im.clearance[size_t(element)];
+  if (c.chunk_boxes.empty()) return kInf;
+  Vec3 lo = c.chunk_boxes[0][0], hi = c.chunk_boxes[0][1];
+  for (const auto& b : c.chunk_boxes) lo = glm::min(lo, b[0]), hi = glm::max(hi, b[1]);
+  // Every candidate and a ray origin on the element lie within `reach` of the anchor; float rounds each
+  // coordinate to half an ulp (2^-24 relative), so a point moves by at most sqrt(3) 2^-24 reach. Four times
+  // that covers both the candidate and the origin, and Embree's own float arithmetic, with room to spare.
+  const Element& el = scene_.elements[size_t(element)];
+  const double reach = glm::length(el.toWorldPoint(0.5 * (lo + hi)) - im.anchor) + 0.5 * glm::length(hi - lo);
+  return 4.0 * std::sqrt(3.0) * std::ldexp(reach + 1e-3, -24);
 }
 
 RayHit RayScene::intersectElementSurface(int element, int surface, const Vec3& o, const Vec3& d, double t_min,

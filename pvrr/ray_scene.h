@@ -6,6 +6,7 @@
 // No Embree type appears here.
 #pragma once
 #include <memory>
+#include <vector>
 
 #include "pvrr/scene.h"
 
@@ -63,6 +64,31 @@ class RayScene {
   RayHit intersectElementSurface(int element, int surface, const Vec3& o, const Vec3& d, double t_min = 0,
                                  double t_max = kInf, bool within_outline = true) const;
 
+  // Where a mirror element's candidate tessellation lies against the tangent planes of points on its surface
+  // (element-local positions and normals, e.g. the vertex stage's grid): per point p with normal n, the
+  // largest (`ahead`) and the smallest (`behind`) signed distance (x - p) . n over the candidate vertices x,
+  // computed exactly where within kClearanceCap of the surface's size, else +inf (ahead) or -inf (behind).
+  // A convex mirror's candidates lie wholly behind each tangent plane (ahead <= 0). The answer to the last set
+  // of points is kept per element: asking again with the same points costs one comparison. Empty for a lens.
+  struct TangentClearance {
+    std::vector<double> ahead, behind;
+  };
+  static constexpr double kClearanceCap = 1e-3;
+  std::shared_ptr<const TangentClearance> tangentClearance(int element, const std::vector<Vec3>& points,
+                                                           const std::vector<Vec3>& normals) const;
+  // How far from their true places float rounding can put the element's candidates and the float origin of a
+  // ray that starts on the element, at its current pose (a bound, in m).
+  double candidateRounding(int element) const;
+  // intersect() on everything but mirror element `element`, for a ray from p on it that cannot meet it: it
+  // leaves into the front (d . n >= kMinLeave) where tangentClearance's `ahead` at p is at most
+  // candidateRounding, or into the back where `behind` is at least minus that. Such a ray's height over the
+  // tangent plane, t (d . n), exceeds every candidate's beyond t = 2 candidateRounding / |d . n|; what the
+  // whole scene's query could report nearer lies within float rounding of p, where the exact test finds p
+  // itself (t <= t_min) and rejects it. So the hit is intersect()'s, without traversing the element's
+  // candidates, which every ray leaving the surface starts among.
+  static constexpr double kMinLeave = 1e-2;
+  RayHit intersectBeside(int element, const Vec3& o, const Vec3& d, double t_min = 0, double t_max = kInf) const;
+
   // After elements moved (Element::local_to_world changed, e.g. spectacles turning with the head): moves
   // their candidate tessellations in Embree and recommits. The environment is untouched.
   void updateElementPoses();
@@ -73,6 +99,8 @@ class RayScene {
 
  private:
   struct Impl;
+  // intersect() on the whole scene (beside_element < 0) or on everything but one mirror element.
+  RayHit intersectIn(int beside_element, const Vec3& o, const Vec3& d, double t_min, double t_max) const;
   // The exact hit behind Embree's candidate (geometry, primitive, barycentrics, float distance) on o + t d
   // with t in (t_min, t_max); false when the exact test rejects the candidate.
   bool resolveCandidate(const Vec3& o, const Vec3& d, double t_min, double t_max, unsigned geom_id,

@@ -148,6 +148,14 @@ static void traceVertexRaysFrom(const RayScene& rays, ElementFrame& f, const Vec
   f.tir_trace_depth = opt.tir_trace_depth;
   f.rays.assign(opt.channels.size(), std::vector<VertexRay>(f.world_pos.size()));
   const std::optional<Tracer> tracer = tirTracer(rays, f);
+  // Where a mirror's rays cannot meet the mirror itself (RayScene::intersectBeside).
+  std::shared_ptr<const RayScene::TangentClearance> clearance;
+  double rounding = 0;
+  if (el.type == ElementType::Mirror && opt.beside_own_mirror) {
+    clearance = rays.tangentClearance(f.element, f.grid.positions, f.grid.normals);
+    rounding = rays.candidateRounding(f.element);
+  }
+  std::vector<char> beside(opt.channels.size() * f.world_pos.size(), 0);  // counted after the loops
   for (size_t c = 0; c < opt.channels.size(); ++c) {
     const double wl = opt.channels[c].wavelength_nm > 0 ? opt.channels[c].wavelength_nm : kLineD_nm;
     // Vertices are independent: one task per block of vertices.
@@ -208,7 +216,15 @@ static void traceVertexRaysFrom(const RayScene& rays, ElementFrame& f, const Vec
         }
         vr.dir = out.direction;
       }
-      RayHit h = rays.intersect(vr.origin, vr.dir, eps);
+      bool leaves_clear = false;
+      if (clearance && !clearance->ahead.empty()) {
+        const double dn = glm::dot(vr.dir, n);
+        leaves_clear = (dn >= RayScene::kMinLeave && clearance->ahead[i] <= rounding) ||
+                       (dn <= -RayScene::kMinLeave && clearance->behind[i] >= -rounding);
+      }
+      beside[c * f.world_pos.size() + i] = leaves_clear;
+      const RayHit h = leaves_clear ? rays.intersectBeside(f.element, vr.origin, vr.dir, eps)
+                                    : rays.intersect(vr.origin, vr.dir, eps);
       if (h.hit()) {
         vr.status = VertexStatus::Hit;
         vr.hit = h.point;
@@ -218,6 +234,7 @@ static void traceVertexRaysFrom(const RayScene& rays, ElementFrame& f, const Vec
       }
     });
   }
+  f.rays_beside = int(std::count(beside.begin(), beside.end(), 1));
   f.rays_ms = msSince(t0);
 }
 

@@ -114,6 +114,12 @@ struct VertexStageOptions {
   // vertex whose ray is totally reflected inside the lens gets the tracer's answer (VertexRay::traced);
   // 0: it stays dark.
   int tir_trace_depth = 0;
+  // A mirror vertex's ray that cannot meet its own mirror (RayScene::intersectBeside: the mirror's candidate
+  // tessellation lies wholly behind the vertex's tangent plane, as a convex mirror's does, and the ray leaves
+  // in front of it) is traced beside the mirror, with the same hit, without traversing the mirror's
+  // candidates, among which every such ray starts. false traces every ray through the whole scene, for the
+  // tests that compare.
+  bool beside_own_mirror = true;
 };
 
 struct ElementFrame {
@@ -126,6 +132,7 @@ struct ElementFrame {
   std::vector<cad::GridPatch> grid_patches;
   std::vector<PatchView> views;              // one per patch
   double rays_ms = 0, fit_ms = 0;
+  int rays_beside = 0;  // rays traced beside their own mirror (VertexStageOptions::beside_own_mirror), all channels
   int patches_u = 1, patches_v = 1;
   std::string split_note;                    // why patches were split, if they were
   // Per vertex: non-zero when a triangle holding it can be seen by VertexStageOptions::viewer_clip (empty:

@@ -1181,6 +1181,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     auto t0 = Clock::now();
     double refraction_ms = 0, texcoord_ms = 0;
     bool any_texcoords = false;
+    size_t mirror_rays = 0, beside = 0;  // traced this frame; beside: VertexStageOptions::beside_own_mirror
     for (size_t e = 0; e < n_el; ++e) {
       if (reuse[e]) {
         frames[e] = cache->elements[e];
@@ -1195,10 +1196,15 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       frames[e] = prepareElement(scene, int(e), &grid_cache.get(scene, int(e)));
       traceVertexRays(rays, frames[e], ob.eye, opts[e]);
       if (scene.elements[e].type == ElementType::Lens) refraction_ms += frames[e].rays_ms;
+      else mirror_rays += frames[e].rays.size() * frames[e].world_pos.size(), beside += size_t(frames[e].rays_beside);
     }
     const double cpu_ms = msSince(t0);
     if (all_reused) out.stages.skipped("vertex-rays", cached);
-    else out.stages.ran("vertex-rays", cpu_ms - texcoord_ms);
+    else
+      out.stages.ran("vertex-rays", cpu_ms - texcoord_ms, -1,
+                     mirror_rays == 0 ? std::string()
+                                      : std::to_string(beside) + " of " + std::to_string(mirror_rays) +
+                                            " mirror rays traced beside their own mirror");
     if (!has_lens) out.stages.skipped("refraction", "no lens in the scene");
     else if (all_reused) out.stages.skipped("refraction", cached);
     else out.stages.ran("refraction", refraction_ms);
