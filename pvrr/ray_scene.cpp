@@ -1,18 +1,18 @@
 #include "pvrr/ray_scene.h"
 
 #include <embree3/rtcore.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
 #include <cstdio>
+#include <atomic>
 #include <cstdlib>
 #include <mutex>
 #include <string>
 
 #include "cad/error.h"
 #include "cad/sag.h"
-
-#include <tbb/parallel_for.h>
 
 namespace pvrr {
 
@@ -99,21 +99,23 @@ struct RayScene::Impl {
   // `scene`, attached to both), for single-surface queries: one traversal of a small BVH instead of
   // stepping through every other hit along the ray in the whole scene.
   std::vector<std::array<RTCScene, 2>> element_scenes;
-  // Mirror element -> a scene with every geometry but that element's (the same Embree geometries under the
-  // same IDs), for intersectBeside; null for lenses.
-  std::vector<RTCScene> beside_scenes;
-  // Mirror element -> its candidate vertices (element-local) in chunks of kClearanceChunk with their bounding
-  // boxes, and the last tangentClearance() query and answer.
+  // Per mirror element (null for lenses): its candidate vertices (element-local) in chunks of kClearanceChunk
+  // with their bounding boxes, the box of them all; the last tangentClearance() query and answer; and the
+  // scene with every geometry but the element's (the same Embree geometries under the same IDs), built by
+  // the first tangentClearance() that finds a point clear (intersectBeside).
   struct Clearance {
     std::vector<std::array<Vec3, 2>> chunk_boxes;
+    Vec3 lo{0}, hi{0};
+    std::mutex mutex;  // guards points, normals, answer and the building of `beside`
     std::vector<Vec3> points, normals;
     std::shared_ptr<const RayScene::TangentClearance> answer;
+    std::atomic<RTCScene> beside{nullptr};
   };
-  std::vector<Clearance> clearance;
-  std::mutex clearance_mutex;
+  std::vector<std::unique_ptr<Clearance>> clearance;
+  bool moving = false;  // RaySceneOptions::moving_elements took effect: dynamic scenes
   ~Impl() {
-    for (RTCScene s : beside_scenes)
-      if (s) rtcReleaseScene(s);
+    for (const auto& c : clearance)
+      if (c && c->beside.load()) rtcReleaseScene(c->beside.load());
     for (auto& pair : element_scenes)
       for (RTCScene s : pair)
         if (s) rtcReleaseScene(s);
@@ -221,27 +223,25 @@ RayScene::RayScene(const Scene& scene, RaySceneOptions options) : scene_(scene),
     }
   }
   rtcCommitScene(im.scene);
-  im.beside_scenes.assign(scene.elements.size(), nullptr);
+  im.moving = moving;
   im.clearance.resize(scene.elements.size());
   for (size_t e = 0; e < scene.elements.size(); ++e) {
     if (scene.elements[e].type != ElementType::Mirror) continue;
-    RTCScene beside = rtcNewScene(im.device);
-    im.beside_scenes[e] = beside;
-    rtcSetSceneBuildQuality(beside, moving ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_HIGH);
-    if (moving) rtcSetSceneFlags(beside, RTC_SCENE_FLAG_DYNAMIC);
-    for (size_t id = 0; id < im.geoms.size(); ++id)
-      if (im.geoms[id].kind != HitKind::None && !(im.geoms[id].kind == HitKind::Element && im.geoms[id].index == int(e)))
-        rtcAttachGeometryByID(beside, rtcGetGeometry(im.scene, unsigned(id)), unsigned(id));
-    rtcCommitScene(beside);
     const std::vector<Vec3>& local = im.geoms[size_t(im.element_geoms[e][0])].local;
+    if (local.empty()) continue;
+    auto c = std::make_unique<Impl::Clearance>();
+    c->lo = c->hi = local[0];
     for (size_t from = 0; from < local.size(); from += kClearanceChunk) {
       std::array<Vec3, 2> box{local[from], local[from]};
       for (size_t j = from; j < std::min(local.size(), from + kClearanceChunk); ++j) {
         box[0] = glm::min(box[0], local[j]);
         box[1] = glm::max(box[1], local[j]);
       }
-      im.clearance[e].chunk_boxes.push_back(box);
+      c->chunk_boxes.push_back(box);
+      c->lo = glm::min(c->lo, box[0]);
+      c->hi = glm::max(c->hi, box[1]);
     }
+    im.clearance[e] = std::move(c);
   }
   RTCError err = rtcGetDeviceError(im.device);
   if (err != RTC_ERROR_NONE) throw Error("Embree: scene build failed (error " + std::to_string(int(err)) + ")");
@@ -267,8 +267,11 @@ void RayScene::updateElementPoses() {
     rtcCommitGeometry(geom);
   }
   rtcCommitScene(im.scene);
-  for (RTCScene s : im.beside_scenes)
-    if (s) rtcCommitScene(s);
+  for (const auto& c : im.clearance) {
+    if (!c) continue;
+    std::lock_guard<std::mutex> lock(c->mutex);
+    if (c->beside.load()) rtcCommitScene(c->beside.load());
+  }
   for (auto& pair : im.element_scenes)
     for (RTCScene s : pair)
       if (s) rtcCommitScene(s);
@@ -362,8 +365,9 @@ RayHit RayScene::intersect(const Vec3& o, const Vec3& d, double t_min, double t_
 }
 
 RayHit RayScene::intersectBeside(int element, const Vec3& o, const Vec3& d, double t_min, double t_max) const {
-  PVRR_CHECK(element >= 0 && size_t(element) < impl_->beside_scenes.size() && impl_->beside_scenes[size_t(element)],
-             << "element " << element << " is not a mirror");
+  PVRR_CHECK(element >= 0 && size_t(element) < impl_->clearance.size() && impl_->clearance[size_t(element)] &&
+                 impl_->clearance[size_t(element)]->beside.load(std::memory_order_acquire),
+             << "element " << element << ": no tangentClearance() found a point of it clear");
   return intersectIn(element, o, d, t_min, t_max);
 }
 
@@ -371,7 +375,8 @@ RayHit RayScene::intersectIn(int beside_element, const Vec3& o, const Vec3& d, d
   // A ray that is not finite (degenerate input upstream) meets nothing; Embree asserts on it.
   if (!std::isfinite(o.x + o.y + o.z + d.x + d.y + d.z)) return RayHit{};
   const Impl& im = *impl_;
-  RTCScene scene = beside_element < 0 ? im.scene : im.beside_scenes[size_t(beside_element)];
+  RTCScene scene =
+      beside_element < 0 ? im.scene : im.clearance[size_t(beside_element)]->beside.load(std::memory_order_acquire);
   // After a rejected candidate the next query starts strictly beyond it (the float slack must not bring the
   // same triangle back).
   float past = 0.0f;
@@ -442,17 +447,20 @@ std::shared_ptr<const RayScene::TangentClearance> RayScene::tangentClearance(int
                                                                              const std::vector<Vec3>& points,
                                                                              const std::vector<Vec3>& normals) const {
   Impl& im = *impl_;
-  PVRR_CHECK(element >= 0 && size_t(element) < im.clearance.size(), << element);
+  PVRR_CHECK(element >= 0 && size_t(element) < scene_.elements.size(), << element);
   PVRR_CHECK(points.size() == normals.size(), << points.size() << " points, " << normals.size() << " normals");
-  Impl::Clearance& c = im.clearance[size_t(element)];
-  std::lock_guard<std::mutex> lock(im.clearance_mutex);
-  if (c.answer && c.points == points && c.normals == normals) return c.answer;
   auto out = std::make_shared<TangentClearance>();
-  if (c.chunk_boxes.empty()) return out;  // a lens
+  if (!im.clearance[size_t(element)]) return out;  // a lens, or no candidates
+  Impl::Clearance& c = *im.clearance[size_t(element)];
+  {
+    std::lock_guard<std::mutex> lock(c.mutex);
+    if (c.answer && c.points == points && c.normals == normals) return c.answer;
+  }
+  // Computed without the lock (its parallel loop may run other tasks on this thread).
   const std::vector<Vec3>& local = im.geoms[size_t(im.element_geoms[size_t(element)][0])].local;
-  Vec3 lo = c.chunk_boxes[0][0], hi = c.chunk_boxes[0][1];
-  for (const auto& b : c.chunk_boxes) lo = glm::min(lo, b[0]), hi = glm::max(hi, b[1]);
-  const double cap = kClearanceCap * std::max(glm::length(hi - lo), 1e-9);
+  const double size = std::max(glm::length(c.hi - c.lo), 1e-9);
+  const double cap = kClearanceCap * size;
+  out->tolerance = kClearanceTolerance * size;
   const size_t chunks = c.chunk_boxes.size();
   out->ahead.resize(points.size());
   out->behind.resize(points.size());
@@ -481,29 +489,35 @@ std::shared_ptr<const RayScene::TangentClearance> RayScene::tangentClearance(int
       search(first);
       for (size_t k = 0; k < chunks && best <= cap; ++k)
         if (k != first && bound[k] > best) search(k);
-      const double value = best > cap ? kInf : best;
+      // Beyond the cap, or not a number (a degenerate normal): never clear.
+      const double value = best <= cap ? best : kInf;
       (side == 0 ? out->ahead[i] : out->behind[i]) = sign * value;
     }
   });
+  bool any_clear = false;
+  for (size_t i = 0; i < points.size() && !any_clear; ++i)
+    any_clear = out->ahead[i] <= out->tolerance || out->behind[i] >= -out->tolerance;
+  // The scene beside the element, once: built outside the lock (Embree's build runs tasks), installed under it.
+  RTCScene built = nullptr;
+  if (any_clear && !c.beside.load(std::memory_order_acquire)) {
+    built = rtcNewScene(im.device);
+    rtcSetSceneBuildQuality(built, im.moving ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_HIGH);
+    if (im.moving) rtcSetSceneFlags(built, RTC_SCENE_FLAG_DYNAMIC);
+    for (size_t id = 0; id < im.geoms.size(); ++id)
+      if (im.geoms[id].kind != HitKind::None &&
+          !(im.geoms[id].kind == HitKind::Element && im.geoms[id].index == element))
+        rtcAttachGeometryByID(built, rtcGetGeometry(im.scene, unsigned(id)), unsigned(id));
+    rtcCommitScene(built);
+  }
+  std::lock_guard<std::mutex> lock(c.mutex);
+  if (built) {
+    if (c.beside.load()) rtcReleaseScene(built);  // another thread was first
+    else c.beside.store(built, std::memory_order_release);
+  }
   c.points = points;
   c.normals = normals;
   c.answer = out;
   return out;
-}
-
-double RayScene::candidateRounding(int element) const {
-  const Impl& im = *impl_;
-  PVRR_CHECK(element >= 0 && size_t(element) < im.clearance.size(), << element);
-  const Impl::Clearance& c = im.clearance[size_t(element)];
-  if (c.chunk_boxes.empty()) return kInf;
-  Vec3 lo = c.chunk_boxes[0][0], hi = c.chunk_boxes[0][1];
-  for (const auto& b : c.chunk_boxes) lo = glm::min(lo, b[0]), hi = glm::max(hi, b[1]);
-  // Every candidate and a ray origin on the element lie within `reach` of the anchor; float rounds each
-  // coordinate to half an ulp (2^-24 relative), so a point moves by at most sqrt(3) 2^-24 reach. Four times
-  // that covers both the candidate and the origin, and Embree's own float arithmetic, with room to spare.
-  const Element& el = scene_.elements[size_t(element)];
-  const double reach = glm::length(el.toWorldPoint(0.5 * (lo + hi)) - im.anchor) + 0.5 * glm::length(hi - lo);
-  return 4.0 * std::sqrt(3.0) * std::ldexp(reach + 1e-3, -24);
 }
 
 RayHit RayScene::intersectElementSurface(int element, int surface, const Vec3& o, const Vec3& d, double t_min,

@@ -65,27 +65,28 @@ class RayScene {
                                  double t_max = kInf, bool within_outline = true) const;
 
   // Where a mirror element's candidate tessellation lies against the tangent planes of points on its surface
-  // (element-local positions and normals, e.g. the vertex stage's grid): per point p with normal n, the
+  // (element-local positions and normals, e.g. the vertex stage's grid): per point p with unit normal n, the
   // largest (`ahead`) and the smallest (`behind`) signed distance (x - p) . n over the candidate vertices x,
-  // computed exactly where within kClearanceCap of the surface's size, else +inf (ahead) or -inf (behind).
-  // A convex mirror's candidates lie wholly behind each tangent plane (ahead <= 0). The answer to the last set
-  // of points is kept per element: asking again with the same points costs one comparison. Empty for a lens.
+  // exact where within kClearanceCap of the mirror's size, else +inf (ahead) or -inf (behind). A convex
+  // mirror's candidates lie wholly behind each tangent plane: ahead <= 0 to double rounding (`tolerance`,
+  // kClearanceTolerance of the size); a plane's lie on it. The answer to the last set of points is kept per
+  // element: asking again with the same points costs one comparison. Empty for a lens.
   struct TangentClearance {
     std::vector<double> ahead, behind;
+    double tolerance = 0;
   };
-  static constexpr double kClearanceCap = 1e-3;
+  static constexpr double kClearanceCap = 1e-3, kClearanceTolerance = 1e-12;
   std::shared_ptr<const TangentClearance> tangentClearance(int element, const std::vector<Vec3>& points,
                                                            const std::vector<Vec3>& normals) const;
-  // How far from their true places float rounding can put the element's candidates and the float origin of a
-  // ray that starts on the element, at its current pose (a bound, in m).
-  double candidateRounding(int element) const;
-  // intersect() on everything but mirror element `element`, for a ray from p on it that cannot meet it: it
-  // leaves into the front (d . n >= kMinLeave) where tangentClearance's `ahead` at p is at most
-  // candidateRounding, or into the back where `behind` is at least minus that. Such a ray's height over the
-  // tangent plane, t (d . n), exceeds every candidate's beyond t = 2 candidateRounding / |d . n|; what the
-  // whole scene's query could report nearer lies within float rounding of p, where the exact test finds p
-  // itself (t <= t_min) and rejects it. So the hit is intersect()'s, without traversing the element's
-  // candidates, which every ray leaving the surface starts among.
+  // intersect() on everything but mirror element `element`, for a ray from a point p of it that cannot meet
+  // its candidates: the ray leaves into the front, d . n >= kMinLeave, where tangentClearance's `ahead` at p
+  // is at most its tolerance (or into the back, d . n <= -kMinLeave, where `behind` is at least minus it).
+  // Float rounding moves candidates and the ray's origin by at most r (~2^-22 of their distance from the
+  // scene's anchor), so the ray's height over the tangent plane, t (d . n), exceeds every candidate's beyond
+  // t = 2 r / |d . n|: what the whole scene's query could report nearer lies within that distance of p (under
+  // 0.1 mm for the car mirror), where the exact test finds p itself (t <= t_min) and rejects it. So the hit is
+  // intersect()'s, without traversing the element's candidates, among which every such ray starts. Its scene
+  // (a second BVH over everything else) is built by the first tangentClearance() that finds a point clear.
   static constexpr double kMinLeave = 1e-2;
   RayHit intersectBeside(int element, const Vec3& o, const Vec3& d, double t_min = 0, double t_max = kInf) const;
 

@@ -150,10 +150,9 @@ static void traceVertexRaysFrom(const RayScene& rays, ElementFrame& f, const Vec
   const std::optional<Tracer> tracer = tirTracer(rays, f);
   // Where a mirror's rays cannot meet the mirror itself (RayScene::intersectBeside).
   std::shared_ptr<const RayScene::TangentClearance> clearance;
-  double rounding = 0;
   if (el.type == ElementType::Mirror && opt.beside_own_mirror) {
     clearance = rays.tangentClearance(f.element, f.grid.positions, f.grid.normals);
-    rounding = rays.candidateRounding(f.element);
+    if (clearance->ahead.size() != f.world_pos.size()) clearance.reset();  // a mirror without candidates
   }
   std::vector<char> beside(opt.channels.size() * f.world_pos.size(), 0);  // counted after the loops
   for (size_t c = 0; c < opt.channels.size(); ++c) {
@@ -217,10 +216,10 @@ static void traceVertexRaysFrom(const RayScene& rays, ElementFrame& f, const Vec
         vr.dir = out.direction;
       }
       bool leaves_clear = false;
-      if (clearance && !clearance->ahead.empty()) {
+      if (clearance) {
         const double dn = glm::dot(vr.dir, n);
-        leaves_clear = (dn >= RayScene::kMinLeave && clearance->ahead[i] <= rounding) ||
-                       (dn <= -RayScene::kMinLeave && clearance->behind[i] >= -rounding);
+        leaves_clear = (dn >= RayScene::kMinLeave && clearance->ahead[i] <= clearance->tolerance) ||
+                       (dn <= -RayScene::kMinLeave && clearance->behind[i] >= -clearance->tolerance);
       }
       beside[c * f.world_pos.size() + i] = leaves_clear;
       const RayHit h = leaves_clear ? rays.intersectBeside(f.element, vr.origin, vr.dir, eps)

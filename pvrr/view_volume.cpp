@@ -351,17 +351,16 @@ bool NearClip::cannotOpen(const Vec3& lo, const Vec3& hi) const {
   return gap > reach_ * (1 + 1e-6) + 1e-6 * size;
 }
 
-// A triangle counter-clockwise in NDC (x right, y up, as window space), unprojected onto the plane z_ndc = 0,
-// and a point unprojected from z_ndc = -1/2. Along every ray from the centre of projection z_ndc rises from
-// -infinity, so that point lies on the centre's side of the plane: the triangle faces the centre exactly
-// when its counter-clockwise normal points to that side.
 std::vector<size_t> depthSortedDrawOrder(const std::vector<std::array<Vec3, 2>>& boxes, bool reversed_depth) {
   std::vector<std::pair<double, size_t>> key(boxes.size());
   for (size_t m = 0; m < boxes.size(); ++m) {
     const Vec3 &lo = boxes[m][0], &hi = boxes[m][1];
-    key[m] = {reversed_depth ? -glm::length(glm::max(glm::abs(lo), glm::abs(hi)))
-                             : glm::length(glm::clamp(Vec3(0.0), lo, hi)),
-              m};
+    // A box around the centre (a room around the eye): the distance to its nearest face, which its surface
+    // cannot come closer than.
+    const bool around = glm::all(glm::lessThanEqual(lo, Vec3(0.0))) && glm::all(glm::greaterThanEqual(hi, Vec3(0.0)));
+    const double nearest = around ? std::min({-lo.x, -lo.y, -lo.z, hi.x, hi.y, hi.z})
+                                  : glm::length(glm::clamp(Vec3(0.0), lo, hi));
+    key[m] = {reversed_depth ? -glm::length(glm::max(glm::abs(lo), glm::abs(hi))) : nearest, m};
   }
   std::stable_sort(key.begin(), key.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<size_t> order(key.size());
@@ -369,6 +368,10 @@ std::vector<size_t> depthSortedDrawOrder(const std::vector<std::array<Vec3, 2>>&
   return order;
 }
 
+// A triangle counter-clockwise in NDC (x right, y up, as window space), unprojected onto the plane z_ndc = 0,
+// and a point unprojected from z_ndc = -1/2. Along every ray from the centre of projection z_ndc rises from
+// -infinity, so that point lies on the centre's side of the plane: the triangle faces the centre exactly
+// when its counter-clockwise normal points to that side.
 bool facingTrianglesWindCounterClockwise(const Mat4& view_proj) {
   const Mat4 inv = glm::inverse(view_proj);
   auto unproject = [&](double x, double y, double z) {

@@ -91,9 +91,10 @@ bool facingTrianglesWindCounterClockwise(const Mat4& view_proj);
 
 // The order in which to draw the solids inside the boxes [lo, hi] (relative to the centre of projection) so
 // that the early depth test rejects the fragments of hidden ones instead of shading them: nearest first, by
-// the distance to each box's nearest point (0 for a box around the centre), or with reversed depth (the
-// farther fragment wins) farthest first, by the distance to each box's farthest corner. Stable: boxes with
-// equal keys keep their given order. The picture changes only where two solids tie in depth.
+// the distance to each box's nearest point (for a box around the centre, such as a room around the eye, to
+// its nearest face), or with reversed depth (the farther fragment wins) farthest first, by the distance to
+// each box's farthest corner. Stable: boxes with equal keys keep their given order. The picture changes only
+// where two solids tie in depth.
 std::vector<size_t> depthSortedDrawOrder(const std::vector<std::array<Vec3, 2>>& boxes, bool reversed_depth);
 
 struct ViewVolume {

@@ -18,6 +18,7 @@ const char* formatName(ColorFormat f) {
     case ColorFormat::RGBA16F: return "RGBA16F";
     case ColorFormat::RGBA32F: return "RGBA32F";
     case ColorFormat::R32F: return "R32F";
+    case ColorFormat::RGBA16: return "RGBA16";
   }
   return "?";
 }
@@ -29,6 +30,7 @@ GLenum internalFormat(ColorFormat f) {
     case ColorFormat::RGBA16F: return GL_RGBA16F;
     case ColorFormat::RGBA32F: return GL_RGBA32F;
     case ColorFormat::R32F: return GL_R32F;
+    case ColorFormat::RGBA16: return GL_RGBA16;
   }
   return GL_RGBA8;
 }

@@ -12,7 +12,7 @@ namespace pvrr::gl {
 
 class GlContext;
 
-enum class ColorFormat { RGBA8, SRGB8A8, RGBA16F, RGBA32F, R32F };
+enum class ColorFormat { RGBA8, SRGB8A8, RGBA16F, RGBA32F, R32F, RGBA16 };
 enum class DepthFormat { None, Depth24, Depth32F };
 
 // How texture data from 8-bit images is interpreted when sampled: Srgb stores GL_SRGB8_ALPHA8 (sampling returns

@@ -420,6 +420,24 @@ struct Renderer::Impl {
     }
   }
 
+  // The environment meshes' bounding boxes relative to `origin`.
+  std::vector<std::array<Vec3, 2>> environmentBoxes(const Vec3& origin) const {
+    std::vector<std::array<Vec3, 2>> boxes(scene.meshes.size());
+    for (size_t m = 0; m < scene.meshes.size(); ++m) {
+      const Vec3 to_anchor = scene.meshes[m].anchor - origin;
+      boxes[m] = {env_bounds[m][0] + to_anchor, env_bounds[m][1] + to_anchor};
+    }
+    return boxes;
+  }
+
+  // The order to draw them in: the scene's, or sorted by their distance (RendererOptions::sort_environment).
+  std::vector<size_t> environmentDrawOrder(const std::vector<std::array<Vec3, 2>>& boxes, bool reversed_depth) const {
+    if (options.sort_environment) return depthSortedDrawOrder(boxes, reversed_depth);
+    std::vector<size_t> order(boxes.size());
+    for (size_t m = 0; m < order.size(); ++m) order[m] = m;
+    return order;
+  }
+
   // Sky and environment from a camera at `origin`; `view_origin` is where the viewing rays start (for the
   // two-sided normal), relative to `origin`.
   // reversed_depth: the zooming-region pass (view_volume.h): the fragment farthest from the camera wins.
@@ -428,20 +446,6 @@ struct Renderer::Impl {
   // no pixel is shaded twice for it; what was drawn into the target before (the elements of the second
   // pass, drawn first so that the environment behind them fails the early depth test) stays.
   // Returns how many closed convex meshes it drew and culled.
-  // The environment meshes in scene order, or sorted by their bounds' distance from `origin`
-  // (RendererOptions::sort_environment).
-  std::vector<size_t> environmentDrawOrder(const Vec3& origin, bool reversed_depth) const {
-    std::vector<std::array<Vec3, 2>> boxes(scene.meshes.size());
-    for (size_t m = 0; m < scene.meshes.size(); ++m) {
-      const Vec3 to_anchor = scene.meshes[m].anchor - origin;
-      boxes[m] = {env_bounds[m][0] + to_anchor, env_bounds[m][1] + to_anchor};
-    }
-    if (options.sort_environment) return depthSortedDrawOrder(boxes, reversed_depth);
-    std::vector<size_t> order(boxes.size());
-    for (size_t m = 0; m < order.size(); ++m) order[m] = m;
-    return order;
-  }
-
   CullCount drawEnvironment(const Mat4& view, const Mat4& proj, const Vec3& origin, bool reversed_depth = false,
                             const Vec3* rays_from = nullptr, bool planes = false) const {
     const Mat4 vp = relativeViewProj(proj, view, origin);
@@ -489,13 +493,12 @@ struct Renderer::Impl {
     }
     bool culling = false;
     CullCount count;
-    for (const size_t m : environmentDrawOrder(origin, reversed_depth)) {
+    const std::vector<std::array<Vec3, 2>> boxes = environmentBoxes(origin);  // camera-relative
+    for (const size_t m : environmentDrawOrder(boxes, reversed_depth)) {
       const EnvMesh& mesh = scene.meshes[m];
       const DiffuseMaterial& mat = scene.materials[size_t(mesh.material)];
       const Program& p = *programs[env_faceted[m]][env_textured[m]];
-      const Vec3 to_anchor = mesh.anchor - origin;  // camera-relative bounds
-      const Vec3 lo = env_bounds[m][0] + to_anchor, hi = env_bounds[m][1] + to_anchor;
-      const bool cull = may_cull && mesh.closed_convex && near_clip.cannotOpen(lo, hi);
+      const bool cull = may_cull && mesh.closed_convex && near_clip.cannotOpen(boxes[m][0], boxes[m][1]);
       count.drawn += mesh.closed_convex;
       count.culled += cull;
       if (cull != culling) {
@@ -1391,7 +1394,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
         ob.width, ob.height,
         options.seen_points
             ? std::vector<ColorFormat>{ColorFormat::RGBA32F, ColorFormat::RGBA32F, ColorFormat::RGBA32F}
-            : std::vector<ColorFormat>{ColorFormat::RGBA32F},
+            : std::vector<ColorFormat>{ColorFormat::RGBA16},
         DepthFormat::Depth32F);
   frame_target->clearDepth();  // no colour clear: the sky covers every pixel nothing else does
   // The elements come first: the depth state must not depend on what an earlier pass (or none) left.

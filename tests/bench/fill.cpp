@@ -3,7 +3,8 @@
 // of a 1024^2 map (*_fetch3_<map format>: a dispersive lens's three texture-coordinate sets over the whole
 // screen; *_fetch3_r32f_planes: one read from each of three R32F planes, as a lens with RGB dispersion
 // reads its map). These figures chose the first-pass map formats (RGBA32F: llvmpipe filters it faster than
-// RGBA16F; R32F planes for RGB lenses) and dropped the colour clears (the sky covers every pixel).
+// RGBA16F; R32F planes for RGB lenses), the picture-only frame target (RGBA16: written faster than RGBA32F,
+// *_fill_no_colour_clear) and dropped the colour clears (the sky covers every pixel).
 // Figures: docs/performance.md.
 #include <benchmark/benchmark.h>
 
@@ -98,6 +99,8 @@ PVRR_FRAME(rgba32f_fill, RGBA32F, RGBA8, Constant, true)
 PVRR_FRAME(rgba32f_fill_no_colour_clear, RGBA32F, RGBA8, Constant, false)
 PVRR_FRAME(rgba16f_fill, RGBA16F, RGBA8, Constant, true)
 PVRR_FRAME(rgba8_fill, RGBA8, RGBA8, Constant, true)
+PVRR_FRAME(rgba16_fill_no_colour_clear, RGBA16, RGBA8, Constant, false)
+PVRR_FRAME(rgba8_fill_no_colour_clear, RGBA8, RGBA8, Constant, false)
 PVRR_FRAME(srgb8_fill, SRGB8A8, RGBA8, Constant, true)
 PVRR_FRAME(rgba32f_fetch3_rgba16f, RGBA32F, RGBA16F, ThreeReads, false)
 PVRR_FRAME(rgba32f_fetch3_rgba32f, RGBA32F, RGBA32F, ThreeReads, false)

@@ -14,6 +14,7 @@
 #include "pvrr/gl/renderer.h"
 #include "support/frames.h"
 #include "support/gl_backends.h"
+#include "support/scenes.h"
 
 namespace pvrr {
 namespace {
@@ -38,8 +39,8 @@ constexpr double kTie = 1e-5;
 Differences compare(const gl::RasterFrame& a, const gl::RasterFrame& b, const Vec3& eye) {
   Differences d;
   d.pixels = test::differingPixels(a, b);
-  for (size_t i = 0; i < a.color.size() && i < b.color.size(); ++i) {
-    if (a.color[i] == b.color[i] && a.seen[i] == b.seen[i] && a.element[i] == b.element[i]) continue;
+  for (size_t i = 0; i < a.color.size() && i < b.color.size() && i < a.seen.size() && i < b.seen.size(); ++i) {
+    if (!test::pixelDiffers(a, b, i)) continue;
     const double rel = glm::length(a.seen[i] - b.seen[i]) / std::max(glm::length(a.seen[i] - eye), 1e-9);
     d.worst = std::max(d.worst, rel);
     d.beyond_ties += !(rel <= kTie);
@@ -52,7 +53,7 @@ TEST_P(DrawOrderTest, ShippedScenesAreTheSameButForDepthTies) {
   if (!ctx) return;
   for (const char* name : {"car-mirror", "concave-mirror", "mirror-pair", "reading-lens", "saddle-mirror", "plane-mirror",
                            "spectacle-lens"}) {
-    const Scene s = test::shippedScene(name);
+    const Scene s = test::shippedScene(name, {"observer.image_size=[160,120]"});
     RayScene rays(s);
     gl::Renderer in_scene_order(s, rays, sceneOrder()), sorted(s, rays, gl::RendererOptions{});
     for (const gl::RasterMode mode : {gl::RasterMode::Pvrr, gl::RasterMode::Envmap, gl::RasterMode::Raster}) {
@@ -82,12 +83,14 @@ long long samplesPassed(gl::Renderer& r) {
 
 // The reading lens looks down at a page on a table, and the car mirror's driver sees the own door in front of
 // the street: in scene order, the table under the page and the road behind the door are shaded first and then
-// covered. Measured at 160 x 120 (all passes): reading lens 0.55 of the fragments, car mirror 0.88.
+// covered. Measured at 160 x 120 (all passes): reading lens 0.63 of the fragments, car mirror 0.89 (at 1280 x
+// 720: 0.58 and 0.90). The farthest-first order of reversed-depth maps is checked on its own
+// (DepthSortedDrawOrder in tests/pvrr/closed_mesh_test.cpp).
 TEST_P(DrawOrderTest, NearestFirstShadesFewerFragments) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
   for (const auto& [name, most] : {std::pair<const char*, double>{"reading-lens", 0.7}, {"car-mirror", 0.95}}) {
-    const Scene s = test::shippedScene(name);
+    const Scene s = test::shippedScene(name, {"observer.image_size=[160,120]"});
     RayScene rays(s);
     gl::Renderer in_scene_order(s, rays, sceneOrder()), sorted(s, rays, gl::RendererOptions{});
     const long long before = samplesPassed(in_scene_order), after = samplesPassed(sorted);

@@ -15,13 +15,15 @@
 #include "pvrr/scene_build.h"
 #include "pvrr/scene_json.h"
 #include "support/frames.h"
+#include "support/scenes.h"
 #include "support/gl_backends.h"
 
 namespace pvrr {
 namespace {
 
 using test::differingPixels;
-using test::shippedScene;
+// models/NAME.json at 160 x 120 pixels.
+Scene shippedScene(const std::string& name) { return test::shippedScene(name, {"observer.image_size=[160,120]"}); }
 
 class UnreadTexelsTest : public ::testing::TestWithParam<gl::GlBackend> {};
 

@@ -135,18 +135,19 @@ TEST(FacingTriangles, WindCounterClockwiseUnlessTheProjectionMirrors) {
   }
 }
 
-// Boxes relative to the centre of projection, at known distances: nearest points 0 (around the centre),
-// 1 (a door beside the eye), 5 (a car), 0.5 below (a road plane under the eye, flat in y) and a far building.
+// Boxes relative to the centre of projection, at known distances: nearest points 4 (a car), 0.5 (a road
+// plane under the eye, flat in y), 1 (a door beside the eye) and |(20, 0, 20)| (a building); a room around
+// the eye, whose nearest face is 2 away.
 TEST(DepthSortedDrawOrder, NearestFirstOrFarthestFirstWithReversedDepth) {
   const std::vector<std::array<Vec3, 2>> boxes = {
       {Vec3(-1, -1, 4), Vec3(1, 1, 6)},         // 0: car, nearest 4 (z), farthest |(1,1,6)|
       {Vec3(-100, -0.5, -100), Vec3(100, -0.5, 100)},  // 1: road, nearest 0.5, farthest |(100,0.5,100)|
       {Vec3(1, -1, -1), Vec3(1.1, 1, 1)},       // 2: door, nearest 1, farthest |(1.1,1,1)|
-      {Vec3(-2, -2, -2), Vec3(2, 2, 2)},        // 3: a room around the eye, nearest 0
+      {Vec3(-2, -2, -2), Vec3(2, 3, 2)},        // 3: a room around the eye, nearest face 2
       {Vec3(20, 0, 20), Vec3(30, 10, 40)},      // 4: building, nearest |(20,0,20)|
   };
-  EXPECT_EQ(depthSortedDrawOrder(boxes, false), (std::vector<size_t>{3, 1, 2, 0, 4}));
-  // Farthest corners: road 141.4, building 50.99, car 6.16, room 3.46, door 1.73.
+  EXPECT_EQ(depthSortedDrawOrder(boxes, false), (std::vector<size_t>{1, 2, 3, 0, 4}));
+  // Farthest corners: road 141.4, building 50.99, car 6.16, room 4.12, door 1.79.
   EXPECT_EQ(depthSortedDrawOrder(boxes, true), (std::vector<size_t>{1, 4, 0, 3, 2}));
   // Equal keys keep the given order; no boxes, no order.
   const std::vector<std::array<Vec3, 2>> twins = {{Vec3(0, 0, 3), Vec3(1, 1, 4)}, {Vec3(0, 0, 3), Vec3(1, 1, 4)},
