@@ -106,7 +106,7 @@ struct RayScene::Impl {
   struct Clearance {
     std::vector<std::array<Vec3, 2>> chunk_boxes;
     Vec3 lo{0}, hi{0};
-    std::mutex mutex;  // guards points, normals, answer and the building of `beside`
+    std::mutex mutex;  // guards points, normals and answer, and the installing and committing of `beside`
     std::vector<Vec3> points, normals;
     std::shared_ptr<const RayScene::TangentClearance> answer;
     std::atomic<RTCScene> beside{nullptr};
@@ -470,6 +470,11 @@ std::shared_ptr<const RayScene::TangentClearance> RayScene::tangentClearance(int
   tbb::parallel_for(size_t(0), points.size(), [&](size_t i) {
     const Vec3 p = points[i], n = glm::normalize(normals[i]);
     const double pn = glm::dot(p, n);
+    if (!std::isfinite(pn)) {  // a point or normal not finite (a degenerate normal): never clear
+      out->ahead[i] = kInf;
+      out->behind[i] = -kInf;
+      return;
+    }
     std::vector<double> bound(chunks);
     for (int side = 0; side < 2; ++side) {
       const double sign = side == 0 ? 1.0 : -1.0;  // ahead: the largest of (x - p) . n; behind: of -(x - p) . n
@@ -489,8 +494,7 @@ std::shared_ptr<const RayScene::TangentClearance> RayScene::tangentClearance(int
       search(first);
       for (size_t k = 0; k < chunks && best <= cap; ++k)
         if (k != first && bound[k] > best) search(k);
-      // Beyond the cap, or not a number (a degenerate normal): never clear.
-      const double value = best <= cap ? best : kInf;
+      const double value = best <= cap ? best : kInf;  // beyond the cap: never clear
       (side == 0 ? out->ahead[i] : out->behind[i]) = sign * value;
     }
   });
@@ -501,6 +505,7 @@ std::shared_ptr<const RayScene::TangentClearance> RayScene::tangentClearance(int
   RTCScene built = nullptr;
   if (any_clear && !c.beside.load(std::memory_order_acquire)) {
     built = rtcNewScene(im.device);
+    if (!built) throw Error("Embree: could not create the scene beside element " + std::to_string(element));
     rtcSetSceneBuildQuality(built, im.moving ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_HIGH);
     if (im.moving) rtcSetSceneFlags(built, RTC_SCENE_FLAG_DYNAMIC);
     for (size_t id = 0; id < im.geoms.size(); ++id)
@@ -508,6 +513,12 @@ std::shared_ptr<const RayScene::TangentClearance> RayScene::tangentClearance(int
           !(im.geoms[id].kind == HitKind::Element && im.geoms[id].index == element))
         rtcAttachGeometryByID(built, rtcGetGeometry(im.scene, unsigned(id)), unsigned(id));
     rtcCommitScene(built);
+    const RTCError err = rtcGetDeviceError(im.device);
+    if (err != RTC_ERROR_NONE) {
+      rtcReleaseScene(built);
+      throw Error("Embree: building the scene beside element " + std::to_string(element) + " failed (error " +
+                  std::to_string(int(err)) + ")");
+    }
   }
   std::lock_guard<std::mutex> lock(c.mutex);
   if (built) {

@@ -91,7 +91,8 @@ class RayScene {
   RayHit intersectBeside(int element, const Vec3& o, const Vec3& d, double t_min = 0, double t_max = kInf) const;
 
   // After elements moved (Element::local_to_world changed, e.g. spectacles turning with the head): moves
-  // their candidate tessellations in Embree and recommits. The environment is untouched.
+  // their candidate tessellations in Embree and recommits (the scenes beside mirrors too). The environment is
+  // untouched. As Embree requires, no query (intersect*, tangentClearance) may run meanwhile.
   void updateElementPoses();
 
   const Scene& scene() const { return scene_; }

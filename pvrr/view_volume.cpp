@@ -355,8 +355,8 @@ std::vector<size_t> depthSortedDrawOrder(const std::vector<std::array<Vec3, 2>>&
   std::vector<std::pair<double, size_t>> key(boxes.size());
   for (size_t m = 0; m < boxes.size(); ++m) {
     const Vec3 &lo = boxes[m][0], &hi = boxes[m][1];
-    // A box around the centre (a room around the eye): the distance to its nearest face, which its surface
-    // cannot come closer than.
+    // A box around the centre: the distance to its nearest face, where a room that is its box has its
+    // nearest wall (an ordering heuristic: a mesh inside the box may come closer).
     const bool around = glm::all(glm::lessThanEqual(lo, Vec3(0.0))) && glm::all(glm::greaterThanEqual(hi, Vec3(0.0)));
     const double nearest = around ? std::min({-lo.x, -lo.y, -lo.z, hi.x, hi.y, hi.z})
                                   : glm::length(glm::clamp(Vec3(0.0), lo, hi));

@@ -1389,12 +1389,19 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
 
   // --- second pass ---
   t0 = Clock::now();
-  if (!frame_target || frame_target->width() != ob.width || frame_target->height() != ob.height)
+  // A picture-only frame goes into 16 bits a channel (RendererOptions::seen_points), unless an element is
+  // drawn in several additive draws (more than three channels): their partial sums can be negative or above
+  // 1 (spectral weights), and a normalised target would clamp each before the sum.
+  const bool additive = mode == RasterMode::Pvrr && std::any_of(frames.begin(), frames.end(), [](const ElementFrame& f) {
+                          return f.rays.size() > 3;
+                        });
+  const ColorFormat colour = options.seen_points || additive ? ColorFormat::RGBA32F : ColorFormat::RGBA16;
+  if (!frame_target || frame_target->width() != ob.width || frame_target->height() != ob.height ||
+      frame_target->colorFormat(0) != colour)
     frame_target = std::make_unique<Framebuffer>(
         ob.width, ob.height,
-        options.seen_points
-            ? std::vector<ColorFormat>{ColorFormat::RGBA32F, ColorFormat::RGBA32F, ColorFormat::RGBA32F}
-            : std::vector<ColorFormat>{ColorFormat::RGBA16},
+        options.seen_points ? std::vector<ColorFormat>{colour, ColorFormat::RGBA32F, ColorFormat::RGBA32F}
+                            : std::vector<ColorFormat>{colour},
         DepthFormat::Depth32F);
   frame_target->clearDepth();  // no colour clear: the sky covers every pixel nothing else does
   // The elements come first: the depth state must not depend on what an earlier pass (or none) left.

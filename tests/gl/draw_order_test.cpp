@@ -39,7 +39,8 @@ constexpr double kTie = 1e-5;
 Differences compare(const gl::RasterFrame& a, const gl::RasterFrame& b, const Vec3& eye) {
   Differences d;
   d.pixels = test::differingPixels(a, b);
-  for (size_t i = 0; i < a.color.size() && i < b.color.size() && i < a.seen.size() && i < b.seen.size(); ++i) {
+  if (d.pixels == a.color.size()) return d;  // frames without seen points (differingPixels failed)
+  for (size_t i = 0; i < a.color.size() && i < b.color.size(); ++i) {
     if (!test::pixelDiffers(a, b, i)) continue;
     const double rel = glm::length(a.seen[i] - b.seen[i]) / std::max(glm::length(a.seen[i] - eye), 1e-9);
     d.worst = std::max(d.worst, rel);

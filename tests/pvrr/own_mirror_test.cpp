@@ -64,6 +64,16 @@ TEST(TangentClearance, SphericalCapsAndAPlaneAgainstTheClosedForm) {
     // The same points again: the kept answer.
     EXPECT_EQ(rays.tangentClearance(0, f.grid.positions, f.grid.normals), c);
   }
+  // A point or normal that is not finite is never clear.
+  const Scene s = capScene(0.5, diameter);
+  RayScene rays(s);
+  const auto c = rays.tangentClearance(0, {Vec3(0), Vec3(0, 0, std::nan("")), Vec3(0)},
+                                       {Vec3(0, 0, 1), Vec3(0, 0, 1), Vec3(0, std::nan(""), 1)});
+  EXPECT_LE(c->ahead[0], c->tolerance);
+  for (size_t i : {1, 2}) {
+    EXPECT_EQ(c->ahead[i], kInf) << i;
+    EXPECT_EQ(c->behind[i], -kInf) << i;
+  }
 }
 
 // Every vertex ray of element `element` traced beside its mirror equals the whole scene's; returns how many
