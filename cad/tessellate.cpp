@@ -375,20 +375,27 @@ std::vector<GridPatch> splitGrid(const Tessellation& grid, int patches_u, int pa
       p.j0 = cv[size_t(b)];
       p.j1 = cv[size_t(b + 1)];
       p.vertices.reserve(size_t(p.i1 - p.i0 + 1) * size_t(p.j1 - p.j0 + 1));
+      p.triangles.reserve(2 * size_t(p.i1 - p.i0) * size_t(p.j1 - p.j0));  // two a quad (more where cut)
       for (int i = p.i0; i <= p.i1; ++i)
         for (int j = p.j0; j <= p.j1; ++j) p.vertices.push_back(uint32_t(i * gv + j));
     }
+  // Each vertex's grid row and column, once (two integer divisions per triangle corner were most of the
+  // split's time).
+  const size_t n = grid.positions.size();
+  std::vector<int> row(n), col(n);
+  for (size_t k = 0; k < n; ++k) row[k] = int(k) / gv, col[k] = int(k) % gv;
   for (const Triangle& tri : grid.triangles) {
     const uint32_t idx[3] = {tri.x, tri.y, tri.z};
     int qi = gu, qj = gv;
     for (uint32_t k : idx) {
-      qi = std::min(qi, int(k) / gv);
-      qj = std::min(qj, int(k) % gv);
+      if (k >= n) throw Error("splitGrid: a triangle refers to vertex " + std::to_string(k) + " of " + std::to_string(n));
+      qi = std::min(qi, row[k]);
+      qj = std::min(qj, col[k]);
     }
     if (qi >= gu - 1 || qj >= gv - 1) throw Error("splitGrid: a triangle does not lie in a grid quad");
     GridPatch& p = patches[size_t(patch_of_qu[size_t(qi)] * patches_v + patch_of_qv[size_t(qj)])];
     const int w = p.j1 - p.j0 + 1;
-    auto local = [&](uint32_t k) { return uint32_t((int(k) / gv - p.i0) * w + (int(k) % gv - p.j0)); };
+    auto local = [&](uint32_t k) { return uint32_t((row[k] - p.i0) * w + (col[k] - p.j0)); };
     p.triangles.emplace_back(local(tri.x), local(tri.y), local(tri.z));
   }
   return patches;
