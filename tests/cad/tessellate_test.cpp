@@ -244,6 +244,10 @@ TEST(GridPatches, TooManyPatchesThrow) {
   EXPECT_THROW(splitGrid(g, 0, 1), Error);
   Tessellation adaptive;
   EXPECT_THROW(wholeGrid(adaptive), Error);
+  // A triangle that refers past the grid's vertices.
+  Tessellation bad = g;
+  bad.triangles.back().z = uint32_t(g.vertexCount());
+  EXPECT_THROW(splitGrid(bad, 1, 1), Error);
 }
 
 }  // namespace
