@@ -508,7 +508,7 @@ struct Renderer::Impl {
       p.use();
       p.set("u_offset", glm::vec3(mesh.anchor - origin));
       p.set("u_albedo", glm::vec3(mat.color));
-      if (mat.texture >= 0) glBindTexture(GL_TEXTURE_2D, textures[size_t(mat.texture)].name());
+      if (env_textured[m]) glBindTexture(GL_TEXTURE_2D, textures[size_t(mat.texture)].name());
       draw(env_meshes[m]);
     }
     glDisable(GL_CULL_FACE);
@@ -1058,13 +1058,9 @@ struct Renderer::Impl {
     };
     for (size_t b = 0; b < fp.spans.size(); ++b) {
       const int y0 = int(b) * fp.band, y1 = std::min(y0 + fp.band, region[1]);
-      const std::array<int, 2>& s = fp.spans[b];
-      if (s[0] >= s[1]) {
-        close(0, region[0], y0, y1);
-      } else {
-        close(0, s[0], y0, y1);
-        close(s[1], region[0], y0, y1);
-      }
+      const std::array<int, 2>& s = fp.spans[b];  // an empty band's span is {0, 0}: all of it closes
+      close(0, s[0], y0, y1);
+      close(s[1], region[0], y0, y1);
     }
     if (ndc.empty()) return 0;
     if (!mask_vao) {
