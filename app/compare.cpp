@@ -443,9 +443,10 @@ int cmdCompare(const std::vector<std::string>& argv) {
                   zs.median_arcmin, zs.p95_arcmin, zs.pixels, os.median_arcmin, os.pixels);
     if (per_channel) {
       // pvrr: each channel's own texture coordinates feed the seen point, one render per channel (the timed
-      // frame is the middle channel's). Other modes have one seen point for every channel.
+      // frame is the middle channel's); impostor: each channel's own refracted ray, likewise. Other modes
+      // have one seen point for every channel.
       std::array<std::vector<Vec3>, 3> seen;
-      const bool own = m == "pvrr";
+      const bool own = m == "pvrr" || m == "impostor";
       for (int c = 0; c < 3; ++c) {
         if (!own || c == 1) {
           seen[size_t(c)] = f.seen;

@@ -188,7 +188,7 @@ struct ObserverDesc {
 };
 
 struct RenderDesc {
-  enum class Mode { Pvrr, Raster, Raytrace, Envmap };
+  enum class Mode { Pvrr, Raster, Raytrace, Envmap, Impostor };
   enum class Dispersion { Off, Rgb, Spectral };
   Mode mode = Mode::Pvrr;
   int map_size = 1024;

@@ -889,11 +889,12 @@ RenderDesc readRender(const Ctx& c, const json* j, const std::string& source) {
   Obj o(c, j, "render", "an object {\"mode\", \"map_size\", \"output\", ...}",
         {"mode", "map_size", "map_texels_per_pixel", "map_reuse_margin_deg", "output", "max_depth", "dispersion", "spectral_samples",
          "background"});
-  const std::string mode = o.choice("mode", {"pvrr", "raster", "raytrace", "envmap"}, "pvrr");
-  r.mode = mode == "pvrr"     ? RenderDesc::Mode::Pvrr
-           : mode == "raster" ? RenderDesc::Mode::Raster
+  const std::string mode = o.choice("mode", {"pvrr", "raster", "raytrace", "envmap", "impostor"}, "pvrr");
+  r.mode = mode == "pvrr"       ? RenderDesc::Mode::Pvrr
+           : mode == "raster"   ? RenderDesc::Mode::Raster
            : mode == "raytrace" ? RenderDesc::Mode::Raytrace
-                                : RenderDesc::Mode::Envmap;
+           : mode == "envmap"   ? RenderDesc::Mode::Envmap
+                                : RenderDesc::Mode::Impostor;
   r.map_size = o.integer("map_size", 16, kMaxImageSize, 1024);
   r.map_texels_per_pixel = o.number("map_texels_per_pixel", closed(0, 1e4), 4);
   r.map_reuse_margin_deg = o.number("map_reuse_margin_deg", closed(0, 10), 2);
@@ -1235,6 +1236,7 @@ const char* toString(RenderDesc::Mode m) {
     case RenderDesc::Mode::Raster: return "raster";
     case RenderDesc::Mode::Raytrace: return "raytrace";
     case RenderDesc::Mode::Envmap: return "envmap";
+    case RenderDesc::Mode::Impostor: return "impostor";
   }
   return "?";
 }

@@ -201,6 +201,13 @@ void Program::set(const std::string& name, int value) const {
 void Program::set(const std::string& name, const glm::vec2& value) const { setVec2(name, &value.x); }
 void Program::set(const std::string& name, const glm::vec3& value) const { setVec3(name, &value.x); }
 void Program::set(const std::string& name, const glm::vec4& value) const { setVec4(name, &value.x); }
+void Program::set(const std::string& name, const glm::mat3& value) const {
+  const int location = uniformLocation(name);
+  if (location < 0) return;
+  use();
+  glUniformMatrix3fv(location, 1, GL_FALSE, &value[0][0]);
+}
+
 void Program::set(const std::string& name, const glm::mat4& value) const { setMat4(name, &value[0][0]); }
 
 void Program::setFloats(const std::string& name, const float* values, int count) const {

@@ -68,6 +68,7 @@ class Program {
   void set(const std::string& name, const glm::vec2& value) const;
   void set(const std::string& name, const glm::vec3& value) const;
   void set(const std::string& name, const glm::vec4& value) const;
+  void set(const std::string& name, const glm::mat3& value) const;
   void set(const std::string& name, const glm::mat4& value) const;
   void setVec2(const std::string& name, const float* xy, int count = 1) const;
   void setVec3(const std::string& name, const float* xyz, int count = 1) const;

@@ -15,6 +15,7 @@
 #include "pvrr/gl/framebuffer.h"
 #include "pvrr/gl/program.h"
 #include "pvrr/format.h"
+#include "pvrr/lens_height_map.h"
 #include "pvrr/map_footprint.h"
 #include "pvrr/spectrum.h"
 
@@ -24,7 +25,18 @@ RasterMode parseRasterMode(const std::string& mode) {
   if (mode == "raster") return RasterMode::Raster;
   if (mode == "pvrr") return RasterMode::Pvrr;
   if (mode == "envmap") return RasterMode::Envmap;
-  throw Error("mode: expected one of pvrr, raster, envmap, raytrace; got \"" + mode + "\"");
+  if (mode == "impostor") return RasterMode::Impostor;
+  throw Error("mode: expected one of pvrr, raster, envmap, impostor, raytrace; got \"" + mode + "\"");
+}
+
+std::string modeName(RasterMode mode) {
+  switch (mode) {
+    case RasterMode::Raster: return "raster";
+    case RasterMode::Pvrr: return "pvrr";
+    case RasterMode::Envmap: return "envmap";
+    case RasterMode::Impostor: return "impostor";
+  }
+  return "?";
 }
 
 namespace {
@@ -249,7 +261,9 @@ struct Renderer::Impl {
   const RayScene& rays;
   RendererOptions options;
   // A program's defines, plus the scene's light counts (shaders/shading.glsl) and NO_SEEN_POINTS when
-  // RendererOptions::seen_points is off.
+  // RendererOptions::seen_points is off, unless the variant writes seen points all the same (kWithSeenPoints:
+  // the impostor cube maps, whose seen points are the distances the search reads).
+  static constexpr const char* kWithSeenPoints = "#define WITH_SEEN_POINTS";
   std::vector<std::string> defines(std::vector<std::string> d) const {
     int dir = 0, point = 0;
     for (const Light& l : scene.lights) {
@@ -258,7 +272,8 @@ struct Renderer::Impl {
     }
     d.push_back("#define NUM_DIR_LIGHTS " + std::to_string(dir));
     d.push_back("#define NUM_POINT_LIGHTS " + std::to_string(point));
-    if (!options.seen_points) d.push_back("#define NO_SEEN_POINTS");
+    if (!options.seen_points && std::find(d.begin(), d.end(), kWithSeenPoints) == d.end())
+      d.push_back("#define NO_SEEN_POINTS");
     return d;
   }
   Program sky_program = makeProgram("sky.vert", "sky.frag", defines({}));
@@ -289,14 +304,27 @@ struct Renderer::Impl {
   }
   // Environment meshes (shaders/env.frag): FACETED (one normal per triangle), TEXTURED (a material with a
   // texture; without, no texture is sampled: llvmpipe samples inside a uniform branch all the same).
-  const Program& envProgram(bool faceted, bool textured, bool planes) const {
+  const Program& envProgram(bool faceted, bool textured, bool planes, bool with_seen = false) const {
     std::vector<std::string> d;
+    if (with_seen) d.push_back(kWithSeenPoints);
     if (faceted) d.push_back("#define FACETED");
     if (textured) d.push_back("#define TEXTURED");
     if (planes) d.push_back("#define PLANES");
     return builtProgram("env.vert", "env.frag", d);
   }
-  const Program& skyProgram(bool planes) const { return planes ? planesVariant("sky.vert", "sky.frag", {}) : sky_program; }
+  const Program& skyProgram(bool planes, bool with_seen = false) const {
+    if (with_seen && !options.seen_points) return builtProgram("sky.vert", "sky.frag", {kWithSeenPoints});
+    return planes ? planesVariant("sky.vert", "sky.frag", {}) : sky_program;
+  }
+  // Distance-impostor elements (shaders/element.frag, MODE_IMPOSTOR): a mirror, or a lens with one or three
+  // wavelengths.
+  const Program& impostorProgram(bool lens, int channels) const {
+    std::vector<std::string> d{"#define MODE_IMPOSTOR",
+                               "#define IMPOSTOR_ITERATIONS " + std::to_string(options.impostor_iterations),
+                               "#define IMPOSTOR_CHANNELS " + std::to_string(channels)};
+    if (lens) d.push_back("#define LENS");
+    return builtProgram("element.vert", "element.frag", d);
+  }
   const Program& plainProgram(bool planes) const {
     return planes ? planesVariant("element.vert", "element.frag", {"#define MODE_PLAIN"}) : plain_program;
   }
@@ -333,7 +361,14 @@ struct Renderer::Impl {
   // process (nextFirstPassSerial), so a cache filled by another renderer never matches.
   uint64_t first_pass_serial = 0;
   std::vector<int> map_side;  // per map slot: the longer side its last first pass rendered (MapPass::side)
-  std::vector<std::unique_ptr<CubeTarget>> cubes;  // envmap cubes, one per element
+  std::vector<std::unique_ptr<CubeTarget>> cubes;  // envmap and impostor cubes, one per element
+  // Impostor mode: each lens's refractor height maps (pvrr/lens_height_map.h), built on first use (a lens's
+  // shape in its own frame never changes; its pose reaches the shader as u_to_local).
+  struct LensMaps {
+    GLuint front = 0, back = 0;
+    LensHeightMap map;
+  };
+  std::vector<LensMaps> lens_maps;
   std::vector<MeshBuffers> element_meshes;     // per (element, patch) in pvrr mode; per element otherwise
   ElementGridCache grid_cache;                 // the elements' tessellations, posed anew each frame
 
@@ -390,6 +425,9 @@ struct Renderer::Impl {
   }
 
   ~Impl() {
+    for (LensMaps& m : lens_maps)
+      for (GLuint t : {m.front, m.back})
+        if (t) glDeleteTextures(1, &t);
     for (auto& m : env_meshes) m.release();
     for (auto& m : element_meshes) m.release();
     if (empty_vao) glDeleteVertexArrays(1, &empty_vao);
@@ -446,10 +484,11 @@ struct Renderer::Impl {
   // no pixel is shaded twice for it; what was drawn into the target before (the elements of the second
   // pass, drawn first so that the environment behind them fails the early depth test) stays.
   // Returns how many closed convex meshes it drew and culled.
+  // with_seen: write seen points even when RendererOptions::seen_points is off (impostor cube maps).
   CullCount drawEnvironment(const Mat4& view, const Mat4& proj, const Vec3& origin, bool reversed_depth = false,
-                            const Vec3* rays_from = nullptr, bool planes = false) const {
+                            const Vec3* rays_from = nullptr, bool planes = false, bool with_seen = false) const {
     const Mat4 vp = relativeViewProj(proj, view, origin);
-    const Program& sky = skyProgram(planes);
+    const Program& sky = skyProgram(planes, with_seen);
     auto drawSky = [&] {
       sky.use();
       sky.set("u_inv_view_proj", toFloat(glm::inverse(vp)));
@@ -472,7 +511,7 @@ struct Renderer::Impl {
       const bool faceted = env_faceted[m], textured = env_textured[m];
       const Program*& p = programs[faceted][textured];
       if (p) continue;
-      p = &envProgram(faceted, textured, planes);
+      p = &envProgram(faceted, textured, planes, with_seen);
       p->use();
       p->set("u_view_proj", toFloat(vp));
       p->set("u_view_origin", rays_from ? glm::vec3(*rays_from - origin) : glm::vec3(0.0f));
@@ -521,6 +560,49 @@ struct Renderer::Impl {
       glDepthFunc(GL_LESS);
     }
     return count;
+  }
+
+  LensMaps& lensMaps(size_t e) {
+    if (lens_maps.size() < scene.elements.size()) lens_maps.resize(scene.elements.size());
+    return lens_maps[e];
+  }
+  // Builds and uploads lens e's height maps (RGBA32F: z and the outward normal, linear, clamped); returns 1.
+  int createLensMaps(size_t e) {
+    LensMaps& m = lensMaps(e);
+    m.map = buildLensHeightMap(scene.elements[e], options.lens_height_map_size);
+    for (GLuint* t : {&m.front, &m.back}) {
+      glGenTextures(1, t);
+      glBindTexture(GL_TEXTURE_2D, *t);
+      const std::vector<float>& data = t == &m.front ? m.map.front : m.map.back;
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, m.map.nx, m.map.ny, 0, GL_RGBA, GL_FLOAT, data.data());
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    }
+    glBindTexture(GL_TEXTURE_2D, 0);
+    checkGlError("uploading a lens's refractor height maps");
+    return 1;
+  }
+  // The uniforms of a lens's impostor draw (shaders/element.frag, MODE_IMPOSTOR with LENS): its height maps
+  // on units 2 and 3, their placement, its pose and its index at the R, G and B wavelengths.
+  void setLensMaps(const Program& p, size_t e) {
+    const LensMaps& m = lensMaps(e);
+    const Element& el = scene.elements[e];
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_2D, m.front);
+    glActiveTexture(GL_TEXTURE3);
+    glBindTexture(GL_TEXTURE_2D, m.back);
+    glActiveTexture(GL_TEXTURE0);
+    p.set("u_lens_front", 2);
+    p.set("u_lens_back", 3);
+    p.set("u_hm", glm::vec4(float(m.map.x0), float(m.map.y0), float(1.0 / (m.map.nx * m.map.dx)),
+                            float(1.0 / (m.map.ny * m.map.dy))));
+    p.set("u_hm_z", glm::vec2(float(m.map.back_z_min), float(m.map.front_z_max)));
+    p.set("u_to_local", glm::mat3(Mat3(el.world_to_local)));
+    const double* wl = kRgbWavelengths_nm;
+    p.set("u_index", glm::vec3(float(el.dispersion.index(wl[0])), float(el.dispersion.index(wl[1])),
+                               float(el.dispersion.index(wl[2]))));
   }
 
   void setElementMaterial(const Program& p, const Element& el, int index) const {
@@ -1236,13 +1318,33 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     skip_first_pass = nothing_moved;
     continuing = cache && cache->valid;
   } else {
-    const std::string why = n_el == 0 ? "no mirror or lens in the scene"
-                                      : std::string("mode ") + (mode == RasterMode::Raster ? "raster" : "envmap");
-    out.stages.skipped("vertex-rays", why);
-    out.stages.skipped("refraction", has_lens ? why : "no lens in the scene");
+    const std::string why = n_el == 0 ? "no mirror or lens in the scene" : "mode " + modeName(mode);
+    out.stages.skipped("vertex-rays", mode == RasterMode::Impostor && n_el > 0
+                                          ? why + ": each fragment reflects or refracts its own ray (second pass)"
+                                          : why);
+    if (mode == RasterMode::Impostor && has_lens)
+      out.stages.skipped("refraction", why + ": per fragment, through the lens's refractor height maps (second pass)");
+    else
+      out.stages.skipped("refraction", has_lens ? why : "no lens in the scene");
     out.stages.skipped("viewpoint-fit", why);
     out.stages.skipped("texture-coordinates", why);
-    out.stages.skipped("colour-channels", why);
+    if (mode == RasterMode::Impostor && has_lens) {
+      int most = 1;
+      bool spectral = false;
+      for (size_t e = 0; e < n_el; ++e) {
+        const size_t n = dispersionChannels(scene, int(e)).size();
+        most = std::max(most, n > 1 ? 3 : 1);
+        spectral = spectral || n > 3;
+      }
+      if (most > 1)
+        out.stages.ran("colour-channels", 0, most,
+                       std::string("R, G and B refracted with their own index per fragment") +
+                           (spectral ? " (spectral dispersion approximated by the C, d and F lines in mode impostor)" : ""));
+      else
+        out.stages.skipped("colour-channels", "dispersion off: one wavelength (the d line)");
+    } else {
+      out.stages.skipped("colour-channels", why);
+    }
   }
 
   // --- first pass (and the nested passes of elements seen in other elements' maps) ---
@@ -1345,28 +1447,36 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       out.stages.skipped("nested-passes", dark_note);
     else
       out.stages.skipped("nested-passes", "no element is inside another element's view volume");
-  } else if (mode == RasterMode::Envmap && n_el > 0) {
+  } else if ((mode == RasterMode::Envmap || mode == RasterMode::Impostor) && n_el > 0) {
     while (cubes.size() < n_el) cubes.push_back(std::make_unique<CubeTarget>());
     CullCount culled;
+    // Impostor cube maps hold the seen points (each direction's distance) even in a colour-only frame.
+    const bool with_seen = mode == RasterMode::Impostor;
+    const std::vector<GLenum> formats = options.seen_points || with_seen ? std::vector<GLenum>{GL_RGBA16F, GL_RGBA32F}
+                                                                         : std::vector<GLenum>{GL_RGBA16F};
+    int height_maps = 0;
     for (size_t e = 0; e < n_el; ++e) {
       CubeTarget& c = *cubes[e];
-      if (c.size != options.map_size) {
-        if (options.seen_points) c.create(options.map_size, {GL_RGBA16F, GL_RGBA32F});
-        else c.create(options.map_size, {GL_RGBA16F});
-      }
+      if (c.size != options.map_size || c.colors.size() != formats.size()) c.create(options.map_size, formats);
       const Vec3 centre = Vec3(scene.elements[e].local_to_world[3]);
       const double near_m = 1e-3, far_m = 2.0 * (scene.boundsRadius() + glm::length(centre - scene.bounds_min)) + 1.0;
       const Mat4 proj = glm::perspective(kPi / 2, 1.0, near_m, far_m);
       for (int face = 0; face < 6; ++face) {
         c.selectFace(face);
-        culled.add(drawEnvironment(glm::lookAt(centre, centre + kCubeDir[face], kCubeUp[face]), proj, centre));
+        culled.add(drawEnvironment(glm::lookAt(centre, centre + kCubeDir[face], kCubeUp[face]), proj, centre, false,
+                                   nullptr, false, with_seen));
       }
+      if (mode == RasterMode::Impostor && scene.elements[e].type == ElementType::Lens && !lensMaps(e).front)
+        height_maps += createLensMaps(e);
     }
     glFinish();
-    out.stages.ran("first-pass", msSince(t0), -1, cullNote(culled));
-    out.stages.skipped("nested-passes", "mode envmap: other elements are absent from the cube maps");
+    std::string note = mode == RasterMode::Impostor ? "distance impostors: colour and seen-point cube maps" : "";
+    if (height_maps > 0) appendNote(note, "refractor height maps of " + std::to_string(height_maps) + " lens(es) built");
+    appendNote(note, cullNote(culled));
+    out.stages.ran("first-pass", msSince(t0), -1, note);
+    out.stages.skipped("nested-passes", "mode " + modeName(mode) + ": other elements are absent from the cube maps");
   } else {
-    out.stages.skipped("first-pass", n_el == 0 ? "no mirror or lens in the scene" : "mode raster");
+    out.stages.skipped("first-pass", n_el == 0 ? "no mirror or lens in the scene" : "mode " + modeName(mode));
     out.stages.skipped("nested-passes", n_el == 0 ? "no mirror or lens in the scene" : "mode raster");
   }
 
@@ -1422,7 +1532,10 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     } else {
       ElementFrame f = prepareElement(scene, int(e), &grid_cache.get(scene, int(e)));
       if (lens && mode == RasterMode::Envmap) traceVertexRays(rays, f, ob.eye, VertexStageOptions{});
-      const Program& p = mode == RasterMode::Raster ? plain_program : (lens ? lens_envmap_program : envmap_program);
+      const Program& p = mode == RasterMode::Raster ? plain_program
+                         : mode == RasterMode::Impostor
+                             ? impostorProgram(lens, dispersionChannels(scene, int(e)).size() > 1 ? 3 : 1)
+                             : (lens ? lens_envmap_program : envmap_program);
       p.use();
       p.set("u_view_proj", toFloat(vp));
       p.set("u_offset", glm::vec3(anchor - ob.eye));
@@ -1430,15 +1543,19 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       setLights(p, ob.eye);
       setElementMaterial(p, el, int(e));
       if (mode == RasterMode::Raster) p.set("u_dark", 0);
-      if (mode == RasterMode::Envmap) {
+      if (mode == RasterMode::Envmap || mode == RasterMode::Impostor) {
         glActiveTexture(GL_TEXTURE0);
         glBindTexture(GL_TEXTURE_CUBE_MAP, cubes[e]->colors[0]);
         glActiveTexture(GL_TEXTURE1);
-        if (options.seen_points) glBindTexture(GL_TEXTURE_CUBE_MAP, cubes[e]->colors[1]);
+        if (cubes[e]->colors.size() > 1) glBindTexture(GL_TEXTURE_CUBE_MAP, cubes[e]->colors[1]);
         glActiveTexture(GL_TEXTURE0);
         p.set("u_cube", 0);
         p.set("u_seen_cube", 1);
         p.set("u_seen_offset", glm::vec3(anchor - ob.eye));
+      }
+      if (mode == RasterMode::Impostor && lens) {
+        setLensMaps(p, e);
+        p.set("u_seen_channel", options.seen_channel < 0 ? 1 : std::min(options.seen_channel, 2));
       }
       MeshBuffers& mb = meshSlot();
       uploadElementGrid(mb, f, anchor);

@@ -1,6 +1,9 @@
 // The raster paths on the GPU: "raster" (elements drawn as plain surfaces), "pvrr" (the paper's two passes,
-// with the CPU stages of pvrr/vertex_stage.h), and "envmap" (a dynamic cube map from each element's centre,
-// the classic baseline). A current GL context (pvrr/gl/context.h) is required.
+// with the CPU stages of pvrr/vertex_stage.h), "envmap" (a dynamic cube map from each element's centre,
+// the classic baseline) and "impostor" (the glass mode of distance impostors: the same cube maps with each
+// direction's distance, searched per fragment along the exact reflected ray, or along the ray refracted
+// through a lens's refractor height maps; docs/method.md "Distance impostors"). A current GL context
+// (pvrr/gl/context.h) is required.
 //
 // Multiple reflection (pvrr mode): an element inside another element's view volume is drawn in that
 // element's first pass with its own PVRR maps, its vertex rays starting where the outer element's rays that
@@ -20,8 +23,9 @@
 
 namespace pvrr::gl {
 
-enum class RasterMode { Raster, Pvrr, Envmap };
+enum class RasterMode { Raster, Pvrr, Envmap, Impostor };
 RasterMode parseRasterMode(const std::string& mode);  // throws pvrr::Error
+std::string modeName(RasterMode mode);                 // the name parseRasterMode takes
 
 // What one frame produced, read back from the GPU. Rows top-down. `seen` and `surface` are world points
 // (double, reconstructed from camera-relative floats).
@@ -37,7 +41,12 @@ struct RasterFrame {
 };
 
 struct RendererOptions {
-  int map_size = 1024;              // first-pass map's longer side at most (pvrr), cube face size (envmap)
+  int map_size = 1024;              // first-pass map's longer side at most (pvrr), cube face size (envmap, impostor)
+  // impostor: the false-position steps of each fragment's search of the distance impostor, after the two
+  // first guesses (the search stops early where it has converged to float precision).
+  int impostor_iterations = 8;
+  // impostor: the longer side (texels) of a lens's refractor height maps (pvrr/lens_height_map.h), built once.
+  int lens_height_map_size = 512;
   // pvrr: each top-level map's texels per image pixel of its patch (Scene render.map_texels_per_pixel); the
   // map's longer side is lowered from map_size to that (topLevelMapSide). 0: always map_size.
   double map_texels_per_pixel = 4;

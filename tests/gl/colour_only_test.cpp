@@ -47,7 +47,9 @@ TEST_P(ColourOnlyTest, SameColoursWithoutSeenPoints) {
     without.vertex.channels.clear();
     without.seen_points = false;
     gl::Renderer a(s, rays, with), b(s, rays, without);
-    for (gl::RasterMode mode : {gl::RasterMode::Pvrr, gl::RasterMode::Envmap, gl::RasterMode::Raster}) {
+    // Impostor: its cube maps keep their seen points (the distances it searches) in the colour-only frame.
+    for (gl::RasterMode mode :
+         {gl::RasterMode::Pvrr, gl::RasterMode::Envmap, gl::RasterMode::Impostor, gl::RasterMode::Raster}) {
       const gl::RasterFrame fa = a.render(mode), fb = b.render(mode);
       ASSERT_EQ(fa.color.size(), fb.color.size()) << scene;
       EXPECT_EQ(fa.seen.size(), fa.color.size());
@@ -84,7 +86,8 @@ TEST_P(ColourOnlyTest, FirstFrameOfEachModeEqualsALaterOne) {
   Scene s = buildScene(loadScene(std::string(PVRR_SOURCE_DIR) + "/models/car-mirror.json",
                                  {"observer.image_size=[96,72]", "render.map_size=256"}));
   RayScene rays(s);
-  for (gl::RasterMode mode : {gl::RasterMode::Raster, gl::RasterMode::Envmap, gl::RasterMode::Pvrr}) {
+  for (gl::RasterMode mode :
+       {gl::RasterMode::Raster, gl::RasterMode::Envmap, gl::RasterMode::Impostor, gl::RasterMode::Pvrr}) {
     // A fresh context per mode: GL state belongs to the context, so no earlier renderer's frames set it.
     const auto ctx = test::glContextOrFail(GetParam());
     if (!ctx) return;

@@ -58,8 +58,11 @@ TEST(TangentClearance, SphericalCapsAndAPlaneAgainstTheClosedForm) {
       const double toward = radius > 0 ? c->ahead[i] : -c->behind[i], away = radius > 0 ? -c->behind[i] : c->ahead[i];
       EXPECT_LE(toward, 1e-12) << where;
       EXPECT_GE(toward, -near) << where;
-      if (far > 1.01 * cap) EXPECT_EQ(away, kInf) << where << ": beyond the cap";
-      else if (far < 0.99 * cap) EXPECT_NEAR(away, far, 0.02 * far) << where;
+      if (far > 1.01 * cap) {
+        EXPECT_EQ(away, kInf) << where << ": beyond the cap";
+      } else if (far < 0.99 * cap) {
+        EXPECT_NEAR(away, far, 0.02 * far) << where;
+      }
     }
     // The same points again: the kept answer.
     EXPECT_EQ(rays.tangentClearance(0, f.grid.positions, f.grid.normals), c);
