@@ -222,7 +222,9 @@ void renderChart(const std::string& path, const Axes& axes, const std::vector<Pl
     table->AddColumn(xs);
     table->AddColumn(ys);
     vtkPlot* p = nullptr;
-    if (s.line) {
+    // A line of one point draws nothing (and VTK logs an error): that point gets a marker instead.
+    const bool as_line = s.line && s.x.size() >= 2;
+    if (as_line) {
       p = chart->AddPlot(vtkChart::LINE);
     } else {
       vtkNew<LabelledPoints> lp;
@@ -242,7 +244,7 @@ void renderChart(const std::string& path, const Axes& axes, const std::vector<Pl
       const unsigned char* c = kColours[s.colour % kNumColours];
       p->SetColor(c[0], c[1], c[2], 255);
     }
-    p->SetWidth(s.line ? 2.0f : 3.0f);
+    p->SetWidth(as_line ? 2.0f : 3.0f);
     if (s.dashed) p->GetPen()->SetLineType(vtkPen::DASH_LINE);
     tables.push_back(table);
   }
