@@ -47,6 +47,7 @@ LensHeightMap buildLensHeightMap(const Element& lens, int n) {
   const size_t texels = size_t(m.nx) * size_t(m.ny);
   m.front.resize(4 * texels);
   m.back.resize(4 * texels);
+  m.inside.resize(texels);
   std::vector<char> clamped(texels, 0);
   const Vec2 centre = outline.centre();
   tbb::parallel_for(0, m.ny, [&](int j) {
@@ -58,8 +59,10 @@ LensHeightMap buildLensHeightMap(const Element& lens, int n) {
       const Vec4 b = surfaceTexel(*lens.lens.back, centre, p, true, cb);
       for (int c = 0; c < 4; ++c) m.front[4 * k + size_t(c)] = float(f[c]), m.back[4 * k + size_t(c)] = float(b[c]);
       clamped[k] = cf || cb;
+      m.inside[k] = outline.contains(p) ? 1.0f : 0.0f;
     }
   });
+  m.reach = glm::length(extent);
   m.back_z_min = kInf;
   m.front_z_max = -kInf;
   for (size_t k = 0; k < texels; ++k) {

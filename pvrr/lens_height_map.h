@@ -6,8 +6,10 @@
 // samples one surface on a regular grid of texel centres over the outline's bounding box, widened by
 // kHeightMapMargin of its size on each side (rays inside the glass travel sideways), and stores per texel the
 // local height z and the unit normal facing out of the glass: +z side for the front (eye-side) surface, -z
-// side for the back. The fragment shader (shaders/element.frag, MODE_IMPOSTOR with LENS) intersects a ray
-// inside the glass with the surface ahead by false position on the bilinearly filtered heights.
+// side for the back, and a mask of the outline (1 inside, 0 outside: the reference tracer's lens has no rim,
+// so light that reaches the surfaces beyond the outline is absorbed there). The fragment shader
+// (shaders/element.frag, MODE_IMPOSTOR with LENS) finds where a ray inside the glass meets a surface again by
+// stepping out and then false position on the bilinearly filtered heights.
 //
 // Units and frames: the lens's local frame, metres. Texel (i, j) is centred on (x0 + (i + 0.5) dx,
 // y0 + (j + 0.5) dy); texture coordinate s = (x - x0) / (nx dx), t = (y - y0) / (ny dy).
@@ -25,7 +27,9 @@ struct LensHeightMap {
   double x0 = 0, y0 = 0, dx = 0, dy = 0;
   // Per texel, rows of increasing y: z, then the outward unit normal (4 floats).
   std::vector<float> front, back;
+  std::vector<float> inside;  // per texel: 1 where its centre lies inside the outline, else 0
   double back_z_min = 0, front_z_max = 0;  // the extreme heights over the map: bounds of a ray's search
+  double reach = 0;  // the map box's diagonal: no straight path inside the glass is longer
   int clamped_texels = 0;  // texels where a sag is undefined (beyond a sphere's radius): moved inwards
 };
 
@@ -33,8 +37,9 @@ struct LensHeightMap {
 // Throws pvrr::Error for a mirror, or for n outside [8, 8192].
 LensHeightMap buildLensHeightMap(const Element& lens, int n);
 
-// The map's bilinear sample (z and the normal, normalised) of one surface at local (x, y), as the GPU's
-// GL_LINEAR filter with clamp-to-edge computes it (in double): for tests.
+// The map's bilinear sample (z and the normal, normalised) of one surface at local (x, y): GL_LINEAR with
+// clamp-to-edge in exact arithmetic (a GPU's filter weights have about 8 fractional bits, which moves a height
+// by up to 1/512 of the difference between neighbouring texels, ~6e-8 m on the shipped lenses): for tests.
 Vec4 sampleHeightMap(const LensHeightMap& map, bool back, double x, double y);
 
 }  // namespace pvrr

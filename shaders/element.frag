@@ -58,8 +58,12 @@ uniform samplerCube u_seen_cube;  // its seen points relative to that origin (u_
 #if defined(LENS)
 uniform sampler2D u_lens_front;   // refractor height maps (pvrr/lens_height_map.h): z, outward unit normal
 uniform sampler2D u_lens_back;
+uniform sampler2D u_lens_mask;    // 1 inside the outline, 0 outside
 uniform vec4 u_hm;                // the maps' x0, y0, 1 / width, 1 / height (lens local, metres)
 uniform vec2 u_hm_z;              // the back surface's lowest z and the front surface's highest z
+uniform float u_hm_reach;         // the maps' diagonal: no straight path inside the glass is longer
+uniform int u_max_events;         // the events inside the glass the tracer follows: render.max_depth - 1
+uniform float u_far;              // render.far_distance_m: where a ray absorbed at the rim puts its seen point
 uniform mat3 u_to_local;          // world directions -> the lens's local frame (whose origin is the cube's)
 uniform vec3 u_index;             // the glass's index at the R, G and B wavelengths (.y: the d line)
 uniform int u_seen_channel;       // IMPOSTOR_CHANNELS 3: the channel whose ray gives the seen point
@@ -103,7 +107,7 @@ vec3 impostorHit(vec3 x, vec3 R) {
     dl = max(dl + ddl, 0.0);
     l = x + R * dl;
   }
-  return l;
+  return dot(l, l) > 0.0 ? l : R;  // x at the cube's origin and d = 0: the direction itself
 }
 
 #if defined(LENS)
@@ -120,72 +124,101 @@ vec4 lensTexel(bool back, vec2 xy) {
   vec2 st = (xy - u_hm.xy) * u_hm.zw;
   return back ? texture(u_lens_back, st) : texture(u_lens_front, st);
 }
-// The ray p + t d inside the glass (lens local) to the surface ahead: the back when d.z < 0, else the front.
-// h(t), the ray's height inside that surface, is positive at t = 0 and not positive at t1, where the ray
-// passes the surface's extreme z: false position with the Illinois halving, on the bilinearly filtered
-// heights. on_surface: p lies on that same surface (the ray was just reflected off it), where h(0) = 0 is a
-// root the search must pass: it first steps out geometrically (t1 / 256, t1 / 128, ... t1) to the first
-// point beyond the surface, and searches between it and the step before.
-float glassExit(vec3 p, vec3 d, bool back, bool on_surface) {
-  float s = back ? 1.0 : -1.0;
-  float t0 = 0.0, t1 = ((back ? u_hm_z.x : u_hm_z.y) - p.z) / d.z;
-  float h0 = s * (p.z - lensTexel(back, p.xy).x);
-  vec3 q1 = p + t1 * d;
-  float h1 = s * (q1.z - lensTexel(back, q1.xy).x);
-  if (on_surface) {
-    float t_end = t1;
-    for (int k = 8; k >= 0; --k) {
-      float t = t_end * exp2(-float(k));
-      vec3 q = p + t * d;
-      float h = s * (q.z - lensTexel(back, q.xy).x);
-      if (h <= 0.0) {
-        t1 = t, h1 = h;
-        break;
-      }
-      t0 = t, h0 = h;
+bool inOutline(vec2 xy) { return texture(u_lens_mask, (xy - u_hm.xy) * u_hm.zw).r >= 0.5; }
+// The heights of q above the back surface and below the front one: both positive inside the glass.
+vec2 insideHeights(vec3 q) { return vec2(q.z - lensTexel(true, q.xy).x, lensTexel(false, q.xy).x - q.z); }
+
+// The ray p + t d, leaving a point p of the glass's surface into the glass: where it meets a surface again,
+// and which (back or front, the nearer crossing, as the tracer takes the nearer of its two surfaces). It steps
+// out from 1 um, doubling, to where it leaves the slab between the surfaces' extreme heights or the maps'
+// reach; then false position with the Illinois halving on the crossed surface's filtered height, between the
+// last step inside and the first outside (so the root at p itself is never taken). -1: no crossing.
+float glassExit(vec3 p, vec3 d, out bool back) {
+  float t_max = u_hm_reach;
+  if (d.z < 0.0) t_max = min(t_max, (u_hm_z.x - p.z) / d.z);
+  if (d.z > 0.0) t_max = min(t_max, (u_hm_z.y - p.z) / d.z);
+  t_max = max(t_max, 1e-6);
+  float t0 = 0.0, t1 = -1.0, t = 1e-6;
+  vec2 h1 = vec2(0.0);
+  for (int k = 0; k < 32; ++k) {
+    vec2 h = insideHeights(p + t * d);
+    if (min(h.x, h.y) <= 0.0) {
+      t1 = t, h1 = h;
+      break;
     }
+    t0 = t;
+    if (t >= t_max) break;
+    t = min(2.0 * t, t_max);
   }
-  h0 = max(h0, 0.0);
-  h1 = min(h1, 0.0);
-  if (h0 - h1 <= 0.0) return t0;
-  float t = t1;
+  back = h1.x <= h1.y;
+  if (t1 < 0.0) return -1.0;
+  float g0 = t0 > 0.0 ? (back ? insideHeights(p + t0 * d).x : insideHeights(p + t0 * d).y) : 0.0;
+  float g1 = back ? h1.x : h1.y;
+  g0 = max(g0, 0.0);
+  if (g0 - g1 <= 0.0) return t1;
   int side = 0;
   for (int i = 0; i < 16; ++i) {
-    t = (t0 * h1 - t1 * h0) / (h1 - h0);
-    vec3 q = p + t * d;
-    float h = s * (q.z - lensTexel(back, q.xy).x);
-    if (abs(h) < 1e-9) break;  // a nanometre
-    if (h > 0.0) {
-      t0 = t, h0 = h;
-      if (side == 1) h1 *= 0.5;
+    t = (t0 * g1 - t1 * g0) / (g1 - g0);
+    vec2 hh = insideHeights(p + t * d);
+    float g = back ? hh.x : hh.y;
+    if (abs(g) < 1e-9) break;  // a nanometre
+    if (g > 0.0) {
+      t0 = t, g0 = g;
+      if (side == 1) g1 *= 0.5;
       side = 1;
     } else {
-      t1 = t, h1 = h;
-      if (side == -1) h0 *= 0.5;
+      t1 = t, g1 = g;
+      if (side == -1) g0 *= 0.5;
       side = -1;
     }
   }
   return t;
 }
-// One wavelength's path through the lens from the front-surface point x (local) with the view direction v
-// and front normal n (local, facing the viewer): up to three internal reflections, as the tracer follows
-// them. Returns the exit point and direction (local) and the Fresnel transmittance (0 if the ray stays in).
-vec3 throughLens(vec3 x, vec3 v, vec3 n, float eta, out vec3 dir, out float transmittance) {
+
+// Where the view ray through the fragment at x (lens local, direction v) meets the lens: the front surface
+// near x (the rasterised triangle lies within its sag of the surface), or, for a lens seen from behind
+// (back), the back surface between the eye and x. Secant steps on the ray's height above that surface.
+vec3 entryPoint(vec3 x, vec3 v, bool back) {
+  if (abs(v.z) < 1e-4) return x;
+  float ta = 0.0, ga = x.z - lensTexel(back, x.xy).x;
+  float tb = -ga / v.z;
+  vec3 q = x + tb * v;
+  float gb = q.z - lensTexel(back, q.xy).x;
+  for (int i = 0; i < 6 && abs(gb) > 1e-9 && gb != ga; ++i) {
+    float tc = tb - gb * (tb - ta) / (gb - ga);
+    ta = tb, ga = gb, tb = tc;
+    q = x + tb * v;
+    gb = q.z - lensTexel(back, q.xy).x;
+  }
+  return x + tb * v;
+}
+
+// One wavelength's path through the lens (local frame) from the entry point x, where the view direction v
+// meets the surface with outward normal n. It refracts in, then follows the events inside the glass as the
+// tracer does up to its depth limit (u_max_events, at most 8): each is an exit (refraction, exact Fresnel)
+// or a total internal reflection. Returns the exit point and sets the exit direction and the transmittance;
+// transmittance 0: absorbed, at the returned point (the depth limit) or, with `rim`, where the ray left the
+// outline (the tracer's lens has no rim surface: its seen point lies u_far along `dir`, the ray inside).
+vec3 throughLens(vec3 x, vec3 v, vec3 n, float eta, out vec3 dir, out float transmittance, out bool rim) {
   float cos_i = -dot(v, n);
   vec3 d = refract(v, n, 1.0 / eta);
   transmittance = 1.0 - fresnelDielectric(cos_i, 1.0, eta);
+  rim = false;
   vec3 p = x;
-  bool on_back = false, on_front = true;  // the surface p lies on
-  for (int bounce = 0; bounce < 4; ++bounce) {
-    if (abs(d.z) < 1e-6) break;  // along the lens plane: out through the rim, which the lens has not
-    bool back = d.z < 0.0;
-    p += glassExit(p, d, back, back ? on_back : on_front) * d;
-    on_back = back;
-    on_front = !back;
+  for (int event = 0; event < 8; ++event) {
+    bool back;
+    float t = glassExit(p, d, back);
+    if (t < 0.0 || !inOutline((p + t * d).xy)) {
+      rim = true;
+      break;
+    }
+    p += t * d;
+    if (event >= u_max_events) break;  // absorbed at p
     vec3 nout = normalize(lensTexel(back, p.xy).yzw);
     float c = dot(d, nout);
+    if (c <= 0.0) break;  // met from outside: a path the maps cannot represent
     vec3 out_dir = refract(d, -nout, eta);
-    if (c > 0.0 && out_dir != vec3(0.0)) {
+    if (out_dir != vec3(0.0)) {
       dir = out_dir;
       transmittance *= 1.0 - fresnelDielectric(c, eta, 1.0);
       return p;
@@ -235,22 +268,34 @@ void main() {
 #endif
 #if defined(MODE_IMPOSTOR)
 #if defined(LENS)
+  // In the lens's frame (its origin is the cube's). Seen from behind (the front mesh faces away), the view
+  // ray enters through the back surface, between the eye and this fragment.
+  vec3 x = u_to_local * (v_pos - u_seen_offset), v = u_to_local * view;
+  bool from_back = cos_i <= 0.0;
+  vec3 entry = entryPoint(x, v, from_back);
   vec3 c = vec3(0.0);
-  vec4 seen = vec4(v_pos - u_seen_offset, 1.0);  // a ray that stays in the glass: the surface, dark
-  if (cos_i > 0.0) {
-    vec3 x = u_to_local * (v_pos - u_seen_offset), v = u_to_local * view, nl = u_to_local * n;
-    for (int ch = 0; ch < IMPOSTOR_CHANNELS; ++ch) {
-      int k = IMPOSTOR_CHANNELS == 3 ? ch : 1;
-      vec3 dir;
-      float tr;
-      vec3 q = throughLens(x, v, nl, u_index[k], dir, tr);
-      if (tr <= 0.0) continue;
-      // Back to world axes: the local frame's origin is the cube's.
-      vec3 l = impostorHit(q * u_to_local, dir * u_to_local);
-      vec3 rgb = tr * texture(u_cube, l).rgb;
-      if (IMPOSTOR_CHANNELS == 3) c[ch] = rgb[ch];
-      else c = rgb;
-      if (ch == (IMPOSTOR_CHANNELS == 3 ? u_seen_channel : 0)) seen = texture(u_seen_cube, l);
+  vec4 seen = vec4(entry * u_to_local, 1.0);
+  if (inOutline(entry.xy)) {
+    vec3 n_in = normalize(lensTexel(from_back, entry.xy).yzw);
+    if (dot(v, n_in) < 0.0) {
+      for (int ch = 0; ch < IMPOSTOR_CHANNELS; ++ch) {
+        int k = IMPOSTOR_CHANNELS == 3 ? ch : 1;
+        vec3 dir;
+        float tr;
+        bool rim;
+        vec3 q = throughLens(entry, v, n_in, u_index[k], dir, tr, rim);
+        bool seen_here = ch == (IMPOSTOR_CHANNELS == 3 ? u_seen_channel : 0);
+        if (tr <= 0.0) {  // absorbed, as in the tracer: dark
+          if (seen_here) seen = rim ? vec4((q + u_far * dir) * u_to_local, 0.0) : vec4(q * u_to_local, 1.0);
+          continue;
+        }
+        // Back to world axes: the local frame's origin is the cube's.
+        vec3 l = impostorHit(q * u_to_local, dir * u_to_local);
+        vec3 rgb = tr * texture(u_cube, l).rgb;
+        if (IMPOSTOR_CHANNELS == 3) c[ch] = rgb[ch];
+        else c = rgb;
+        if (seen_here) seen = texture(u_seen_cube, l);
+      }
     }
   }
 #else

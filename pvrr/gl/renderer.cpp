@@ -365,7 +365,9 @@ struct Renderer::Impl {
   // Impostor mode: each lens's refractor height maps (pvrr/lens_height_map.h), built on first use (a lens's
   // shape in its own frame never changes; its pose reaches the shader as u_to_local).
   struct LensMaps {
-    GLuint front = 0, back = 0;
+    GLuint front = 0, back = 0, mask = 0;
+    const cad::SagSurface* front_surface = nullptr;  // what they were built from
+    const cad::SagSurface* back_surface = nullptr;
     LensHeightMap map;
   };
   std::vector<LensMaps> lens_maps;
@@ -426,7 +428,7 @@ struct Renderer::Impl {
 
   ~Impl() {
     for (LensMaps& m : lens_maps)
-      for (GLuint t : {m.front, m.back})
+      for (GLuint t : {m.front, m.back, m.mask})
         if (t) glDeleteTextures(1, &t);
     for (auto& m : env_meshes) m.release();
     for (auto& m : element_meshes) m.release();
@@ -566,15 +568,28 @@ struct Renderer::Impl {
     if (lens_maps.size() < scene.elements.size()) lens_maps.resize(scene.elements.size());
     return lens_maps[e];
   }
-  // Builds and uploads lens e's height maps (RGBA32F: z and the outward normal, linear, clamped); returns 1.
+  // Lens e's maps: whether they are missing or were built from other surfaces.
+  bool lensMapsStale(size_t e) {
+    const LensMaps& m = lensMaps(e);
+    const Element& el = scene.elements[e];
+    return !m.front || m.front_surface != el.lens.front.get() || m.back_surface != el.lens.back.get();
+  }
+  // Builds and uploads lens e's height maps (RGBA32F: z and the outward normal) and its outline mask (R32F),
+  // filtered linearly and clamped to the edge; returns 1.
   int createLensMaps(size_t e) {
     LensMaps& m = lensMaps(e);
-    m.map = buildLensHeightMap(scene.elements[e], options.lens_height_map_size);
-    for (GLuint* t : {&m.front, &m.back}) {
-      glGenTextures(1, t);
+    const Element& el = scene.elements[e];
+    m.map = buildLensHeightMap(el, options.lens_height_map_size);
+    m.front_surface = el.lens.front.get();
+    m.back_surface = el.lens.back.get();
+    for (GLuint* t : {&m.front, &m.back, &m.mask}) {
+      if (!*t) glGenTextures(1, t);
       glBindTexture(GL_TEXTURE_2D, *t);
-      const std::vector<float>& data = t == &m.front ? m.map.front : m.map.back;
-      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, m.map.nx, m.map.ny, 0, GL_RGBA, GL_FLOAT, data.data());
+      if (t == &m.mask)
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_R32F, m.map.nx, m.map.ny, 0, GL_RED, GL_FLOAT, m.map.inside.data());
+      else
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, m.map.nx, m.map.ny, 0, GL_RGBA, GL_FLOAT,
+                     (t == &m.front ? m.map.front : m.map.back).data());
       glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
       glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
       glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
@@ -585,7 +600,8 @@ struct Renderer::Impl {
     return 1;
   }
   // The uniforms of a lens's impostor draw (shaders/element.frag, MODE_IMPOSTOR with LENS): its height maps
-  // on units 2 and 3, their placement, its pose and its index at the R, G and B wavelengths.
+  // and outline mask on units 2 to 4, their placement, its pose, its index at the R, G and B wavelengths, and
+  // the tracer's depth limit and far distance.
   void setLensMaps(const Program& p, size_t e) {
     const LensMaps& m = lensMaps(e);
     const Element& el = scene.elements[e];
@@ -593,9 +609,15 @@ struct Renderer::Impl {
     glBindTexture(GL_TEXTURE_2D, m.front);
     glActiveTexture(GL_TEXTURE3);
     glBindTexture(GL_TEXTURE_2D, m.back);
+    glActiveTexture(GL_TEXTURE4);
+    glBindTexture(GL_TEXTURE_2D, m.mask);
     glActiveTexture(GL_TEXTURE0);
     p.set("u_lens_front", 2);
     p.set("u_lens_back", 3);
+    p.set("u_lens_mask", 4);
+    p.set("u_hm_reach", float(m.map.reach));
+    p.set("u_max_events", scene.render.max_depth - 1);
+    p.set("u_far", float(scene.render.far_distance_m));
     p.set("u_hm", glm::vec4(float(m.map.x0), float(m.map.y0), float(1.0 / (m.map.nx * m.map.dx)),
                             float(1.0 / (m.map.ny * m.map.dy))));
     p.set("u_hm_z", glm::vec2(float(m.map.back_z_min), float(m.map.front_z_max)));
@@ -1466,7 +1488,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
         culled.add(drawEnvironment(glm::lookAt(centre, centre + kCubeDir[face], kCubeUp[face]), proj, centre, false,
                                    nullptr, false, with_seen));
       }
-      if (mode == RasterMode::Impostor && scene.elements[e].type == ElementType::Lens && !lensMaps(e).front)
+      if (mode == RasterMode::Impostor && scene.elements[e].type == ElementType::Lens && lensMapsStale(e))
         height_maps += createLensMaps(e);
     }
     glFinish();

@@ -101,43 +101,83 @@ TEST_P(ImpostorTest, CarMirrorFarBelowTheCubeMap) {
   EXPECT_NE(fp->note.find("distance impostors"), std::string::npos) << fp->note;
 }
 
+// The room seen through a 40 mm lens (n = 1.5, no dispersion) 0.5 m in front of the eye, as in
+// lens_types_test.cpp; `eye` and `target` may put the viewer behind it.
+Scene roomLens(const char* name, cad::SagSurfacePtr front, cad::SagSurfacePtr back, double thickness,
+               const cad::Outline& disc, const Vec3& eye = Vec3(0, 0, 2.5), const Vec3& target = Vec3(0, 0, -3)) {
+  Scene s = test::roomScene(eye, target, 160, 120);
+  s.observer.fov_y_rad = radians(8);
+  Element e;
+  e.name = name;
+  e.type = ElementType::Lens;
+  e.lens = cad::makeLens(front, back, disc, thickness, 0.0, name);
+  e.outline = disc;
+  e.local_to_world = test::pose(Vec3(0, 0, 2.0), Vec3(0, 0, 1));
+  e.world_to_local = glm::inverse(e.local_to_world);
+  e.dispersion = Dispersion::constant(1.5);
+  e.tess_u = e.tess_v = 24;
+  s.elements.push_back(e);
+  s.updateBounds();
+  return s;
+}
+Scene plusLens(const Vec3& eye = Vec3(0, 0, 2.5), const Vec3& target = Vec3(0, 0, -3)) {
+  const cad::Outline disc = cad::Outline::circle(0.04);
+  return roomLens("+10 D", cad::makeSphere(0.1, disc), cad::makeSphere(-0.1, disc), 0.005, disc, eye, target);
+}
+// The plano-convex lens of lens_types_test.cpp: 36 mm across, R = 20 mm at the back, 12 mm thick. Beyond 13.4
+// mm from the axis the rays are totally reflected off the back; beyond ~16.4 mm they leave through the edge.
+Scene planoConvex(int max_depth = 4) {
+  const cad::Outline disc = cad::Outline::circle(0.036);
+  Scene s = roomLens("plano-convex", cad::makePlane(disc), cad::makeSphere(-0.02, disc), 0.012, disc);
+  s.render.max_depth = max_depth;
+  return s;
+}
+TracedFrame reference(const Scene& s) {
+  RayScene rays(s);
+  TraceOptions to;
+  to.max_depth = s.render.max_depth;
+  return Tracer(rays, to).render();
+}
+gl::RasterFrame impostorFrame(const Scene& s) {
+  RayScene rays(s);
+  gl::RendererOptions o;
+  o.map_size = 512;
+  const gl::RasterFrame f = gl::Renderer(s, rays, o).render(gl::RasterMode::Impostor);
+  expectFinite(f);
+  return f;
+}
+// Mean absolute colour difference over the pixels where both see element 0, and the reference's mean colour.
+std::pair<double, double> colourError(const TracedFrame& ref, const gl::RasterFrame& f) {
+  double err = 0, sum = 0;
+  size_t n = 0;
+  for (size_t i = 0; i < ref.color.size(); ++i) {
+    if (ref.element[i] < 0 || f.element[i] < 0) continue;
+    const Vec3 d = glm::abs(f.color[i] - ref.color[i]);
+    err += (d.x + d.y + d.z) / 3;
+    sum += (ref.color[i].x + ref.color[i].y + ref.color[i].z) / 3;
+    ++n;
+  }
+  return {err / double(std::max<size_t>(n, 1)), sum / double(std::max<size_t>(n, 1))};
+}
+
 // Lenses: the spectacle lens (-3 D, the eye chart 4 m away) and the +10 D and -10 D lenses of
 // lens_types_test.cpp (real inverted image, focal region between lens and wall; upright minified image).
-// The glass is traced per fragment in the refractor height maps: measured medians 0.056' (spectacle lens at
-// 320 x 240), far below issue 6's 1' and the cube map's (7.4'), which looks up the exact exit directions of the
-// vertices from the lens centre.
+// Each fragment finds where its view ray meets the front surface in the height map, refracts with the map's
+// normal there and traces the glass in the maps: measured medians 0.0005' (spectacle lens at 160 x 120),
+// 0.0002' (+10 D and -10 D), against issue 6's 1' and the cube map's 7-10' (it looks up the exact exit
+// directions of the vertices from the lens centre). Mean colour error within 2 % of the reference's mean colour
+// (measured 1 % on the eye chart, whose letters the 512^2 cube faces filter; 0.3 % over the room's walls).
 TEST_P(ImpostorTest, LensesRefractedThroughTheirHeightMaps) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
-  struct Case {
-    const char* name;
-    double r_front, r_back, thickness;
-  };
   std::vector<std::pair<std::string, Scene>> scenes;
   scenes.emplace_back("spectacle-lens", test::shippedScene("spectacle-lens", {"observer.image_size=[160,120]"}));
-  for (const Case& c : {Case{"+10 D", 0.1, -0.1, 0.005}, Case{"-10 D", -0.1, 0.1, 0.0015}}) {
-    const Vec3 eye(0, 0, 2.5);
-    Scene s = test::roomScene(eye, Vec3(0, 0, -3), 160, 120);
-    s.observer.fov_y_rad = radians(8);
-    const cad::Outline disc = cad::Outline::circle(0.04);
-    Element e;
-    e.name = c.name;
-    e.type = ElementType::Lens;
-    e.lens = cad::makeLens(cad::makeSphere(c.r_front, disc), cad::makeSphere(c.r_back, disc), disc, c.thickness, 0.0, c.name);
-    e.outline = disc;
-    e.local_to_world = test::pose(Vec3(0, 0, 2.0), Vec3(0, 0, 1));
-    e.world_to_local = glm::inverse(e.local_to_world);
-    e.dispersion = Dispersion::constant(1.5);
-    e.tess_u = e.tess_v = 24;
-    s.elements.push_back(e);
-    s.updateBounds();
-    scenes.emplace_back(c.name, std::move(s));
-  }
+  scenes.emplace_back("+10 D", plusLens());
+  const cad::Outline disc = cad::Outline::circle(0.04);
+  scenes.emplace_back("-10 D", roomLens("-10 D", cad::makeSphere(-0.1, disc), cad::makeSphere(0.1, disc), 0.0015, disc));
   for (auto& [name, s] : scenes) {
+    const TracedFrame ref = reference(s);
     RayScene rays(s);
-    TraceOptions to;
-    to.max_depth = s.render.max_depth;
-    const TracedFrame ref = Tracer(rays, to).render();
     gl::RendererOptions o;
     o.map_size = 512;
     gl::Renderer r(s, rays, o);
@@ -145,16 +185,38 @@ TEST_P(ImpostorTest, LensesRefractedThroughTheirHeightMaps) {
     expectFinite(f);
     const std::vector<double> e = elementErrors(ref, ref.seen, f);
     const double envmap = medianArcmin(ref, r.render(gl::RasterMode::Envmap));
+    const auto [cerr, cmean] = colourError(ref, f);
     std::cout << "[ measured ] " << name << ": impostor median " << quantile(e, 0.5) << "', p95 " << quantile(e, 0.95)
-              << "' over " << e.size() << " px; envmap median " << envmap << "'\n";
+              << "' over " << e.size() << " px; envmap median " << envmap << "'; mean colour error " << cerr << " of "
+              << cmean << "\n";
     ASSERT_GT(e.size(), 2000u) << name;
-    EXPECT_LE(quantile(e, 0.5), 0.2) << name;
-    EXPECT_LE(quantile(e, 0.95), 1.0) << name;
-    EXPECT_GT(envmap, 5 * quantile(e, 0.5)) << name;
+    EXPECT_LE(quantile(e, 0.5), 0.01) << name;
+    EXPECT_LE(quantile(e, 0.95), 0.1) << name;
+    EXPECT_GT(envmap, 100 * quantile(e, 0.5)) << name;
+    EXPECT_LE(cerr, 0.02 * cmean) << name;
     const StageTiming* rf = f.stages.find("refraction");
     ASSERT_TRUE(rf);
     EXPECT_NE(rf->reason.find("refractor height maps"), std::string::npos) << rf->reason;
   }
+}
+
+// The +10 D lens seen from behind: the front mesh faces away, so the fragment finds where its view ray
+// entered through the back surface and refracts there, as the tracer does. The walls seen through it are
+// untextured, so the colour isolates the two Fresnel transmittances (4 % each at normal incidence): measured
+// mean error 4e-5 of the colour.
+TEST_P(ImpostorTest, LensSeenFromBehindEntersThroughItsBack) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  const Scene s = plusLens(Vec3(0.01, 0.005, 1.4), Vec3(0, 0, 3));
+  const TracedFrame ref = reference(s);
+  const gl::RasterFrame f = impostorFrame(s);
+  const std::vector<double> e = elementErrors(ref, ref.seen, f);
+  const auto [cerr, cmean] = colourError(ref, f);
+  std::cout << "[ measured ] +10 D from behind: median " << quantile(e, 0.5) << "', p95 " << quantile(e, 0.95) << "' over "
+            << e.size() << " px; mean colour error " << cerr << " of " << cmean << "\n";
+  ASSERT_GT(e.size(), 2000u);
+  EXPECT_LE(quantile(e, 0.5), 0.01);
+  EXPECT_LE(cerr, 1e-3 * cmean);
 }
 
 // RGB dispersion (the reading lens over a page): each channel is refracted with its own index, so each
@@ -197,60 +259,74 @@ TEST_P(ImpostorTest, EachColourChannelRefractedWithItsOwnIndex) {
   EXPECT_EQ(cc->count, 3);
 }
 
-// Total internal reflection (the plano-convex lens of lens_types_test.cpp, 36 mm across, R = 20 mm, 12 mm
-// thick): beyond 13.4 mm from the axis the rays reflect off the curved back and leave through the plane front
-// towards the wall behind the eye, most after a second reflection off the back's far side. The shader follows
-// them inside the glass as the tracer does: in the ring 14.9 to 16.3 mm, where every ray is reflected, the
-// impostor sees the reference's points (measured: median 0.11', mean colour error 4e-5 of the colour). A
-// search that stopped at the root where a reflected ray leaves the back surface (t = 0) drew the ring dark.
+// Total internal reflection (planoConvex): beyond 13.4 mm from the axis the rays reflect off the curved back
+// and leave through the plane front towards the wall behind the eye, most after a second reflection off the
+// back's far side. The shader follows them inside the glass as the tracer does: in the ring 14.9 to 16.3 mm,
+// where every ray is reflected, the impostor sees the reference's points (measured: median 0.11', p90 0.2',
+// mean colour error 4e-5 of the colour). A search that stopped at the root where a reflected ray leaves the
+// back surface (t = 0) drew the ring dark. Beyond 16.6 mm the light leaves through the edge band, which the
+// tracer's lens does not have: dark in both.
 TEST_P(ImpostorTest, TotalInternalReflectionFollowedInsideTheGlass) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
-  const Vec3 eye(0, 0, 2.5);
-  Scene s = test::roomScene(eye, Vec3(0, 0, -3), 160, 120);
-  s.observer.fov_y_rad = radians(8);
-  const cad::Outline disc = cad::Outline::circle(0.036);
-  Element e;
-  e.name = "plano-convex";
-  e.type = ElementType::Lens;
-  e.lens = cad::makeLens(cad::makePlane(disc), cad::makeSphere(-0.02, disc), disc, 0.012, 0.0, "plano-convex");
-  e.outline = disc;
-  e.local_to_world = test::pose(Vec3(0, 0, 2.0), Vec3(0, 0, 1));
-  e.world_to_local = glm::inverse(e.local_to_world);
-  e.dispersion = Dispersion::constant(1.5);
-  e.tess_u = e.tess_v = 24;
-  s.elements.push_back(e);
-  s.updateBounds();
-  RayScene rays(s);
-  TraceOptions to;
-  to.max_depth = s.render.max_depth;
-  const TracedFrame ref = Tracer(rays, to).render();
-  gl::RendererOptions o;
-  o.map_size = 512;
-  const gl::RasterFrame f = gl::Renderer(s, rays, o).render(gl::RasterMode::Impostor);
-  expectFinite(f);
+  const Scene s = planoConvex();
+  const TracedFrame ref = reference(s);
+  const gl::RasterFrame f = impostorFrame(s);
   const Vec3 axis_point(0, 0, 2.0);
   std::vector<double> angles;
   double err = 0, ref_sum = 0;
-  size_t behind = 0;
+  size_t on_wall = 0, band = 0, band_dark = 0;
   for (size_t i = 0; i < ref.color.size(); ++i) {
     if (ref.element[i] < 0 || f.element[i] < 0) continue;
     const double h = glm::length(Vec2(ref.element_point[i] - axis_point));
+    if (h > 0.0166 && h < 0.0175 && ref.color[i] == Vec3(0.0)) {
+      ++band;
+      band_dark += glm::length(f.color[i]) < 1e-3;
+    }
     if (h < 0.0149 || h > 0.0163) continue;
-    behind += std::abs(ref.seen[i].z - 3.0) < 1e-6;
+    on_wall += std::abs(f.seen[i].z - 3.0) < 1e-3;
     angles.push_back(arcminutes(angleBetween(ref.seen[i] - ref.element_point[i], f.seen[i] - ref.element_point[i])));
     const Vec3 d = glm::abs(f.color[i] - ref.color[i]);
     err += (d.x + d.y + d.z) / 3;
     ref_sum += (ref.color[i].x + ref.color[i].y + ref.color[i].z) / 3;
   }
   std::sort(angles.begin(), angles.end());
-  std::cout << "[ measured ] TIR ring: " << angles.size() << " px (" << behind << " seeing the wall behind the eye), median "
-            << quantile(angles, 0.5) << "', mean colour error " << err / double(angles.size()) << " of "
-            << ref_sum / double(angles.size()) << "\n";
+  std::cout << "[ measured ] TIR ring: " << angles.size() << " px (" << on_wall << " with the impostor's seen point on the "
+            << "wall behind the eye), median " << quantile(angles, 0.5) << "', p90 " << quantile(angles, 0.9)
+            << "', mean colour error " << err / double(angles.size()) << " of " << ref_sum / double(angles.size())
+            << "; edge band " << band_dark << " of " << band << " px dark\n";
   ASSERT_GT(angles.size(), 300u);
-  EXPECT_GT(behind, angles.size() / 2);  // the ring does show the reflected light
-  EXPECT_LE(quantile(angles, 0.5), 1.0);
+  EXPECT_EQ(on_wall, angles.size());
+  EXPECT_LE(quantile(angles, 0.9), 1.0);
   EXPECT_LE(err, 0.01 * ref_sum);
+  ASSERT_GT(band, 50u);
+  EXPECT_GE(band_dark, band * 95 / 100);
+}
+
+// The tracer's depth limit holds inside the glass too: with render.max_depth = 2 it follows one event after
+// the entry, so the rays of the ring, which need two or three, are absorbed where they meet the glass's
+// surface again; the impostor draws them dark with that point as the seen point.
+TEST_P(ImpostorTest, DepthLimitAbsorbsInsideTheGlassAsTheTracerDoes) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  const Scene s = planoConvex(2);
+  const TracedFrame ref = reference(s);
+  const gl::RasterFrame f = impostorFrame(s);
+  const Vec3 axis_point(0, 0, 2.0);
+  size_t ring = 0, both_dark = 0, near = 0;
+  for (size_t i = 0; i < ref.color.size(); ++i) {
+    if (ref.element[i] < 0 || f.element[i] < 0) continue;
+    const double h = glm::length(Vec2(ref.element_point[i] - axis_point));
+    if (h < 0.0149 || h > 0.0163) continue;
+    ++ring;
+    both_dark += ref.color[i] == Vec3(0.0) && glm::length(f.color[i]) < 1e-6;
+    near += glm::length(f.seen[i] - ref.seen[i]) < 1e-4;  // absorbed at the same point of the glass
+  }
+  std::cout << "[ measured ] max_depth 2: " << both_dark << " of " << ring << " ring px dark in both, " << near
+            << " absorbed within 0.1 mm of the reference's point\n";
+  ASSERT_GT(ring, 300u);
+  EXPECT_EQ(both_dark, ring);
+  EXPECT_GE(near, ring * 95 / 100);
 }
 
 PVRR_GL_BACKENDS(ImpostorTest);
