@@ -55,7 +55,15 @@ uniform samplerCube u_seen_cube;
 #elif defined(MODE_IMPOSTOR)
 uniform samplerCube u_cube;       // the environment's colour from the element's origin (the envmap cube)
 uniform samplerCube u_seen_cube;  // its seen points relative to that origin (u_seen_offset): the distances
-#if defined(LENS)
+uniform mat3 u_to_local;          // world directions -> the element's local frame (whose origin is the cube's)
+#if !defined(LENS)
+uniform sampler2D u_surf_p;       // surface maps over the parameter domain (pvrr/surface_map.h), local frame:
+uniform sampler2D u_surf_du;      // position, first derivatives and unit normal
+uniform sampler2D u_surf_dv;
+uniform sampler2D u_surf_n;
+uniform vec4 u_sm;                // texture coordinate = (u, v) * u_sm.xy + u_sm.zw
+uniform vec4 u_uv_box;            // the parameter domain: u0, v0, u1, v1
+#else
 uniform sampler2D u_lens_front;   // refractor height maps (pvrr/lens_height_map.h): z, outward unit normal
 uniform sampler2D u_lens_back;
 uniform sampler2D u_lens_mask;    // 1 inside the outline, 0 outside
@@ -64,7 +72,6 @@ uniform vec2 u_hm_z;              // the back surface's lowest z and the front s
 uniform float u_hm_reach;         // the maps' diagonal: no straight path inside the glass is longer
 uniform int u_max_events;         // the events inside the glass the tracer follows: render.max_depth - 1
 uniform float u_far;              // render.far_distance_m: where a ray absorbed at the rim puts its seen point
-uniform mat3 u_to_local;          // world directions -> the lens's local frame (whose origin is the cube's)
 uniform vec3 u_index;             // the glass's index at the R, G and B wavelengths (.y: the d line)
 uniform int u_seen_channel;       // IMPOSTOR_CHANNELS 3: the channel whose ray gives the seen point
 #endif
@@ -110,7 +117,24 @@ vec3 impostorHit(vec3 x, vec3 R) {
   return dot(l, l) > 0.0 ? l : R;  // x at the cube's origin and d = 0: the direction itself
 }
 
-#if defined(LENS)
+#if !defined(LENS)
+// The parameters of the surface point on the view ray from e with direction v (both local), from the
+// fragment's interpolated parameters: Gauss-Newton steps on the ray's distance from the map's point (the
+// rasterised triangle lies within its sag of the surface, a few steps of its own size away).
+vec2 surfaceHit(vec2 uv, vec3 e, vec3 v) {
+  for (int i = 0; i < 3; ++i) {
+    vec2 st = uv * u_sm.xy + u_sm.zw;
+    vec3 w = texture(u_surf_p, st).xyz - e;
+    vec3 su = texture(u_surf_du, st).xyz, sv = texture(u_surf_dv, st).xyz;
+    vec3 r = w - dot(w, v) * v, a = su - dot(su, v) * v, b = sv - dot(sv, v) * v;
+    float aa = dot(a, a), ab = dot(a, b), bb = dot(b, b), det = aa * bb - ab * ab;
+    if (!(det > 0.0)) break;
+    vec2 g = vec2(dot(a, r), dot(b, r));
+    uv = clamp(uv - vec2(bb * g.x - ab * g.y, aa * g.y - ab * g.x) / det, u_uv_box.xy, u_uv_box.zw);
+  }
+  return uv;
+}
+#else
 // Exact unpolarised dielectric Fresnel reflectance from index n1 into n2 (pvrr/optics.cpp fresnelDielectric).
 float fresnelDielectric(float cos_i, float n1, float n2) {
   float eta = n1 / n2, s2t = eta * eta * (1.0 - cos_i * cos_i);
@@ -249,6 +273,16 @@ void main() {
   vec3 view = normalize(v_pos - u_view_origin);
   float cos_i = -dot(view, n);
   o_surface = vec4(v_pos, u_element_id);
+#if defined(MODE_IMPOSTOR) && !defined(LENS)
+  // The exact surface point on this fragment's view ray (relative to the camera origin) and the exact normal
+  // there, from the surface maps, in place of the triangle's point and the interpolated vertex normals.
+  vec3 e = u_to_local * (u_view_origin - u_seen_offset);
+  vec2 st = surfaceHit(v_st1.xy, e, u_to_local * view) * u_sm.xy + u_sm.zw;
+  vec3 pos = u_seen_offset + texture(u_surf_p, st).xyz * u_to_local;
+  n = normalize(texture(u_surf_n, st).xyz * u_to_local);
+  view = normalize(pos - u_view_origin);
+  cos_i = -dot(view, n);
+#endif
 #if defined(MODE_PLAIN)
   vec3 nf = cos_i < 0.0 ? -n : n;
   o_color = u_dark ? vec4(0.0, 0.0, 0.0, 1.0) : vec4(shadeDiffuse(vec3(0.6), v_pos, nf), 1.0);
@@ -299,7 +333,7 @@ void main() {
     }
   }
 #else
-  vec3 l = impostorHit(v_pos - u_seen_offset, reflect(view, n));
+  vec3 l = impostorHit(pos - u_seen_offset, reflect(view, n));
   vec3 c = texture(u_cube, l).rgb;
   vec4 seen = texture(u_seen_cube, l);
 #endif

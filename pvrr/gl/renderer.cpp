@@ -4,6 +4,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -17,6 +18,7 @@
 #include "pvrr/format.h"
 #include "pvrr/lens_height_map.h"
 #include "pvrr/map_footprint.h"
+#include "pvrr/surface_map.h"
 #include "pvrr/spectrum.h"
 
 namespace pvrr::gl {
@@ -371,6 +373,14 @@ struct Renderer::Impl {
     LensHeightMap map;
   };
   std::vector<LensMaps> lens_maps;
+  // Impostor mode: each mirror's surface maps (pvrr/surface_map.h: position, derivatives, normal over its
+  // parameter domain), built on first use and again if its surface changes.
+  struct MirrorMaps {
+    std::array<GLuint, 4> textures{};  // position, du, dv, normal
+    const cad::Surface* surface = nullptr;
+    SurfaceMap map;
+  };
+  std::vector<MirrorMaps> mirror_maps;
   std::vector<MeshBuffers> element_meshes;     // per (element, patch) in pvrr mode; per element otherwise
   ElementGridCache grid_cache;                 // the elements' tessellations, posed anew each frame
 
@@ -429,6 +439,9 @@ struct Renderer::Impl {
   ~Impl() {
     for (LensMaps& m : lens_maps)
       for (GLuint t : {m.front, m.back, m.mask})
+        if (t) glDeleteTextures(1, &t);
+    for (MirrorMaps& m : mirror_maps)
+      for (GLuint t : m.textures)
         if (t) glDeleteTextures(1, &t);
     for (auto& m : env_meshes) m.release();
     for (auto& m : element_meshes) m.release();
@@ -599,6 +612,45 @@ struct Renderer::Impl {
     checkGlError("uploading a lens's refractor height maps");
     return 1;
   }
+  // Mirror e's surface maps, rebuilt when missing or built from another surface; returns 1 when built.
+  int updateMirrorMaps(size_t e) {
+    if (mirror_maps.size() < scene.elements.size()) mirror_maps.resize(scene.elements.size());
+    MirrorMaps& m = mirror_maps[e];
+    const cad::Surface* surface = scene.elements[e].surface.get();
+    if (m.textures[0] && m.surface == surface) return 0;
+    m.map = buildSurfaceMap(*surface, options.surface_map_size);
+    m.surface = surface;
+    const std::vector<float>* data[4] = {&m.map.position, &m.map.du, &m.map.dv, &m.map.normal};
+    for (size_t k = 0; k < 4; ++k) {
+      if (!m.textures[k]) glGenTextures(1, &m.textures[k]);
+      glBindTexture(GL_TEXTURE_2D, m.textures[k]);
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, m.map.n, m.map.n, 0, GL_RGBA, GL_FLOAT, data[k]->data());
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    }
+    glBindTexture(GL_TEXTURE_2D, 0);
+    checkGlError("uploading a mirror's surface maps");
+    return 1;
+  }
+  // The uniforms of a mirror's impostor draw: its surface maps on units 2 to 5, the map's placement in its
+  // parameter domain, and its pose.
+  void setMirrorMaps(const Program& p, size_t e) {
+    const MirrorMaps& m = mirror_maps.at(e);
+    const char* names[4] = {"u_surf_p", "u_surf_du", "u_surf_dv", "u_surf_n"};
+    for (int k = 0; k < 4; ++k) {
+      glActiveTexture(GLenum(GL_TEXTURE2 + k));
+      glBindTexture(GL_TEXTURE_2D, m.textures[size_t(k)]);
+      p.set(names[k], 2 + k);
+    }
+    glActiveTexture(GL_TEXTURE0);
+    const double n = m.map.n, su = (n - 1) / n / (m.map.u1 - m.map.u0), sv = (n - 1) / n / (m.map.v1 - m.map.v0);
+    p.set("u_sm", glm::vec4(float(su), float(sv), float(0.5 / n - m.map.u0 * su), float(0.5 / n - m.map.v0 * sv)));
+    p.set("u_uv_box", glm::vec4(float(m.map.u0), float(m.map.v0), float(m.map.u1), float(m.map.v1)));
+    p.set("u_to_local", glm::mat3(Mat3(scene.elements[e].world_to_local)));
+  }
+
   // The uniforms of a lens's impostor draw (shaders/element.frag, MODE_IMPOSTOR with LENS): its height maps
   // and outline mask on units 2 to 4, their placement, its pose, its index at the R, G and B wavelengths, and
   // the tracer's depth limit and far distance.
@@ -635,9 +687,10 @@ struct Renderer::Impl {
     p.set("u_metal_k", glm::vec3(el.mirror.k));
   }
 
-  // Whole-element mesh (plain and envmap modes, and elements drawn dark at the depth limit): position
-  // relative to the element's origin, normal; for an envmap lens the exact exit direction of each vertex's
-  // ray in a_st0 and its Fresnel transmittance in a_w0 (the "refraction vectors" baseline).
+  // Whole-element mesh (plain, envmap and impostor modes, and elements drawn dark at the depth limit):
+  // position relative to the element's origin, normal; for an envmap lens the exact exit direction of each
+  // vertex's ray in a_st0 and its Fresnel transmittance in a_w0 (the "refraction vectors" baseline); the
+  // vertex's surface parameters (u, v) in a_st1 (the impostor mirror's start on its surface maps).
   void uploadElementGrid(MeshBuffers& mb, const ElementFrame& f, const Vec3& anchor) {
     std::vector<float> data;
     data.reserve(f.world_pos.size() * kElementFloats);
@@ -646,7 +699,8 @@ struct Renderer::Impl {
       glm::vec3 p(f.world_pos[i] - anchor), n(f.world_normal[i]);
       const glm::vec3 d = has_rays ? glm::vec3(f.rays[0][i].dir) : glm::vec3(0, 0, 1);
       const glm::vec3 tr = has_rays ? glm::vec3(f.rays[0][i].transmittance) : glm::vec3(1);
-      data.insert(data.end(), {p.x, p.y, p.z, n.x, n.y, n.z, d.x, d.y, d.z, 0, 0, 1, 0, 0, 1, tr.x, tr.y, tr.z,
+      const glm::vec2 uv = i < f.grid.params.size() ? glm::vec2(f.grid.params[i]) : glm::vec2(0);
+      data.insert(data.end(), {p.x, p.y, p.z, n.x, n.y, n.z, d.x, d.y, d.z, uv.x, uv.y, 1, 0, 0, 1, tr.x, tr.y, tr.z,
                                0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0});
     }
     std::vector<uint32_t> idx;
@@ -1476,7 +1530,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     const bool with_seen = mode == RasterMode::Impostor;
     const std::vector<GLenum> formats = options.seen_points || with_seen ? std::vector<GLenum>{GL_RGBA16F, GL_RGBA32F}
                                                                          : std::vector<GLenum>{GL_RGBA16F};
-    int height_maps = 0;
+    int height_maps = 0, surface_maps = 0;
     for (size_t e = 0; e < n_el; ++e) {
       CubeTarget& c = *cubes[e];
       if (c.size != options.map_size || c.colors.size() != formats.size()) c.create(options.map_size, formats);
@@ -1490,10 +1544,12 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       }
       if (mode == RasterMode::Impostor && scene.elements[e].type == ElementType::Lens && lensMapsStale(e))
         height_maps += createLensMaps(e);
+      if (mode == RasterMode::Impostor && scene.elements[e].type == ElementType::Mirror) surface_maps += updateMirrorMaps(e);
     }
     glFinish();
     std::string note = mode == RasterMode::Impostor ? "distance impostors: colour and seen-point cube maps" : "";
     if (height_maps > 0) appendNote(note, "refractor height maps of " + std::to_string(height_maps) + " lens(es) built");
+    if (surface_maps > 0) appendNote(note, "surface maps of " + std::to_string(surface_maps) + " mirror(s) built");
     appendNote(note, cullNote(culled));
     out.stages.ran("first-pass", msSince(t0), -1, note);
     out.stages.skipped("nested-passes", "mode " + modeName(mode) + ": other elements are absent from the cube maps");
@@ -1575,6 +1631,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
         p.set("u_seen_cube", 1);
         p.set("u_seen_offset", glm::vec3(anchor - ob.eye));
       }
+      if (mode == RasterMode::Impostor && !lens) setMirrorMaps(p, e);
       if (mode == RasterMode::Impostor && lens) {
         setLensMaps(p, e);
         p.set("u_seen_channel", options.seen_channel < 0 ? 1 : std::min(options.seen_channel, 2));

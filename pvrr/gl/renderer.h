@@ -45,8 +45,10 @@ struct RendererOptions {
   // impostor: the false-position steps of each fragment's search of the distance impostor, after the two
   // first guesses (the search stops early where it has converged to float precision).
   int impostor_iterations = 8;
-  // impostor: the longer side (texels) of a lens's refractor height maps (pvrr/lens_height_map.h), built once.
+  // impostor: the longer side (texels) of a lens's refractor height maps (pvrr/lens_height_map.h), and the
+  // side of a mirror's surface maps (pvrr/surface_map.h); each built once per renderer.
   int lens_height_map_size = 512;
+  int surface_map_size = 512;
   // pvrr: each top-level map's texels per image pixel of its patch (Scene render.map_texels_per_pixel); the
   // map's longer side is lowered from map_size to that (topLevelMapSide). 0: always map_size.
   double map_texels_per_pixel = 4;

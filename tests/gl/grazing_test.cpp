@@ -55,7 +55,7 @@ TEST_P(GrazingTest, MirrorSeenNearlyEdgeOnStaysFiniteAndExact) {
     // Measured 0.95' at 60 deg rising to 2.1' at 86 deg (the pixels' footprints on the mirror stretch as
     // 1 / cos(incidence)); a fit gone wrong is tens of arcmin off.
     EXPECT_LE(err[err.size() / 2], kMedianArcmin) << incidence_deg << " deg";
-    // The impostor mode reflects each fragment's own ray, whatever the angle: finite, and as close.
+    // The impostor mode reflects each fragment's own ray, whatever the angle: finite, and closer.
     const gl::RasterFrame imp = r.render(gl::RasterMode::Impostor);
     std::vector<double> imp_err;
     for (size_t i = 0; i < imp.color.size(); ++i) {
@@ -65,8 +65,9 @@ TEST_P(GrazingTest, MirrorSeenNearlyEdgeOnStaysFiniteAndExact) {
     }
     ASSERT_GT(imp_err.size(), 20u) << incidence_deg << " deg";
     std::sort(imp_err.begin(), imp_err.end());
+    // Measured 0.0005' at 60 deg to 0.003' at 88 deg: the exact surface point and normal of each fragment.
     std::cout << "[ measured ] impostor at " << incidence_deg << " deg: median " << imp_err[imp_err.size() / 2] << "'\n";
-    EXPECT_LE(imp_err[imp_err.size() / 2], kMedianArcmin) << incidence_deg << " deg";
+    EXPECT_LE(imp_err[imp_err.size() / 2], 0.05) << incidence_deg << " deg";
   }
 }
 

@@ -1,0 +1,59 @@
+#include "pvrr/surface_map.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+#include <tbb/parallel_for.h>
+
+#include "cad/error.h"
+
+namespace pvrr {
+
+SurfaceMap buildSurfaceMap(const cad::Surface& surface, int n) {
+  if (n < 2 || n > 4096) throw Error("buildSurfaceMap: map size " + std::to_string(n) + ", expected 2 to 4096");
+  const cad::ParamDomain d = surface.domain();
+  SurfaceMap m;
+  m.n = n;
+  m.u0 = d.u0, m.v0 = d.v0, m.u1 = d.u1, m.v1 = d.v1;
+  const size_t samples = size_t(n) * size_t(n);
+  for (auto* a : {&m.position, &m.du, &m.dv, &m.normal}) a->assign(4 * samples, 0.0f);
+  std::atomic<bool> finite{true};
+  tbb::parallel_for(0, n, [&](int j) {
+    const double v = j == n - 1 ? d.v1 : d.v0 + (d.v1 - d.v0) * double(j) / double(n - 1);
+    for (int i = 0; i < n; ++i) {
+      const double u = i == n - 1 ? d.u1 : d.u0 + (d.u1 - d.u0) * double(i) / double(n - 1);
+      const cad::SurfaceDerivs s = surface.evaluate(u, v);
+      const Vec3 nrm = surface.normal(u, v);
+      if (!isFinite(s.p) || !isFinite(s.du) || !isFinite(s.dv) || !isFinite(nrm)) finite = false;
+      const size_t k = 4 * (size_t(j) * size_t(n) + size_t(i));
+      for (int c = 0; c < 3; ++c) {
+        m.position[k + size_t(c)] = float(s.p[c]);
+        m.du[k + size_t(c)] = float(s.du[c]);
+        m.dv[k + size_t(c)] = float(s.dv[c]);
+        m.normal[k + size_t(c)] = float(nrm[c]);
+      }
+    }
+  });
+  if (!finite) throw Error("buildSurfaceMap: the surface evaluates to a non-finite point or normal in its domain");
+  return m;
+}
+
+SurfaceMapSample sampleSurfaceMap(const SurfaceMap& m, double u, double v) {
+  // Sample coordinates: the samples sit at texel centres.
+  const double x = std::clamp((u - m.u0) / (m.u1 - m.u0), 0.0, 1.0) * (m.n - 1);
+  const double y = std::clamp((v - m.v0) / (m.v1 - m.v0), 0.0, 1.0) * (m.n - 1);
+  const int i = std::min(int(x), m.n - 2), j = std::min(int(y), m.n - 2);
+  const double a = x - i, b = y - j;
+  auto at = [&](const std::vector<float>& data, int ii, int jj) {
+    const size_t k = 4 * (size_t(jj) * size_t(m.n) + size_t(ii));
+    return Vec3(data[k], data[k + 1], data[k + 2]);
+  };
+  auto lerp = [&](const std::vector<float>& data) {
+    return (1 - a) * (1 - b) * at(data, i, j) + a * (1 - b) * at(data, i + 1, j) + (1 - a) * b * at(data, i, j + 1) +
+           a * b * at(data, i + 1, j + 1);
+  };
+  return {lerp(m.position), lerp(m.du), lerp(m.dv), glm::normalize(lerp(m.normal))};
+}
+
+}  // namespace pvrr

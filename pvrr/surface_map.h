@@ -1,0 +1,37 @@
+// Surface maps of a mirror for the distance-impostor mode (`--mode impostor`): its exact surface sampled over
+// its parameter domain, so that each fragment reflects at the exact surface point its view ray meets, with the
+// exact normal there, instead of at the rasterised triangle's point with the interpolated vertex normals
+// (whose error falls only quadratically with the vertex spacing: the saddle mirror's impostor median was
+// 1.74' at 15 x 15 vertices, 0.19' at 45 x 45).
+//
+// Sample (i, j) of an n x n map is the surface at u = u0 + i (u1 - u0) / (n - 1), v = v0 + j (v1 - v0) / (n - 1)
+// (the domain's corners are samples): position, the two first derivatives and the exact unit normal (oriented
+// as cad's surface normal), in the element's local frame, metres. Texture coordinate of parameter u:
+// s = (u - u0) / (u1 - u0) (n - 1) / n + 0.5 / n, so that GL_LINEAR interpolates between the samples.
+// The fragment shader (shaders/element.frag, MODE_IMPOSTOR) starts from the fragment's interpolated (u, v)
+// and takes Gauss-Newton steps on the distance of the map's point from its view ray.
+#pragma once
+#include <vector>
+
+#include "cad/surface.h"
+
+namespace pvrr {
+
+struct SurfaceMap {
+  int n = 0;
+  double u0 = 0, v0 = 0, u1 = 1, v1 = 1;
+  // Per sample, rows of increasing v: xyz and a zero (4 floats each).
+  std::vector<float> position, du, dv, normal;
+};
+
+// Throws pvrr::Error for n outside [2, 4096] or a surface whose evaluation is not finite somewhere.
+SurfaceMap buildSurfaceMap(const cad::Surface& surface, int n);
+
+// The map's bilinear sample at parameter (u, v), as GL_LINEAR with clamp-to-edge computes it in exact
+// arithmetic: position (w = 0) and the normal (normalised): for tests.
+struct SurfaceMapSample {
+  Vec3 position, du, dv, normal;
+};
+SurfaceMapSample sampleSurfaceMap(const SurfaceMap& map, double u, double v);
+
+}  // namespace pvrr
