@@ -154,15 +154,19 @@ vec2 insideHeights(vec3 q) { return vec2(q.z - lensTexel(true, q.xy).x, lensTexe
 
 // The ray p + t d, leaving a point p of the glass's surface into the glass: where it meets a surface again,
 // and which (back or front, the nearer crossing, as the tracer takes the nearer of its two surfaces). It steps
-// out from 1 um, doubling, to where it leaves the slab between the surfaces' extreme heights or the maps'
-// reach; then false position with the Illinois halving on the crossed surface's filtered height, between the
-// last step inside and the first outside (so the root at p itself is never taken). -1: no crossing.
+// out, doubling, to where it leaves the slab between the surfaces' extreme heights or the maps' reach; then
+// false position with the Illinois halving on the crossed surface's filtered height, between the last step
+// inside and the first outside (so the root at p itself is never taken). The first step covers half the
+// height of the surface ahead (in d.z's direction) above or below p, or 1 um when p lies on that surface
+// (after a reflection off it). -1: no crossing.
 float glassExit(vec3 p, vec3 d, out bool back) {
   float t_max = u_hm_reach;
   if (d.z < 0.0) t_max = min(t_max, (u_hm_z.x - p.z) / d.z);
   if (d.z > 0.0) t_max = min(t_max, (u_hm_z.y - p.z) / d.z);
   t_max = max(t_max, 1e-6);
-  float t0 = 0.0, t1 = -1.0, t = 1e-6;
+  vec2 h0 = insideHeights(p);
+  float ahead = d.z < 0.0 ? h0.x : h0.y;
+  float t0 = 0.0, t1 = -1.0, t = min(max(1e-6, 0.5 * ahead / max(abs(d.z), 1e-3)), t_max);
   vec2 h1 = vec2(0.0);
   for (int k = 0; k < 32; ++k) {
     vec2 h = insideHeights(p + t * d);
@@ -176,7 +180,8 @@ float glassExit(vec3 p, vec3 d, out bool back) {
   }
   back = h1.x <= h1.y;
   if (t1 < 0.0) return -1.0;
-  float g0 = t0 > 0.0 ? (back ? insideHeights(p + t0 * d).x : insideHeights(p + t0 * d).y) : 0.0;
+  if (t0 > 0.0) h0 = insideHeights(p + t0 * d);
+  float g0 = back ? h0.x : h0.y;
   float g1 = back ? h1.x : h1.y;
   g0 = max(g0, 0.0);
   if (g0 - g1 <= 0.0) return t1;

@@ -70,6 +70,11 @@ void BM_RasterFrame(benchmark::State& state, const char* scene, gl::RasterMode m
 BENCHMARK_CAPTURE(BM_RasterFrame, car_mirror_pvrr, "car-mirror", gl::RasterMode::Pvrr)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_RasterFrame, car_mirror_envmap, "car-mirror", gl::RasterMode::Envmap)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_RasterFrame, car_mirror_raster, "car-mirror", gl::RasterMode::Raster)->Unit(benchmark::kMillisecond)->UseRealTime();
+// The distance-impostor glass mode: six cube faces at the scene's map size, then per-fragment searches (a
+// spectacle lens fills the image).
+BENCHMARK_CAPTURE(BM_RasterFrame, car_mirror_impostor, "car-mirror", gl::RasterMode::Impostor)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_RasterFrame, spectacle_lens_impostor, "spectacle-lens", gl::RasterMode::Impostor)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_RasterFrame, spectacle_lens_pvrr, "spectacle-lens", gl::RasterMode::Pvrr)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 
