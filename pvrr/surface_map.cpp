@@ -10,7 +10,7 @@
 
 namespace pvrr {
 
-SurfaceMap buildSurfaceMap(const cad::Surface& surface, int n) {
+SurfaceMap buildSurfaceMap(const cad::Surface& surface, int n, const cad::Outline* outline) {
   if (n < 2 || n > 4096) throw Error("buildSurfaceMap: map size " + std::to_string(n) + ", expected 2 to 4096");
   const cad::ParamDomain d = surface.domain();
   SurfaceMap m;
@@ -18,14 +18,34 @@ SurfaceMap buildSurfaceMap(const cad::Surface& surface, int n) {
   m.u0 = d.u0, m.v0 = d.v0, m.u1 = d.u1, m.v1 = d.v1;
   const size_t samples = size_t(n) * size_t(n);
   for (auto* a : {&m.position, &m.du, &m.dv, &m.normal}) a->assign(4 * samples, 0.0f);
-  std::atomic<bool> finite{true};
+  const Vec2 centre(0.5 * (d.u0 + d.u1), 0.5 * (d.v0 + d.v1));
+  std::atomic<bool> failed{false};
+  std::atomic<int> moved{0};
   tbb::parallel_for(0, n, [&](int j) {
     const double v = j == n - 1 ? d.v1 : d.v0 + (d.v1 - d.v0) * double(j) / double(n - 1);
     for (int i = 0; i < n; ++i) {
       const double u = i == n - 1 ? d.u1 : d.u0 + (d.u1 - d.u0) * double(i) / double(n - 1);
-      const cad::SurfaceDerivs s = surface.evaluate(u, v);
-      const Vec3 nrm = surface.normal(u, v);
-      if (!isFinite(s.p) || !isFinite(s.du) || !isFinite(s.dv) || !isFinite(nrm)) finite = false;
+      Vec2 q(u, v);
+      cad::SurfaceDerivs s{};
+      Vec3 nrm(0.0);
+      bool ok = false;
+      for (int k = 0; k < 60 && !ok; ++k) {
+        if (k > 0) q = centre + 0.9 * (q - centre);
+        try {
+          s = surface.evaluate(q.x, q.y);
+          nrm = surface.normal(q.x, q.y);
+          ok = isFinite(s.p) && isFinite(s.du) && isFinite(s.dv) && isFinite(nrm) && glm::length(nrm) > 0.5;
+        } catch (const Error&) {
+          ok = false;
+        }
+      }
+      if (!ok) {
+        failed = true;
+        continue;
+      }
+      const bool moved_here = q != Vec2(u, v);
+      moved += moved_here;
+      const bool inside = !moved_here && (!outline || outline->contains(Vec2(u, v)));
       const size_t k = 4 * (size_t(j) * size_t(n) + size_t(i));
       for (int c = 0; c < 3; ++c) {
         m.position[k + size_t(c)] = float(s.p[c]);
@@ -33,9 +53,13 @@ SurfaceMap buildSurfaceMap(const cad::Surface& surface, int n) {
         m.dv[k + size_t(c)] = float(s.dv[c]);
         m.normal[k + size_t(c)] = float(nrm[c]);
       }
+      m.position[k + 3] = inside ? 1.0f : 0.0f;
     }
   });
-  if (!finite) throw Error("buildSurfaceMap: the surface evaluates to a non-finite point or normal in its domain");
+  if (failed)
+    throw Error("buildSurfaceMap: a sample of the surface's parameter domain has no evaluable point with a normal "
+                "between it and the domain's centre");
+  m.moved_samples = moved;
   return m;
 }
 
@@ -53,7 +77,10 @@ SurfaceMapSample sampleSurfaceMap(const SurfaceMap& m, double u, double v) {
     return (1 - a) * (1 - b) * at(data, i, j) + a * (1 - b) * at(data, i + 1, j) + (1 - a) * b * at(data, i, j + 1) +
            a * b * at(data, i + 1, j + 1);
   };
-  return {lerp(m.position), lerp(m.du), lerp(m.dv), glm::normalize(lerp(m.normal))};
+  const size_t k0 = 4 * (size_t(j) * size_t(m.n) + size_t(i)) + 3, k1 = k0 + 4, k2 = k0 + 4 * size_t(m.n), k3 = k2 + 4;
+  const double inside = (1 - a) * (1 - b) * m.position[k0] + a * (1 - b) * m.position[k1] +
+                        (1 - a) * b * m.position[k2] + a * b * m.position[k3];
+  return {lerp(m.position), lerp(m.du), lerp(m.dv), glm::normalize(lerp(m.normal)), inside};
 }
 
 }  // namespace pvrr

@@ -82,6 +82,18 @@ uniform bool u_dark;
 #include "shading.glsl"
 
 #if defined(MODE_IMPOSTOR)
+// GL_LINEAR with clamp-to-edge, computed with float weights from four texelFetch: a GPU's filter weights have
+// about 8 fractional bits, which would quantise the surfaces' heights and normals between samples to 1/256 of
+// their difference (~4e-6 rad of normal on the concave mirror's map). No mipmaps, so fetching inside the
+// searches' loops, whose exits differ between neighbouring fragments, is well defined.
+vec4 bilinear(sampler2D t, vec2 st) {
+  ivec2 size = textureSize(t, 0);
+  vec2 x = st * vec2(size) - 0.5, f = floor(x), a = x - f;
+  ivec2 i0 = clamp(ivec2(f), ivec2(0), size - 1), i1 = clamp(ivec2(f) + 1, ivec2(0), size - 1);
+  return mix(mix(texelFetch(t, i0, 0), texelFetch(t, ivec2(i1.x, i0.y), 0), a.x),
+             mix(texelFetch(t, ivec2(i0.x, i1.y), 0), texelFetch(t, i1, 0), a.x), a.y);
+}
+
 // The distance from the cube's origin to what it sees in direction dir (the sky's seen point lies u_far along
 // its ray: a sure overshoot for every nearer point).
 float envDistance(vec3 dir) { return length(texture(u_seen_cube, dir).xyz); }
@@ -124,8 +136,8 @@ vec3 impostorHit(vec3 x, vec3 R) {
 vec2 surfaceHit(vec2 uv, vec3 e, vec3 v) {
   for (int i = 0; i < 3; ++i) {
     vec2 st = uv * u_sm.xy + u_sm.zw;
-    vec3 w = texture(u_surf_p, st).xyz - e;
-    vec3 su = texture(u_surf_du, st).xyz, sv = texture(u_surf_dv, st).xyz;
+    vec3 w = bilinear(u_surf_p, st).xyz - e;
+    vec3 su = bilinear(u_surf_du, st).xyz, sv = bilinear(u_surf_dv, st).xyz;
     vec3 r = w - dot(w, v) * v, a = su - dot(su, v) * v, b = sv - dot(sv, v) * v;
     float aa = dot(a, a), ab = dot(a, b), bb = dot(b, b), det = aa * bb - ab * ab;
     if (!(det > 0.0)) break;
@@ -146,9 +158,9 @@ float fresnelDielectric(float cos_i, float n1, float n2) {
 }
 vec4 lensTexel(bool back, vec2 xy) {
   vec2 st = (xy - u_hm.xy) * u_hm.zw;
-  return back ? texture(u_lens_back, st) : texture(u_lens_front, st);
+  return back ? bilinear(u_lens_back, st) : bilinear(u_lens_front, st);
 }
-bool inOutline(vec2 xy) { return texture(u_lens_mask, (xy - u_hm.xy) * u_hm.zw).r >= 0.5; }
+bool inOutline(vec2 xy) { return bilinear(u_lens_mask, (xy - u_hm.xy) * u_hm.zw).r >= 0.5; }
 // The heights of q above the back surface and below the front one: both positive inside the glass.
 vec2 insideHeights(vec3 q) { return vec2(q.z - lensTexel(true, q.xy).x, lensTexel(false, q.xy).x - q.z); }
 
@@ -182,6 +194,19 @@ float glassExit(vec3 p, vec3 d, out bool back) {
   if (t1 < 0.0) return -1.0;
   if (t0 > 0.0) h0 = insideHeights(p + t0 * d);
   float g0 = back ? h0.x : h0.y;
+  // Outside already at the first step, from a point on the crossed surface itself (g0 ~ 0: a reflection off
+  // it at a grazing angle): halve the step until the ray is inside, so that false position does not return
+  // the root at p.
+  for (int k = 0; k < 16 && t0 == 0.0 && !(g0 > 1e-12); ++k) {
+    float th = 0.5 * t1;
+    vec2 hh = insideHeights(p + th * d);
+    if (min(hh.x, hh.y) > 0.0) {
+      t0 = th, g0 = back ? hh.x : hh.y;
+    } else {
+      t1 = th, h1 = hh;
+      back = h1.x <= h1.y;
+    }
+  }
   float g1 = back ? h1.x : h1.y;
   g0 = max(g0, 0.0);
   if (g0 - g1 <= 0.0) return t1;
@@ -190,7 +215,7 @@ float glassExit(vec3 p, vec3 d, out bool back) {
     t = (t0 * g1 - t1 * g0) / (g1 - g0);
     vec2 hh = insideHeights(p + t * d);
     float g = back ? hh.x : hh.y;
-    if (abs(g) < 1e-9) break;  // a nanometre
+    if (abs(g) < 1e-9) break;  // a nanometre (float heights resolve ~1e-9 m at lens scale)
     if (g > 0.0) {
       t0 = t, g0 = g;
       if (side == 1) g1 *= 0.5;
@@ -224,7 +249,8 @@ vec3 entryPoint(vec3 x, vec3 v, bool back) {
 
 // One wavelength's path through the lens (local frame) from the entry point x, where the view direction v
 // meets the surface with outward normal n. It refracts in, then follows the events inside the glass as the
-// tracer does up to its depth limit (u_max_events, at most 8): each is an exit (refraction, exact Fresnel)
+// tracer does up to its depth limit (u_max_events; render.max_depth is at most 64): each is an exit
+// (refraction, exact Fresnel)
 // or a total internal reflection. Returns the exit point and sets the exit direction and the transmittance;
 // transmittance 0: absorbed, at the returned point (the depth limit) or, with `rim`, where the ray left the
 // outline (the tracer's lens has no rim surface: its seen point lies u_far along `dir`, the ray inside).
@@ -234,7 +260,7 @@ vec3 throughLens(vec3 x, vec3 v, vec3 n, float eta, out vec3 dir, out float tran
   transmittance = 1.0 - fresnelDielectric(cos_i, 1.0, eta);
   rim = false;
   vec3 p = x;
-  for (int event = 0; event < 8; ++event) {
+  for (int event = 0; event < 64; ++event) {
     bool back;
     float t = glassExit(p, d, back);
     if (t < 0.0 || !inOutline((p + t * d).xy)) {
@@ -281,10 +307,16 @@ void main() {
 #if defined(MODE_IMPOSTOR) && !defined(LENS)
   // The exact surface point on this fragment's view ray (relative to the camera origin) and the exact normal
   // there, from the surface maps, in place of the triangle's point and the interpolated vertex normals.
-  vec3 e = u_to_local * (u_view_origin - u_seen_offset);
-  vec2 st = surfaceHit(v_st1.xy, e, u_to_local * view) * u_sm.xy + u_sm.zw;
-  vec3 pos = u_seen_offset + texture(u_surf_p, st).xyz * u_to_local;
-  n = normalize(texture(u_surf_n, st).xyz * u_to_local);
+  // A view ray that misses the surface within its outline (at the silhouette, where the triangles reach past
+  // the surface, or past the trimmed outline) sees past the mirror, as in the tracer: the fragment is dropped
+  // and the environment drawn after the elements fills the pixel.
+  vec3 e = u_to_local * (u_view_origin - u_seen_offset), vl = u_to_local * view;
+  vec2 st = surfaceHit(v_st1.xy, e, vl) * u_sm.xy + u_sm.zw;
+  vec4 sp = bilinear(u_surf_p, st);  // w: 1 inside the outline
+  vec3 w = sp.xyz - e;
+  if (sp.w < 0.5 || length(w - dot(w, vl) * vl) > 1e-5 * length(w)) discard;
+  vec3 pos = u_seen_offset + sp.xyz * u_to_local;
+  n = normalize(bilinear(u_surf_n, st).xyz * u_to_local);
   view = normalize(pos - u_view_origin);
   cos_i = -dot(view, n);
 #endif

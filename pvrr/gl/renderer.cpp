@@ -368,17 +368,16 @@ struct Renderer::Impl {
   // shape in its own frame never changes; its pose reaches the shader as u_to_local).
   struct LensMaps {
     GLuint front = 0, back = 0, mask = 0;
-    const cad::SagSurface* front_surface = nullptr;  // what they were built from
-    const cad::SagSurface* back_surface = nullptr;
+    cad::SagSurfacePtr front_surface, back_surface;  // what they were built from (held: never a reused address)
     LensHeightMap map;
   };
   std::vector<LensMaps> lens_maps;
   // Impostor mode: each mirror's surface maps (pvrr/surface_map.h: position, derivatives, normal over its
   // parameter domain), built on first use and again if its surface changes.
   struct MirrorMaps {
-    std::array<GLuint, 4> textures{};  // position, du, dv, normal
-    const cad::Surface* surface = nullptr;
-    SurfaceMap map;
+    std::array<GLuint, 4> textures{};  // position (RGBA32F, w: outline mask), du, dv (RGBA16F), normal (RGBA32F)
+    cad::SurfacePtr surface;           // what they were built from (held: never a reused address)
+    SurfaceMap map;                    // its domain and size; the samples are dropped once uploaded
   };
   std::vector<MirrorMaps> mirror_maps;
   std::vector<MeshBuffers> element_meshes;     // per (element, patch) in pvrr mode; per element otherwise
@@ -585,7 +584,7 @@ struct Renderer::Impl {
   bool lensMapsStale(size_t e) {
     const LensMaps& m = lensMaps(e);
     const Element& el = scene.elements[e];
-    return !m.front || m.front_surface != el.lens.front.get() || m.back_surface != el.lens.back.get();
+    return !m.front || m.front_surface != el.lens.front || m.back_surface != el.lens.back;
   }
   // Builds and uploads lens e's height maps (RGBA32F: z and the outward normal) and its outline mask (R32F),
   // filtered linearly and clamped to the edge; returns 1.
@@ -593,8 +592,8 @@ struct Renderer::Impl {
     LensMaps& m = lensMaps(e);
     const Element& el = scene.elements[e];
     m.map = buildLensHeightMap(el, options.lens_height_map_size);
-    m.front_surface = el.lens.front.get();
-    m.back_surface = el.lens.back.get();
+    m.front_surface = el.lens.front;
+    m.back_surface = el.lens.back;
     for (GLuint* t : {&m.front, &m.back, &m.mask}) {
       if (!*t) glGenTextures(1, t);
       glBindTexture(GL_TEXTURE_2D, *t);
@@ -616,15 +615,17 @@ struct Renderer::Impl {
   int updateMirrorMaps(size_t e) {
     if (mirror_maps.size() < scene.elements.size()) mirror_maps.resize(scene.elements.size());
     MirrorMaps& m = mirror_maps[e];
-    const cad::Surface* surface = scene.elements[e].surface.get();
-    if (m.textures[0] && m.surface == surface) return 0;
-    m.map = buildSurfaceMap(*surface, options.surface_map_size);
-    m.surface = surface;
+    const Element& el = scene.elements[e];
+    if (m.textures[0] && m.surface == el.surface) return 0;
+    m.map = buildSurfaceMap(*el.surface, options.surface_map_size, el.has_outline ? &el.outline : nullptr);
+    m.surface = el.surface;
+    // The derivatives only steer the shader's Gauss-Newton steps: half floats do.
     const std::vector<float>* data[4] = {&m.map.position, &m.map.du, &m.map.dv, &m.map.normal};
+    const GLint formats[4] = {GL_RGBA32F, GL_RGBA16F, GL_RGBA16F, GL_RGBA32F};
     for (size_t k = 0; k < 4; ++k) {
       if (!m.textures[k]) glGenTextures(1, &m.textures[k]);
       glBindTexture(GL_TEXTURE_2D, m.textures[k]);
-      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, m.map.n, m.map.n, 0, GL_RGBA, GL_FLOAT, data[k]->data());
+      glTexImage2D(GL_TEXTURE_2D, 0, formats[k], m.map.n, m.map.n, 0, GL_RGBA, GL_FLOAT, data[k]->data());
       glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
       glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
       glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
@@ -632,6 +633,7 @@ struct Renderer::Impl {
     }
     glBindTexture(GL_TEXTURE_2D, 0);
     checkGlError("uploading a mirror's surface maps");
+    for (auto* a : {&m.map.position, &m.map.du, &m.map.dv, &m.map.normal}) std::vector<float>().swap(*a);
     return 1;
   }
   // The uniforms of a mirror's impostor draw: its surface maps on units 2 to 5, the map's placement in its

@@ -45,6 +45,20 @@ void expectFinite(const gl::RasterFrame& f) {
   }
 }
 
+// Mean absolute colour difference over the pixels where both see element 0, and the reference's mean colour.
+std::pair<double, double> colourError(const TracedFrame& ref, const gl::RasterFrame& f) {
+  double err = 0, sum = 0;
+  size_t n = 0;
+  for (size_t i = 0; i < ref.color.size(); ++i) {
+    if (ref.element[i] < 0 || f.element[i] < 0) continue;
+    const Vec3 d = glm::abs(f.color[i] - ref.color[i]);
+    err += (d.x + d.y + d.z) / 3;
+    sum += (ref.color[i].x + ref.color[i].y + ref.color[i].z) / 3;
+    ++n;
+  }
+  return {err / double(std::max<size_t>(n, 1)), sum / double(std::max<size_t>(n, 1))};
+}
+
 class ImpostorTest : public ::testing::TestWithParam<gl::GlBackend> {};
 
 // A plane mirror in the room of planar walls (tests/support/test_scenes.h), the box inside it casting the
@@ -56,6 +70,11 @@ TEST_P(ImpostorTest, PlaneMirrorInAPlanarRoomSeesWhatTheTracerSees) {
   Scene s = test::roomScene(Vec3(0.4, 0.3, 1.5), Vec3(0, 0, 0), 160, 120);
   const cad::Outline outline = cad::Outline::rectangle(0.6, 0.45, 0.03);
   test::addMirror(s, cad::makePlane(outline), outline, test::pose(Vec3(0, 0, -0.4), Vec3(0.1, 0, 1)), 7, 0.9);
+  // A conductor (aluminium-like n + i k per channel): its Fresnel reflectance at each fragment's angle, with
+  // the normal from the surface maps, against the tracer's at the exact hit.
+  s.elements[0].mirror.metal = true;
+  s.elements[0].mirror.n = Vec3(1.35, 0.96, 0.62);
+  s.elements[0].mirror.k = Vec3(7.5, 6.7, 5.3);
   s.updateBounds();
   RayScene rays(s);
   const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
@@ -73,6 +92,10 @@ TEST_P(ImpostorTest, PlaneMirrorInAPlanarRoomSeesWhatTheTracerSees) {
             << envmap << "'\n";
   EXPECT_GE(within, 0.95);
   EXPECT_GT(envmap, 100 * quantile(e, 0.5));
+  // The walls are untextured and smoothly lit: the colour isolates the metal's Fresnel (measured below).
+  const auto [cerr, cmean] = colourError(ref, f);
+  std::cout << "[ measured ] plane metal mirror: mean colour error " << cerr << " of " << cmean << "\n";
+  EXPECT_LE(cerr, 2e-3 * cmean);
 }
 
 // The default scene: the street is piecewise planar but full of occlusion (the car's own door close to the
@@ -88,9 +111,27 @@ TEST_P(ImpostorTest, CarMirrorFarBelowTheCubeMap) {
   const gl::RasterFrame f = r.render(gl::RasterMode::Impostor);
   expectFinite(f);
   const double impostor = medianArcmin(ref, f), envmap = medianArcmin(ref, r.render(gl::RasterMode::Envmap));
-  std::cout << "[ measured ] car mirror: impostor median " << impostor << "', envmap " << envmap << "'\n";
+  // The colour where the impostor sees the reference's point (under 0.1'): both raster modes sample the
+  // street's minified textures where the one-ray reference samples them elsewhere (measured 8.0 % of the
+  // colour for the impostor, 9.7 % for pvrr on the same pixels); the impostor is no worse than pvrr.
+  const gl::RasterFrame pf = r.render(gl::RasterMode::Pvrr);
+  double cerr = 0, perr = 0, csum = 0;
+  size_t agree = 0;
+  for (size_t i = 0; i < ref.color.size(); ++i) {
+    if (ref.element[i] != 0 || f.element[i] != 0 || pf.element[i] != 0) continue;
+    if (arcminutes(angleBetween(ref.seen[i] - ref.element_point[i], f.seen[i] - ref.element_point[i])) > 0.1) continue;
+    ++agree;
+    const Vec3 d = glm::abs(f.color[i] - ref.color[i]), dp = glm::abs(pf.color[i] - ref.color[i]);
+    cerr += (d.x + d.y + d.z) / 3;
+    perr += (dp.x + dp.y + dp.z) / 3;
+    csum += (ref.color[i].x + ref.color[i].y + ref.color[i].z) / 3;
+  }
+  std::cout << "[ measured ] car mirror: impostor median " << impostor << "', envmap " << envmap << "'; colour error "
+            << cerr / csum << " of the colour over " << agree << " px (pvrr " << perr / csum << ")\n";
   EXPECT_LE(impostor, 0.03);
   EXPECT_GE(envmap, 100 * impostor);
+  ASSERT_GT(agree, 3000u);
+  EXPECT_LE(cerr, 1.1 * perr);
   // What ran: no CPU stage, the cube maps with their distances, the search in the second pass.
   const StageTiming* vr = f.stages.find("vertex-rays");
   const StageTiming* fp = f.stages.find("first-pass");
@@ -99,6 +140,35 @@ TEST_P(ImpostorTest, CarMirrorFarBelowTheCubeMap) {
   EXPECT_NE(vr->reason.find("each fragment"), std::string::npos) << vr->reason;
   EXPECT_TRUE(fp->ran);
   EXPECT_NE(fp->note.find("distance impostors"), std::string::npos) << fp->note;
+}
+
+// Each fragment reflects at the exact surface point on its view ray, with the exact normal, from the mirror's
+// surface maps: the error does not grow as the mesh coarsens. The saddle mirror (a subdivision surface) with
+// 5 x 5 and 15 x 15 vertices: measured medians 0.0026' at both at 160 x 120 (the interpolated vertex normals
+// gave 1.65' at 15 x 15 and 31.6' at 5 x 5); pvrr's own error there is 2.3'.
+TEST_P(ImpostorTest, MirrorAccuracyDoesNotDependOnTheMesh) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  std::vector<double> medians;
+  for (const int tess : {5, 15}) {
+    Scene s = test::shippedScene("saddle-mirror", {"observer.image_size=[160,120]",
+                                                   "elements[0].tessellation=" + std::to_string(tess)});
+    RayScene rays(s);
+    const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
+    gl::RendererOptions o;
+    o.map_size = 512;
+    const gl::RasterFrame f = gl::Renderer(s, rays, o).render(gl::RasterMode::Impostor);
+    expectFinite(f);
+    const std::vector<double> e = elementErrors(ref, ref.seen, f);
+    std::cout << "[ measured ] saddle at " << tess << " x " << tess << ": median " << quantile(e, 0.5) << "', p95 "
+              << quantile(e, 0.95) << "' over " << e.size() << " px\n";
+    ASSERT_GT(e.size(), 1000u);
+    EXPECT_LE(quantile(e, 0.5), 0.02) << tess;
+    EXPECT_LE(quantile(e, 0.95), 0.1) << tess;
+    medians.push_back(quantile(e, 0.5));
+  }
+  // The same error with 16 quads as with 196: a quadratic interpolation error would differ by 12x.
+  EXPECT_LE(std::max(medians[0], medians[1]), 1.5 * std::min(medians[0], medians[1]));
 }
 
 // The room seen through a 40 mm lens (n = 1.5, no dispersion) 0.5 m in front of the eye, as in
@@ -146,45 +216,6 @@ gl::RasterFrame impostorFrame(const Scene& s) {
   expectFinite(f);
   return f;
 }
-// Mean absolute colour difference over the pixels where both see element 0, and the reference's mean colour.
-std::pair<double, double> colourError(const TracedFrame& ref, const gl::RasterFrame& f) {
-  double err = 0, sum = 0;
-  size_t n = 0;
-  for (size_t i = 0; i < ref.color.size(); ++i) {
-    if (ref.element[i] < 0 || f.element[i] < 0) continue;
-    const Vec3 d = glm::abs(f.color[i] - ref.color[i]);
-    err += (d.x + d.y + d.z) / 3;
-    sum += (ref.color[i].x + ref.color[i].y + ref.color[i].z) / 3;
-    ++n;
-  }
-  return {err / double(std::max<size_t>(n, 1)), sum / double(std::max<size_t>(n, 1))};
-}
-
-// Each fragment reflects at the exact surface point on its view ray, with the exact normal, from the mirror's
-// surface maps: the error does not grow as the mesh coarsens. The saddle mirror (a subdivision surface) with
-// 5 x 5 and 15 x 15 vertices: measured medians 0.0024' at both (the interpolated vertex normals gave 1.74' at
-// 15 x 15 and 0.19' at 45 x 45); pvrr's own error there is 2.3'.
-TEST_P(ImpostorTest, MirrorAccuracyDoesNotDependOnTheMesh) {
-  const auto ctx = test::glContextOrFail(GetParam());
-  if (!ctx) return;
-  for (const int tess : {5, 15}) {
-    Scene s = test::shippedScene("saddle-mirror", {"observer.image_size=[160,120]",
-                                                   "elements[0].tessellation=" + std::to_string(tess)});
-    RayScene rays(s);
-    const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
-    gl::RendererOptions o;
-    o.map_size = 512;
-    const gl::RasterFrame f = gl::Renderer(s, rays, o).render(gl::RasterMode::Impostor);
-    expectFinite(f);
-    const std::vector<double> e = elementErrors(ref, ref.seen, f);
-    std::cout << "[ measured ] saddle at " << tess << " x " << tess << ": median " << quantile(e, 0.5) << "', p95 "
-              << quantile(e, 0.95) << "' over " << e.size() << " px\n";
-    ASSERT_GT(e.size(), 1000u);
-    EXPECT_LE(quantile(e, 0.5), 0.02) << tess;
-    EXPECT_LE(quantile(e, 0.95), 0.1) << tess;
-  }
-}
-
 // Lenses: the spectacle lens (-3 D, the eye chart 4 m away) and the +10 D and -10 D lenses of
 // lens_types_test.cpp (real inverted image, focal region between lens and wall; upright minified image).
 // Each fragment finds where its view ray meets the front surface in the height map, refracts with the map's
@@ -290,7 +321,8 @@ TEST_P(ImpostorTest, EachColourChannelRefractedWithItsOwnIndex) {
 // where every ray is reflected, the impostor sees the reference's points (measured: median 0.11', p90 0.2',
 // mean colour error 4e-5 of the colour). A search that stopped at the root where a reflected ray leaves the
 // back surface (t = 0) drew the ring dark. Beyond 16.6 mm the light leaves through the edge band, which the
-// tracer's lens does not have: dark in both.
+// tracer's lens does not have, or meets the depth limit inside: dark in both, absorbed at the same point
+// mostly.
 TEST_P(ImpostorTest, TotalInternalReflectionFollowedInsideTheGlass) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
@@ -300,13 +332,18 @@ TEST_P(ImpostorTest, TotalInternalReflectionFollowedInsideTheGlass) {
   const Vec3 axis_point(0, 0, 2.0);
   std::vector<double> angles;
   double err = 0, ref_sum = 0;
-  size_t on_wall = 0, band = 0, band_dark = 0;
+  size_t on_wall = 0, band = 0, band_dark = 0, band_same = 0;
   for (size_t i = 0; i < ref.color.size(); ++i) {
     if (ref.element[i] < 0 || f.element[i] < 0) continue;
     const double h = glm::length(Vec2(ref.element_point[i] - axis_point));
     if (h > 0.0166 && h < 0.0175 && ref.color[i] == Vec3(0.0)) {
       ++band;
+      // Dark, and absorbed where the tracer absorbs: at the glass's surface when the depth limit is reached
+      // there, or (leaving through the edge) with the seen point far along the ray inside the glass.
+      const bool same_point = glm::length(f.seen[i] - ref.seen[i]) < 1e-3 ||
+                              arcminutes(angleBetween(f.seen[i] - ref.element_point[i], ref.seen[i] - ref.element_point[i])) < 1.0;
       band_dark += glm::length(f.color[i]) < 1e-3;
+      band_same += glm::length(f.color[i]) < 1e-3 && same_point;
     }
     if (h < 0.0149 || h > 0.0163) continue;
     on_wall += std::abs(f.seen[i].z - 3.0) < 1e-3;
@@ -319,13 +356,16 @@ TEST_P(ImpostorTest, TotalInternalReflectionFollowedInsideTheGlass) {
   std::cout << "[ measured ] TIR ring: " << angles.size() << " px (" << on_wall << " with the impostor's seen point on the "
             << "wall behind the eye), median " << quantile(angles, 0.5) << "', p90 " << quantile(angles, 0.9)
             << "', mean colour error " << err / double(angles.size()) << " of " << ref_sum / double(angles.size())
-            << "; edge band " << band_dark << " of " << band << " px dark\n";
+            << "; edge band " << band_dark << " of " << band << " px dark, " << band_same << " absorbed at the same point\n";
   ASSERT_GT(angles.size(), 300u);
   EXPECT_EQ(on_wall, angles.size());
   EXPECT_LE(quantile(angles, 0.9), 1.0);
   EXPECT_LE(err, 0.01 * ref_sum);
   ASSERT_GT(band, 50u);
   EXPECT_GE(band_dark, band * 95 / 100);
+  // Measured 86 %: within a millimetre of the rim the outline mask (half a texel, 0.04 mm) and the tracer's
+  // exact outline test decide differently whether a ray meets a surface or leaves through the edge.
+  EXPECT_GE(band_same, band * 80 / 100);
 }
 
 // The tracer's depth limit holds inside the glass too: with render.max_depth = 2 it follows one event after
