@@ -24,7 +24,7 @@ const std::map<std::string, Command>& commands() {
   static const std::map<std::string, Command> table = {
       {"render",
        {cmdRender, "render a scene to PNG (default: models/car-mirror.json -> out/car-mirror.png)",
-        "pvrr render [SCENE] [--mode pvrr|raster|envmap|raytrace] [--size WxH] [--out FILE.png]\n"
+        "pvrr render [SCENE] [--mode pvrr|raster|envmap|impostor|raytrace] [--size WxH] [--out FILE.png]\n"
         "            [--gl auto|egl|osmesa] [--set PATH=VALUE]... [--stats FILE.json] [--frames N] [--orbit DEG]\n"
         "  Renders SCENE (default models/car-mirror.json) and prints the output path and the frame time.\n"
         "  --stats writes {\"frame_ms\", \"stages\":[{\"name\",\"ms\",\"ran\",\"reason\"}], \"elements\":[...]}.\n"
@@ -52,7 +52,7 @@ const std::map<std::string, Command>& commands() {
         "  (+ ix,iy,iz,bx,by,bz,bnx,bny,bnz for lenses); FILE.json beside it holds each patch's camera."}},
       {"compare",
        {cmdCompare, "render the reference and each mode; write images, error heat maps and metrics.json",
-        "pvrr compare SCENE [--modes pvrr,envmap,raster] [--size WxH] [--frames N] [--gl B] [--set PATH=VALUE]... --out DIR\n"
+        "pvrr compare SCENE [--modes pvrr,envmap,impostor,raster] [--size WxH] [--frames N] [--gl B] [--set PATH=VALUE]... --out DIR\n"
         "  Writes DIR/reference.png, DIR/MODE.png, DIR/MODE-error.png and DIR/metrics.json: per mode the frame\n"
         "  time, stages and angular error (median, p95, max), split into the zooming region and the rest\n"
         "  (\"regions\"); with rgb dispersion also per colour channel (\"channels\") and the fringes' sign\n"

@@ -57,11 +57,11 @@ TEST(Reports, SweepAndCompareRunOnEveryDefaultScene) {
 
     const fs::path cmp = dir / (scene.stem().string() + "-compare");
     const auto c = runPvrr("compare 'models/" + scene.filename().string() +
-                           "' --modes pvrr,envmap --size 32x24 --frames 1 --gl osmesa --set render.map_size=64 --out '" +
+                           "' --modes pvrr,envmap,impostor --size 32x24 --frames 1 --gl osmesa --set render.map_size=64 --out '" +
                            cmp.string() + "'");
     ASSERT_EQ(c.code, 0) << scene << ": " << c.err;
     const auto m = readJson(cmp / "metrics.json");
-    for (const char* mode : {"pvrr", "envmap"}) {
+    for (const char* mode : {"pvrr", "envmap", "impostor"}) {
       const auto& v = m["modes"][mode];
       EXPECT_GT(v["pixels"].get<size_t>(), 0u) << scene << " " << mode;
       size_t sum = 0;
@@ -78,19 +78,19 @@ TEST(Reports, SweepAndCompareRunOnEveryDefaultScene) {
   fs::remove_all(dir);
 }
 
-// Reading lens with rgb dispersion: metrics.json has each mode's error per channel, pvrr's per-channel seen
-// points match the reference's channels (each channel within the bound of the whole), and the fringes have
-// the right sign: blue bends more than red, in the reference and in pvrr mode.
+// Reading lens with rgb dispersion: metrics.json has each mode's error per channel, pvrr's and the impostor's
+// per-channel seen points match the reference's channels (each channel within the bound of the whole), and the
+// fringes have the right sign: blue bends more than red, in the reference and in both modes.
 TEST(Reports, CompareReportsPerChannelErrorsAndFringeSign) {
   const fs::path dir = pvrr::test::freshTestDir("compare-rgb");
-  const auto r = runPvrr("compare models/reading-lens.json --modes pvrr,envmap --size 64x48 --frames 1 --gl osmesa --out '" +
+  const auto r = runPvrr("compare models/reading-lens.json --modes pvrr,envmap,impostor --size 64x48 --frames 1 --gl osmesa --out '" +
                          dir.string() + "'");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto m = readJson(dir / "metrics.json");
   ASSERT_TRUE(m["reference"].contains("fringe")) << m["reference"].dump();
   EXPECT_TRUE(m["reference"]["fringe"]["blue_bends_more"].get<bool>());
   EXPECT_GT(m["reference"]["fringe"]["fraction_blue_bends_more"].get<double>(), 0.9);
-  for (const char* mode : {"pvrr", "envmap"}) {
+  for (const char* mode : {"pvrr", "envmap", "impostor"}) {
     const auto& ch = m["modes"][mode]["channels"];
     for (const char* c : {"R", "G", "B"}) {
       ASSERT_TRUE(ch.contains(c)) << mode << " " << c;
@@ -107,6 +107,10 @@ TEST(Reports, CompareReportsPerChannelErrorsAndFringeSign) {
   const double ref_spread = m["reference"]["fringe"]["median_blue_minus_red_deviation_arcmin"];
   const double pvrr_spread = pv["fringe"]["median_blue_minus_red_deviation_arcmin"];
   EXPECT_NEAR(pvrr_spread, ref_spread, 0.1 * ref_spread);
+  const auto& im = m["modes"]["impostor"];
+  for (const char* c : {"R", "G", "B"}) EXPECT_LT(im["channels"][c]["angular_error_arcmin"]["median"].get<double>(), 0.1) << c;
+  EXPECT_TRUE(im["fringe"]["agrees_with_reference"].get<bool>());
+  EXPECT_NEAR(im["fringe"]["median_blue_minus_red_deviation_arcmin"].get<double>(), ref_spread, 0.1 * ref_spread);
   EXPECT_TRUE(m["definitions"].contains("fringe"));
   fs::remove_all(dir);
 }
