@@ -252,6 +252,31 @@ bool mayBeInVolume(const std::vector<Vec3>& points, const Mat4& m) {
   return all == 0;
 }
 
+// A 2D float texture of w x h texels, 1 or 4 floats each, made or replaced in `tex`. The impostor shader
+// reads these maps with texelFetch and filters them in float itself (shaders/element.frag `bilinear`):
+// nearest, clamped.
+void uploadDataTexture(GLuint& tex, GLint internal_format, int w, int h, int channels, const float* data) {
+  if (!tex) glGenTextures(1, &tex);
+  glBindTexture(GL_TEXTURE_2D, tex);
+  glTexImage2D(GL_TEXTURE_2D, 0, internal_format, w, h, 0, channels == 1 ? GL_RED : GL_RGBA, GL_FLOAT, data);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glBindTexture(GL_TEXTURE_2D, 0);
+}
+
+// Binds `textures` to units first, first + 1, ... and names them in `p`; unit 0 active after.
+void bindDataTextures(const Program& p, int first, std::initializer_list<std::pair<const char*, GLuint>> textures) {
+  int unit = first;
+  for (const auto& [name, tex] : textures) {
+    glActiveTexture(GLenum(GL_TEXTURE0 + unit));
+    glBindTexture(GL_TEXTURE_2D, tex);
+    p.set(name, unit++);
+  }
+  glActiveTexture(GL_TEXTURE0);
+}
+
 // Cube-map faces in GL order (+X, -X, +Y, -Y, +Z, -Z): view direction and up vector.
 const Vec3 kCubeDir[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
 const Vec3 kCubeUp[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
@@ -586,28 +611,17 @@ struct Renderer::Impl {
     const Element& el = scene.elements[e];
     return !m.front || m.front_surface != el.lens.front || m.back_surface != el.lens.back;
   }
-  // Builds and uploads lens e's height maps (RGBA32F: z and the outward normal) and its outline mask (R32F),
-  // filtered linearly and clamped to the edge; returns 1.
+  // Builds and uploads lens e's height maps (RGBA32F: z and the outward normal) and its outline mask (R32F);
+  // returns 1.
   int createLensMaps(size_t e) {
     LensMaps& m = lensMaps(e);
     const Element& el = scene.elements[e];
     m.map = buildLensHeightMap(el, options.lens_height_map_size);
     m.front_surface = el.lens.front;
     m.back_surface = el.lens.back;
-    for (GLuint* t : {&m.front, &m.back, &m.mask}) {
-      if (!*t) glGenTextures(1, t);
-      glBindTexture(GL_TEXTURE_2D, *t);
-      if (t == &m.mask)
-        glTexImage2D(GL_TEXTURE_2D, 0, GL_R32F, m.map.nx, m.map.ny, 0, GL_RED, GL_FLOAT, m.map.inside.data());
-      else
-        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, m.map.nx, m.map.ny, 0, GL_RGBA, GL_FLOAT,
-                     (t == &m.front ? m.map.front : m.map.back).data());
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    }
-    glBindTexture(GL_TEXTURE_2D, 0);
+    uploadDataTexture(m.front, GL_RGBA32F, m.map.nx, m.map.ny, 4, m.map.front.data());
+    uploadDataTexture(m.back, GL_RGBA32F, m.map.nx, m.map.ny, 4, m.map.back.data());
+    uploadDataTexture(m.mask, GL_R32F, m.map.nx, m.map.ny, 1, m.map.inside.data());
     checkGlError("uploading a lens's refractor height maps");
     return 1;
   }
@@ -622,16 +636,7 @@ struct Renderer::Impl {
     // The derivatives only steer the shader's Gauss-Newton steps: half floats do.
     const std::vector<float>* data[4] = {&m.map.position, &m.map.du, &m.map.dv, &m.map.normal};
     const GLint formats[4] = {GL_RGBA32F, GL_RGBA16F, GL_RGBA16F, GL_RGBA32F};
-    for (size_t k = 0; k < 4; ++k) {
-      if (!m.textures[k]) glGenTextures(1, &m.textures[k]);
-      glBindTexture(GL_TEXTURE_2D, m.textures[k]);
-      glTexImage2D(GL_TEXTURE_2D, 0, formats[k], m.map.n, m.map.n, 0, GL_RGBA, GL_FLOAT, data[k]->data());
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    }
-    glBindTexture(GL_TEXTURE_2D, 0);
+    for (size_t k = 0; k < 4; ++k) uploadDataTexture(m.textures[k], formats[k], m.map.n, m.map.n, 4, data[k]->data());
     checkGlError("uploading a mirror's surface maps");
     for (auto* a : {&m.map.position, &m.map.du, &m.map.dv, &m.map.normal}) std::vector<float>().swap(*a);
     return 1;
@@ -640,13 +645,8 @@ struct Renderer::Impl {
   // parameter domain, and its pose.
   void setMirrorMaps(const Program& p, size_t e) {
     const MirrorMaps& m = mirror_maps.at(e);
-    const char* names[4] = {"u_surf_p", "u_surf_du", "u_surf_dv", "u_surf_n"};
-    for (int k = 0; k < 4; ++k) {
-      glActiveTexture(GLenum(GL_TEXTURE2 + k));
-      glBindTexture(GL_TEXTURE_2D, m.textures[size_t(k)]);
-      p.set(names[k], 2 + k);
-    }
-    glActiveTexture(GL_TEXTURE0);
+    bindDataTextures(p, 2, {{"u_surf_p", m.textures[0]}, {"u_surf_du", m.textures[1]}, {"u_surf_dv", m.textures[2]},
+                            {"u_surf_n", m.textures[3]}});
     const double n = m.map.n, su = (n - 1) / n / (m.map.u1 - m.map.u0), sv = (n - 1) / n / (m.map.v1 - m.map.v0);
     p.set("u_sm", glm::vec4(float(su), float(sv), float(0.5 / n - m.map.u0 * su), float(0.5 / n - m.map.v0 * sv)));
     p.set("u_uv_box", glm::vec4(float(m.map.u0), float(m.map.v0), float(m.map.u1), float(m.map.v1)));
@@ -659,16 +659,7 @@ struct Renderer::Impl {
   void setLensMaps(const Program& p, size_t e) {
     const LensMaps& m = lensMaps(e);
     const Element& el = scene.elements[e];
-    glActiveTexture(GL_TEXTURE2);
-    glBindTexture(GL_TEXTURE_2D, m.front);
-    glActiveTexture(GL_TEXTURE3);
-    glBindTexture(GL_TEXTURE_2D, m.back);
-    glActiveTexture(GL_TEXTURE4);
-    glBindTexture(GL_TEXTURE_2D, m.mask);
-    glActiveTexture(GL_TEXTURE0);
-    p.set("u_lens_front", 2);
-    p.set("u_lens_back", 3);
-    p.set("u_lens_mask", 4);
+    bindDataTextures(p, 2, {{"u_lens_front", m.front}, {"u_lens_back", m.back}, {"u_lens_mask", m.mask}});
     p.set("u_hm_reach", float(m.map.reach));
     p.set("u_max_events", scene.render.max_depth - 1);
     p.set("u_far", float(scene.render.far_distance_m));

@@ -59,6 +59,29 @@ std::pair<double, double> colourError(const TracedFrame& ref, const gl::RasterFr
   return {err / double(std::max<size_t>(n, 1)), sum / double(std::max<size_t>(n, 1))};
 }
 
+// The reference frame, an impostor frame (finite everywhere) and its errors, and envmap's median.
+struct ImpostorRun {
+  TracedFrame ref;
+  gl::RasterFrame f;
+  std::vector<double> errors;  // sorted, arcmin
+  double envmap_median = 0;
+};
+ImpostorRun runImpostor(const Scene& s) {
+  ImpostorRun run;
+  RayScene rays(s);
+  TraceOptions to;
+  to.max_depth = s.render.max_depth;
+  run.ref = Tracer(rays, to).render();
+  gl::RendererOptions o;
+  o.map_size = 512;
+  gl::Renderer r(s, rays, o);
+  run.f = r.render(gl::RasterMode::Impostor);
+  expectFinite(run.f);
+  run.errors = elementErrors(run.ref, run.ref.seen, run.f);
+  run.envmap_median = medianArcmin(run.ref, r.render(gl::RasterMode::Envmap));
+  return run;
+}
+
 class ImpostorTest : public ::testing::TestWithParam<gl::GlBackend> {};
 
 // A plane mirror in the room of planar walls (tests/support/test_scenes.h), the box inside it casting the
@@ -76,24 +99,18 @@ TEST_P(ImpostorTest, PlaneMirrorInAPlanarRoomSeesWhatTheTracerSees) {
   s.elements[0].mirror.n = Vec3(1.35, 0.96, 0.62);
   s.elements[0].mirror.k = Vec3(7.5, 6.7, 5.3);
   s.updateBounds();
-  RayScene rays(s);
-  const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
-  gl::RendererOptions o;
-  o.map_size = 512;
-  gl::Renderer r(s, rays, o);
-  const gl::RasterFrame f = r.render(gl::RasterMode::Impostor);
-  expectFinite(f);
-  const std::vector<double> e = elementErrors(ref, ref.seen, f);
+  const ImpostorRun run = runImpostor(s);
+  const std::vector<double>& e = run.errors;
   ASSERT_GT(e.size(), 1500u);  // 1862 at 160 x 120
   const double within = double(std::upper_bound(e.begin(), e.end(), 0.05) - e.begin()) / double(e.size());
-  const double envmap = medianArcmin(ref, r.render(gl::RasterMode::Envmap));
+  const double envmap = run.envmap_median;
   std::cout << "[ measured ] plane mirror on " << gl::glBackendName(GetParam()) << ": impostor median "
             << quantile(e, 0.5) << "', " << 100 * within << " % of " << e.size() << " px within 0.05'; envmap median "
             << envmap << "'\n";
   EXPECT_GE(within, 0.95);
   EXPECT_GT(envmap, 100 * quantile(e, 0.5));
   // The walls are untextured and smoothly lit: the colour isolates the metal's Fresnel (measured below).
-  const auto [cerr, cmean] = colourError(ref, f);
+  const auto [cerr, cmean] = colourError(run.ref, run.f);
   std::cout << "[ measured ] plane metal mirror: mean colour error " << cerr << " of " << cmean << "\n";
   EXPECT_LE(cerr, 2e-3 * cmean);
 }
@@ -171,34 +188,15 @@ TEST_P(ImpostorTest, MirrorAccuracyDoesNotDependOnTheMesh) {
   EXPECT_LE(std::max(medians[0], medians[1]), 1.5 * std::min(medians[0], medians[1]));
 }
 
-// The room seen through a 40 mm lens (n = 1.5, no dispersion) 0.5 m in front of the eye, as in
-// lens_types_test.cpp; `eye` and `target` may put the viewer behind it.
-Scene roomLens(const char* name, cad::SagSurfacePtr front, cad::SagSurfacePtr back, double thickness,
-               const cad::Outline& disc, const Vec3& eye = Vec3(0, 0, 2.5), const Vec3& target = Vec3(0, 0, -3)) {
-  Scene s = test::roomScene(eye, target, 160, 120);
-  s.observer.fov_y_rad = radians(8);
-  Element e;
-  e.name = name;
-  e.type = ElementType::Lens;
-  e.lens = cad::makeLens(front, back, disc, thickness, 0.0, name);
-  e.outline = disc;
-  e.local_to_world = test::pose(Vec3(0, 0, 2.0), Vec3(0, 0, 1));
-  e.world_to_local = glm::inverse(e.local_to_world);
-  e.dispersion = Dispersion::constant(1.5);
-  e.tess_u = e.tess_v = 24;
-  s.elements.push_back(e);
-  s.updateBounds();
-  return s;
-}
 Scene plusLens(const Vec3& eye = Vec3(0, 0, 2.5), const Vec3& target = Vec3(0, 0, -3)) {
   const cad::Outline disc = cad::Outline::circle(0.04);
-  return roomLens("+10 D", cad::makeSphere(0.1, disc), cad::makeSphere(-0.1, disc), 0.005, disc, eye, target);
+  return test::roomLensScene("+10 D", cad::makeSphere(0.1, disc), cad::makeSphere(-0.1, disc), 0.005, disc, eye, target);
 }
 // The plano-convex lens of lens_types_test.cpp: 36 mm across, R = 20 mm at the back, 12 mm thick. Beyond 13.4
 // mm from the axis the rays are totally reflected off the back; beyond ~16.4 mm they leave through the edge.
 Scene planoConvex(int max_depth = 4) {
   const cad::Outline disc = cad::Outline::circle(0.036);
-  Scene s = roomLens("plano-convex", cad::makePlane(disc), cad::makeSphere(-0.02, disc), 0.012, disc);
+  Scene s = test::roomLensScene("plano-convex", cad::makePlane(disc), cad::makeSphere(-0.02, disc), 0.012, disc);
   s.render.max_depth = max_depth;
   return s;
 }
@@ -230,18 +228,12 @@ TEST_P(ImpostorTest, LensesRefractedThroughTheirHeightMaps) {
   scenes.emplace_back("spectacle-lens", test::shippedScene("spectacle-lens", {"observer.image_size=[160,120]"}));
   scenes.emplace_back("+10 D", plusLens());
   const cad::Outline disc = cad::Outline::circle(0.04);
-  scenes.emplace_back("-10 D", roomLens("-10 D", cad::makeSphere(-0.1, disc), cad::makeSphere(0.1, disc), 0.0015, disc));
+  scenes.emplace_back("-10 D", test::roomLensScene("-10 D", cad::makeSphere(-0.1, disc), cad::makeSphere(0.1, disc), 0.0015, disc));
   for (auto& [name, s] : scenes) {
-    const TracedFrame ref = reference(s);
-    RayScene rays(s);
-    gl::RendererOptions o;
-    o.map_size = 512;
-    gl::Renderer r(s, rays, o);
-    const gl::RasterFrame f = r.render(gl::RasterMode::Impostor);
-    expectFinite(f);
-    const std::vector<double> e = elementErrors(ref, ref.seen, f);
-    const double envmap = medianArcmin(ref, r.render(gl::RasterMode::Envmap));
-    const auto [cerr, cmean] = colourError(ref, f);
+    const ImpostorRun run = runImpostor(s);
+    const std::vector<double>& e = run.errors;
+    const double envmap = run.envmap_median;
+    const auto [cerr, cmean] = colourError(run.ref, run.f);
     std::cout << "[ measured ] " << name << ": impostor median " << quantile(e, 0.5) << "', p95 " << quantile(e, 0.95)
               << "' over " << e.size() << " px; envmap median " << envmap << "'; mean colour error " << cerr << " of "
               << cmean << "\n";
@@ -250,7 +242,7 @@ TEST_P(ImpostorTest, LensesRefractedThroughTheirHeightMaps) {
     EXPECT_LE(quantile(e, 0.95), 0.1) << name;
     EXPECT_GT(envmap, 100 * quantile(e, 0.5)) << name;
     EXPECT_LE(cerr, 0.02 * cmean) << name;
-    const StageTiming* rf = f.stages.find("refraction");
+    const StageTiming* rf = run.f.stages.find("refraction");
     ASSERT_TRUE(rf);
     EXPECT_NE(rf->reason.find("refractor height maps"), std::string::npos) << rf->reason;
   }

@@ -39,21 +39,7 @@ struct LensCase {
 // The room seen through a lens with outline `disc` 0.5 m in front of the eye (n = 1.5, no dispersion).
 Scene lensScene(const char* name, cad::SagSurfacePtr front, cad::SagSurfacePtr back, double thickness,
                 const cad::Outline& disc) {
-  const Vec3 eye(0, 0, 2.5), lens_pos(0, 0, 2.0);
-  Scene s = test::roomScene(eye, Vec3(0, 0, -3), 160, 120);
-  s.observer.fov_y_rad = radians(8);
-  Element e;
-  e.name = name;
-  e.type = ElementType::Lens;
-  e.lens = cad::makeLens(front, back, disc, thickness, 0.0, name);
-  e.outline = disc;
-  e.local_to_world = test::pose(lens_pos, Vec3(0, 0, 1));
-  e.world_to_local = glm::inverse(e.local_to_world);
-  e.dispersion = Dispersion::constant(1.5);
-  e.tess_u = e.tess_v = 24;
-  s.elements.push_back(e);
-  s.updateBounds();
-  return s;
+  return test::roomLensScene(name, front, back, thickness, disc);
 }
 
 Scene lensScene(const LensCase& c) {

@@ -1,5 +1,6 @@
 // Small scenes built in code for tests whose expectations are analytic. Header-only.
 #pragma once
+#include "cad/lens.h"
 #include "cad/sag.h"
 #include "pvrr/scene.h"
 
@@ -68,6 +69,28 @@ inline Scene roomScene(const Vec3& eye, const Vec3& target, int width = 96, int 
   s.lights = {amb, sun};
   s.updateBounds();
   s.render.far_distance_m = 1e4;
+  return s;
+}
+
+// The room seen through a lens with outline `disc` (n = 1.5, no dispersion, 24 x 24 vertices) at z = 2 m facing
+// +z, from `eye` towards `target` with an 8 deg field: by default 0.5 m in front of the lens, looking through
+// it at the far wall 5 m away.
+inline Scene roomLensScene(const char* name, cad::SagSurfacePtr front, cad::SagSurfacePtr back, double thickness,
+                           const cad::Outline& disc, const Vec3& eye = Vec3(0, 0, 2.5),
+                           const Vec3& target = Vec3(0, 0, -3)) {
+  Scene s = roomScene(eye, target, 160, 120);
+  s.observer.fov_y_rad = radians(8);
+  Element e;
+  e.name = name;
+  e.type = ElementType::Lens;
+  e.lens = cad::makeLens(front, back, disc, thickness, 0.0, name);
+  e.outline = disc;
+  e.local_to_world = pose(Vec3(0, 0, 2.0), Vec3(0, 0, 1));
+  e.world_to_local = glm::inverse(e.local_to_world);
+  e.dispersion = Dispersion::constant(1.5);
+  e.tess_u = e.tess_v = 24;
+  s.elements.push_back(e);
+  s.updateBounds();
   return s;
 }
 
