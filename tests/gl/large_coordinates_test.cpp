@@ -43,16 +43,26 @@ Scene mirrorInARoom(const Vec3& offset) {
   return s;
 }
 
+// The +10 D lens of the lens tests (tests/support/test_scenes.h), the room seen through it.
+Scene lensInARoom(const Vec3& offset) {
+  const cad::Outline disc = cad::Outline::circle(0.04);
+  Scene s = test::roomLensScene("+10 D", cad::makeSphere(0.1, disc), cad::makeSphere(-0.1, disc), 0.005, disc);
+  translate(s, offset);
+  return s;
+}
+
 struct Result {
   std::vector<Vec3> color, seen_rel;  // seen points relative to the eye
   std::vector<int> element;
   double median_arcmin = 0;
 };
 
-Result run(const Vec3& offset, gl::RasterMode mode) {
-  Scene s = mirrorInARoom(offset);
+Result run(const Vec3& offset, gl::RasterMode mode, bool lens = false) {
+  Scene s = lens ? lensInARoom(offset) : mirrorInARoom(offset);
   RayScene rays(s);
-  const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
+  TraceOptions to;
+  to.max_depth = s.render.max_depth;
+  const TracedFrame ref = Tracer(rays, to).render();
   gl::RendererOptions opt;
   opt.map_size = 512;
   gl::Renderer r(s, rays, opt);
@@ -73,41 +83,52 @@ Result run(const Vec3& offset, gl::RasterMode mode) {
 
 class LargeCoordinatesTest : public ::testing::TestWithParam<gl::GlBackend> {};
 
+// The same frame at the origin and far away: the same element pixels (to 1 %), colours and seen points.
+void expectSameFarAway(gl::RasterMode mode, bool lens) {
+  const Vec3 far_away(3.2e6, 1.5e3, -5.4e6);  // UTM-like easting/northing, metres
+  const Result near = run(Vec3(0.0), mode, lens), far = run(far_away, mode, lens);
+  ASSERT_EQ(near.color.size(), far.color.size());
+  size_t differ = 0, pixels = 0;
+  double worst_seen = 0;
+  for (size_t i = 0; i < near.color.size(); ++i) {
+    ASSERT_TRUE(isFinite(far.color[i]) && isFinite(far.seen_rel[i])) << "pixel " << i;
+    if (near.element[i] != far.element[i]) {
+      ++differ;
+      continue;
+    }
+    ++pixels;
+    // Colours: the same shading of the same relative geometry; float rounding of the camera-relative
+    // positions (~1e-7 relative) moves an edge by a pixel at most, so compare the bulk.
+    if (glm::length(near.color[i] - far.color[i]) > 1e-3) ++differ;
+    // Seen points relative to the eye: exact to float rounding of metre-scale coordinates, not of 5e6 m
+    // ones (which would be ~0.5 m).
+    if (near.element[i] >= 0) worst_seen = std::max(worst_seen, glm::length(near.seen_rel[i] - far.seen_rel[i]));
+  }
+  std::cout << "[ measured ] " << (lens ? "lens" : "mirror") << ", mode " << gl::modeName(mode) << ": " << differ
+            << " of " << near.color.size() << " pixels differ, seen points within " << worst_seen << " m, median "
+            << near.median_arcmin << "' at the origin, " << far.median_arcmin << "' far away\n";
+  EXPECT_LE(differ, near.color.size() / 100) << gl::modeName(mode);
+  EXPECT_LT(worst_seen, 1e-3) << gl::modeName(mode);
+  if (mode == gl::RasterMode::Pvrr || mode == gl::RasterMode::Impostor) {
+    EXPECT_LT(far.median_arcmin, 1.0) << gl::modeName(mode);
+    EXPECT_NEAR(far.median_arcmin, near.median_arcmin, 0.01 + 0.05 * near.median_arcmin) << gl::modeName(mode);
+  }
+  EXPECT_GT(pixels, 0u);
+}
+
 TEST_P(LargeCoordinatesTest, SceneMillionsOfMetresAwayRendersAsAtTheOrigin) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
-  const Vec3 far_away(3.2e6, 1.5e3, -5.4e6);  // UTM-like easting/northing, metres
   for (gl::RasterMode mode :
-       {gl::RasterMode::Pvrr, gl::RasterMode::Envmap, gl::RasterMode::Impostor, gl::RasterMode::Raster}) {
-    const Result near = run(Vec3(0.0), mode), far = run(far_away, mode);
-    ASSERT_EQ(near.color.size(), far.color.size());
-    size_t differ = 0, pixels = 0;
-    double worst_seen = 0;
-    for (size_t i = 0; i < near.color.size(); ++i) {
-      ASSERT_TRUE(isFinite(far.color[i]) && isFinite(far.seen_rel[i])) << "pixel " << i;
-      if (near.element[i] != far.element[i]) {
-        ++differ;
-        continue;
-      }
-      ++pixels;
-      // Colours: the same shading of the same relative geometry; float rounding of the camera-relative
-      // positions (~1e-7 relative) moves an edge by a pixel at most, so compare the bulk.
-      if (glm::length(near.color[i] - far.color[i]) > 1e-3) ++differ;
-      // Seen points relative to the eye: exact to float rounding of metre-scale coordinates, not of 5e6 m
-      // ones (which would be ~0.5 m).
-      if (near.element[i] >= 0) worst_seen = std::max(worst_seen, glm::length(near.seen_rel[i] - far.seen_rel[i]));
-    }
-    std::cout << "[ measured ] mode " << int(mode) << ": " << differ << " of " << near.color.size()
-              << " pixels differ, seen points within " << worst_seen << " m, median " << near.median_arcmin << "' at the origin, "
-              << far.median_arcmin << "' far away\n";
-    EXPECT_LE(differ, near.color.size() / 100) << "mode " << int(mode);
-    EXPECT_LT(worst_seen, 1e-3) << "mode " << int(mode);
-    if (mode == gl::RasterMode::Pvrr || mode == gl::RasterMode::Impostor) {
-      EXPECT_LT(far.median_arcmin, 1.0);
-      EXPECT_NEAR(far.median_arcmin, near.median_arcmin, 0.01 + 0.05 * near.median_arcmin);
-    }
-    EXPECT_GT(pixels, 0u);
-  }
+       {gl::RasterMode::Pvrr, gl::RasterMode::Envmap, gl::RasterMode::Impostor, gl::RasterMode::Raster})
+    expectSameFarAway(mode, false);
+}
+
+// A lens: pvrr's refraction on the CPU in doubles, the impostor's in the lens's own frame on the GPU.
+TEST_P(LargeCoordinatesTest, LensMillionsOfMetresAwayRendersAsAtTheOrigin) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  for (gl::RasterMode mode : {gl::RasterMode::Pvrr, gl::RasterMode::Impostor}) expectSameFarAway(mode, true);
 }
 
 PVRR_GL_BACKENDS(LargeCoordinatesTest);
