@@ -108,6 +108,7 @@ struct RenderSettings {
   int map_size = 1024;               // a map's longer side at most (texels)
   double map_texels_per_pixel = 4;   // a top-level map's texels per image pixel of its patch; 0: map_size
   double map_reuse_margin_deg = 2;   // maps widened this much for reuse by later frames; 0: none
+  int impostor_iterations = 8;       // impostor mode: false-position steps of each fragment's search
   std::string output;
   int max_depth = 4;
   std::string dispersion = "off";  // off | rgb | spectral

@@ -562,6 +562,9 @@ TEST(SceneJson, OverridesAreValidatedLikeTheFile) {
   expectContains(errorOf(kBase, {"render.map_texels_per_pixel=-1"}), "render.map_texels_per_pixel: expected a number in [0, 10000]");
   EXPECT_EQ(parse(kBase, {"render.map_reuse_margin_deg=0"}).render.map_reuse_margin_deg, 0.0);
   expectContains(errorOf(kBase, {"render.map_reuse_margin_deg=11"}), "render.map_reuse_margin_deg: expected a number in [0, 10]");
+  EXPECT_EQ(parse(kBase).render.impostor_iterations, 8);
+  EXPECT_EQ(parse(kBase, {"render.impostor_iterations=0"}).render.impostor_iterations, 0);
+  expectContains(errorOf(kBase, {"render.impostor_iterations=65"}), "render.impostor_iterations: expected an integer in [0, 64]");
 }
 
 TEST(SceneJson, OverrideOfAnUnknownPathFailsNamingIt) {
