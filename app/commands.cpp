@@ -253,7 +253,6 @@ RenderedFrame renderFrame(LoadedScene& ls, const std::string& mode, const std::s
     ro.map_size = scene.render.map_size;
     ro.map_texels_per_pixel = scene.render.map_texels_per_pixel;
     ro.map_reuse_margin_deg = scene.render.map_reuse_margin_deg;
-    ro.impostor_iterations = scene.render.impostor_iterations;
     ro.seen_channel = session->seen_channel;
     ro.seen_points = session->seen_points;
     ro.vertex.channels.clear();  // per element: dispersionChannels(scene, e), rgb or spectral as the scene says

@@ -36,6 +36,12 @@ class Outline {
   // Axis-aligned bounding box of the region (for a polygon it need not be centred on centre()).
   Vec2 boundsMin() const;
   Vec2 boundsMax() const;
+  // The same region: shape, sizes, centre and loop all equal (for caches keyed by an outline).
+  bool operator==(const Outline& o) const {
+    return shape_ == o.shape_ && width_ == o.width_ && height_ == o.height_ && corner_radius_ == o.corner_radius_ &&
+           centre_ == o.centre_ && loop_ == o.loop_;
+  }
+  bool operator!=(const Outline& o) const { return !(*this == o); }
 
  private:
   Shape shape_ = Shape::Rectangle;

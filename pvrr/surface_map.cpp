@@ -49,8 +49,8 @@ SurfaceMap buildSurfaceMap(const cad::Surface& surface, int n, const cad::Outlin
       const size_t k = 4 * (size_t(j) * size_t(n) + size_t(i));
       for (int c = 0; c < 3; ++c) {
         m.position[k + size_t(c)] = float(s.p[c]);
-        m.du[k + size_t(c)] = float(s.du[c]);
-        m.dv[k + size_t(c)] = float(s.dv[c]);
+        m.du[k + size_t(c)] = float(s.du[c] * (d.u1 - d.u0));
+        m.dv[k + size_t(c)] = float(s.dv[c] * (d.v1 - d.v0));
         m.normal[k + size_t(c)] = float(nrm[c]);
       }
       m.position[k + 3] = inside ? 1.0f : 0.0f;

@@ -5,14 +5,16 @@
 // 1.74' at 15 x 15 vertices, 0.19' at 45 x 45).
 //
 // Sample (i, j) of an n x n map is the surface at u = u0 + i (u1 - u0) / (n - 1), v = v0 + j (v1 - v0) / (n - 1)
-// (the domain's corners are samples): position, the two first derivatives and the exact unit normal (oriented
-// as cad's surface normal), in the element's local frame, metres; the position's w is 1 where (u, v) lies
-// inside the element's outline (always without one), else 0. Where the surface cannot be evaluated (a sag
-// beyond a sphere's radius, in a corner of the outline's box) or has no normal, the sample is taken from the
-// nearest point towards the domain's centre that can, and marked outside. Texture coordinate of parameter u:
-// s = (u - u0) / (u1 - u0) (n - 1) / n + 0.5 / n, so that GL_LINEAR interpolates between the samples.
-// The fragment shader (shaders/element.frag, MODE_IMPOSTOR) starts from the fragment's interpolated (u, v)
-// and takes Gauss-Newton steps on the distance of the map's point from its view ray.
+// (the domain's corners are samples): position, the first derivatives with respect to the normalised
+// parameters s = (u - u0) / (u1 - u0) and t = (v - v0) / (v1 - v0) (parameters far from 0, such as a NURBS's
+// knots, then cost the shader no float precision) and the exact unit normal (oriented as cad's surface
+// normal), in the element's local frame, metres; the position's w is 1 where (u, v) lies inside the element's
+// outline (always without one), else 0. Where the surface cannot be evaluated (a sag beyond a sphere's
+// radius, in a corner of the outline's box) or has no normal, the sample is taken from the nearest point
+// towards the domain's centre that can, and marked outside. Texture coordinate of normalised parameter s:
+// s (n - 1) / n + 0.5 / n, so that bilinear filtering interpolates between the samples. The fragment shader
+// (shaders/element.frag, MODE_IMPOSTOR) starts from the fragment's interpolated (s, t) and takes Gauss-Newton
+// steps on the distance of the map's point from its view ray.
 #pragma once
 #include <vector>
 
@@ -35,7 +37,8 @@ struct SurfaceMap {
 SurfaceMap buildSurfaceMap(const cad::Surface& surface, int n, const cad::Outline* outline = nullptr);
 
 // The map's bilinear sample at parameter (u, v) (GL_LINEAR with clamp-to-edge; the shader computes it so, with
-// float weights): position, derivatives, the normal (normalised) and the outline mask: for tests.
+// float weights): position, derivatives (normalised parameters, as stored), the normal (normalised) and the
+// outline mask: for tests.
 struct SurfaceMapSample {
   Vec3 position, du, dv, normal;
   double inside = 0;

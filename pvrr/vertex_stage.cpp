@@ -86,10 +86,6 @@ cad::Tessellation tessellateElement(const Element& el) {
                              cad::TessellationOptions{true});
 }
 
-bool sameOutline(const cad::Outline& a, const cad::Outline& b) {
-  return a.shape() == b.shape() && a.width() == b.width() && a.height() == b.height() &&
-         a.cornerRadius() == b.cornerRadius() && a.centre() == b.centre() && a.loop() == b.loop();
-}
 }  // namespace
 
 const cad::Tessellation& ElementGridCache::get(const Scene& scene, int element) {
@@ -98,7 +94,7 @@ const cad::Tessellation& ElementGridCache::get(const Scene& scene, int element) 
   Entry& e = entries_[size_t(element)];
   const cad::SurfacePtr surface = el.type == ElementType::Lens ? cad::SurfacePtr(el.lens.front) : el.surface;
   if (!e.surface || e.surface != surface || e.tess_u != el.tess_u || e.tess_v != el.tess_v ||
-      e.has_outline != el.has_outline || (el.has_outline && !sameOutline(e.outline, el.outline))) {
+      e.has_outline != el.has_outline || (el.has_outline && e.outline != el.outline)) {
     e.grid = tessellateElement(el);
     e.surface = surface;
     e.tess_u = el.tess_u, e.tess_v = el.tess_v;

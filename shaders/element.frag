@@ -61,8 +61,7 @@ uniform sampler2D u_surf_p;       // surface maps over the parameter domain (pvr
 uniform sampler2D u_surf_du;      // position, first derivatives and unit normal
 uniform sampler2D u_surf_dv;
 uniform sampler2D u_surf_n;
-uniform vec4 u_sm;                // texture coordinate = (u, v) * u_sm.xy + u_sm.zw
-uniform vec4 u_uv_box;            // the parameter domain: u0, v0, u1, v1
+uniform vec2 u_sm;                // texture coordinate = (s, t) * u_sm.x + u_sm.y ((s, t): normalised parameters)
 #else
 uniform sampler2D u_lens_front;   // refractor height maps (pvrr/lens_height_map.h): z, outward unit normal
 uniform sampler2D u_lens_back;
@@ -130,19 +129,28 @@ vec3 impostorHit(vec3 x, vec3 R) {
 }
 
 #if !defined(LENS)
-// The parameters of the surface point on the view ray from e with direction v (both local), from the
-// fragment's interpolated parameters: Gauss-Newton steps on the ray's distance from the map's point (the
-// rasterised triangle lies within its sag of the surface, a few steps of its own size away).
+// The normalised parameters of the surface point on the view ray from e with direction v (both local), from
+// the fragment's interpolated ones: Gauss-Newton steps on the ray's distance from the map's point (the
+// rasterised triangle lies within its sag of the surface, a few steps of its own size away), each at most a
+// tenth of the domain, until the distance is below 1e-7 of the point's distance from e (float rounding) or
+// the ray runs along the surface. The caller tests the distance left.
 vec2 surfaceHit(vec2 uv, vec3 e, vec3 v) {
-  for (int i = 0; i < 3; ++i) {
-    vec2 st = uv * u_sm.xy + u_sm.zw;
+  for (int i = 0; i < 6; ++i) {
+    vec2 st = uv * u_sm.x + u_sm.y;
     vec3 w = bilinear(u_surf_p, st).xyz - e;
+    vec3 r = w - dot(w, v) * v;
+    if (length(r) <= 1e-7 * length(w)) break;
     vec3 su = bilinear(u_surf_du, st).xyz, sv = bilinear(u_surf_dv, st).xyz;
-    vec3 r = w - dot(w, v) * v, a = su - dot(su, v) * v, b = sv - dot(sv, v) * v;
-    float aa = dot(a, a), ab = dot(a, b), bb = dot(b, b), det = aa * bb - ab * ab;
-    if (!(det > 0.0)) break;
+    vec3 a = su - dot(su, v) * v, b = sv - dot(sv, v) * v;
+    float aa = dot(a, a), ab = dot(a, b), bb = dot(b, b);
+    // aa bb - ab^2 = ((su x sv) . v)^2 for vectors projected across v, computed without the cancellation.
+    float c = dot(cross(su, sv), v), det = c * c;
+    if (!(det > 1e-12 * aa * bb)) break;  // the ray runs along the surface
     vec2 g = vec2(dot(a, r), dot(b, r));
-    uv = clamp(uv - vec2(bb * g.x - ab * g.y, aa * g.y - ab * g.x) / det, u_uv_box.xy, u_uv_box.zw);
+    vec2 delta = -vec2(bb * g.x - ab * g.y, aa * g.y - ab * g.x) / det;
+    float len = length(delta);
+    if (len > 0.1) delta *= 0.1 / len;
+    uv = clamp(uv + delta, vec2(0.0), vec2(1.0));
   }
   return uv;
 }
@@ -197,7 +205,8 @@ float glassExit(vec3 p, vec3 d, out bool back) {
   // Outside already at the first step, from a point on the crossed surface itself (g0 ~ 0: a reflection off
   // it at a grazing angle): halve the step until the ray is inside, so that false position does not return
   // the root at p.
-  for (int k = 0; k < 16 && t0 == 0.0 && !(g0 > 1e-12); ++k) {
+  // (g0 below 1e-8 m: p's own height, which the searches leave within ~1e-9 m of the surface.)
+  for (int k = 0; k < 16 && t0 == 0.0 && g0 < 1e-8; ++k) {
     float th = 0.5 * t1;
     vec2 hh = insideHeights(p + th * d);
     if (min(hh.x, hh.y) > 0.0) {
@@ -205,8 +214,10 @@ float glassExit(vec3 p, vec3 d, out bool back) {
     } else {
       t1 = th, h1 = hh;
       back = h1.x <= h1.y;
+      g0 = back ? h0.x : h0.y;
     }
   }
+  if (t0 == 0.0 && g0 < 1e-8) return t1;  // outside within nanometres of p: that is the crossing
   float g1 = back ? h1.x : h1.y;
   g0 = max(g0, 0.0);
   if (g0 - g1 <= 0.0) return t1;
@@ -309,9 +320,10 @@ void main() {
   // there, from the surface maps, in place of the triangle's point and the interpolated vertex normals.
   // A view ray that misses the surface within its outline (at the silhouette, where the triangles reach past
   // the surface, or past the trimmed outline) sees past the mirror, as in the tracer: the fragment is dropped
-  // and the environment drawn after the elements fills the pixel.
+  // and the environment drawn after the elements fills the pixel. So is one whose search did not come within
+  // 1e-5 of its distance (counted by the tests as holes: none in the shipped mirrors).
   vec3 e = u_to_local * (u_view_origin - u_seen_offset), vl = u_to_local * view;
-  vec2 st = surfaceHit(v_st1.xy, e, vl) * u_sm.xy + u_sm.zw;
+  vec2 st = surfaceHit(v_st1.xy, e, vl) * u_sm.x + u_sm.y;
   vec4 sp = bilinear(u_surf_p, st);  // w: 1 inside the outline
   vec3 w = sp.xyz - e;
   if (sp.w < 0.5 || length(w - dot(w, vl) * vl) > 1e-5 * length(w)) discard;

@@ -347,7 +347,7 @@ struct Renderer::Impl {
   // wavelengths.
   const Program& impostorProgram(bool lens, int channels) const {
     std::vector<std::string> d{"#define MODE_IMPOSTOR",
-                               "#define IMPOSTOR_ITERATIONS " + std::to_string(options.impostor_iterations),
+                               "#define IMPOSTOR_ITERATIONS " + std::to_string(scene.render.impostor_iterations),
                                "#define IMPOSTOR_CHANNELS " + std::to_string(channels)};
     if (lens) d.push_back("#define LENS");
     return builtProgram("element.vert", "element.frag", d);
@@ -394,6 +394,7 @@ struct Renderer::Impl {
   struct LensMaps {
     GLuint front = 0, back = 0, mask = 0;
     cad::SagSurfacePtr front_surface, back_surface;  // what they were built from (held: never a reused address)
+    cad::Outline outline;                            // and the outline of their mask
     LensHeightMap map;
   };
   std::vector<LensMaps> lens_maps;
@@ -402,6 +403,8 @@ struct Renderer::Impl {
   struct MirrorMaps {
     std::array<GLuint, 4> textures{};  // position (RGBA32F, w: outline mask), du, dv (RGBA16F), normal (RGBA32F)
     cad::SurfacePtr surface;           // what they were built from (held: never a reused address)
+    bool has_outline = false;          // and the outline of their mask
+    cad::Outline outline;
     SurfaceMap map;                    // its domain and size; the samples are dropped once uploaded
   };
   std::vector<MirrorMaps> mirror_maps;
@@ -609,7 +612,8 @@ struct Renderer::Impl {
   bool lensMapsStale(size_t e) {
     const LensMaps& m = lensMaps(e);
     const Element& el = scene.elements[e];
-    return !m.front || m.front_surface != el.lens.front || m.back_surface != el.lens.back;
+    return !m.front || m.front_surface != el.lens.front || m.back_surface != el.lens.back ||
+           m.outline != el.lens.outline;
   }
   // Builds and uploads lens e's height maps (RGBA32F: z and the outward normal) and its outline mask (R32F);
   // returns 1.
@@ -619,20 +623,26 @@ struct Renderer::Impl {
     m.map = buildLensHeightMap(el, options.lens_height_map_size);
     m.front_surface = el.lens.front;
     m.back_surface = el.lens.back;
+    m.outline = el.lens.outline;
     uploadDataTexture(m.front, GL_RGBA32F, m.map.nx, m.map.ny, 4, m.map.front.data());
     uploadDataTexture(m.back, GL_RGBA32F, m.map.nx, m.map.ny, 4, m.map.back.data());
     uploadDataTexture(m.mask, GL_R32F, m.map.nx, m.map.ny, 1, m.map.inside.data());
     checkGlError("uploading a lens's refractor height maps");
     return 1;
   }
-  // Mirror e's surface maps, rebuilt when missing or built from another surface; returns 1 when built.
+  // Mirror e's surface maps, rebuilt when missing or built from another surface or outline; returns 1 when
+  // built.
   int updateMirrorMaps(size_t e) {
     if (mirror_maps.size() < scene.elements.size()) mirror_maps.resize(scene.elements.size());
     MirrorMaps& m = mirror_maps[e];
     const Element& el = scene.elements[e];
-    if (m.textures[0] && m.surface == el.surface) return 0;
+    if (m.textures[0] && m.surface == el.surface && m.has_outline == el.has_outline &&
+        (!el.has_outline || m.outline == el.outline))
+      return 0;
     m.map = buildSurfaceMap(*el.surface, options.surface_map_size, el.has_outline ? &el.outline : nullptr);
     m.surface = el.surface;
+    m.has_outline = el.has_outline;
+    m.outline = el.outline;
     // The derivatives only steer the shader's Gauss-Newton steps: half floats do.
     const std::vector<float>* data[4] = {&m.map.position, &m.map.du, &m.map.dv, &m.map.normal};
     const GLint formats[4] = {GL_RGBA32F, GL_RGBA16F, GL_RGBA16F, GL_RGBA32F};
@@ -641,15 +651,14 @@ struct Renderer::Impl {
     for (auto* a : {&m.map.position, &m.map.du, &m.map.dv, &m.map.normal}) std::vector<float>().swap(*a);
     return 1;
   }
-  // The uniforms of a mirror's impostor draw: its surface maps on units 2 to 5, the map's placement in its
-  // parameter domain, and its pose.
+  // The uniforms of a mirror's impostor draw: its surface maps on units 2 to 5, the samples' placement in
+  // their textures, and its pose.
   void setMirrorMaps(const Program& p, size_t e) {
     const MirrorMaps& m = mirror_maps.at(e);
     bindDataTextures(p, 2, {{"u_surf_p", m.textures[0]}, {"u_surf_du", m.textures[1]}, {"u_surf_dv", m.textures[2]},
                             {"u_surf_n", m.textures[3]}});
-    const double n = m.map.n, su = (n - 1) / n / (m.map.u1 - m.map.u0), sv = (n - 1) / n / (m.map.v1 - m.map.v0);
-    p.set("u_sm", glm::vec4(float(su), float(sv), float(0.5 / n - m.map.u0 * su), float(0.5 / n - m.map.v0 * sv)));
-    p.set("u_uv_box", glm::vec4(float(m.map.u0), float(m.map.v0), float(m.map.u1), float(m.map.v1)));
+    const double n = m.map.n;
+    p.set("u_sm", glm::vec2(float((n - 1) / n), float(0.5 / n)));
     p.set("u_to_local", glm::mat3(Mat3(scene.elements[e].world_to_local)));
   }
 
@@ -683,16 +692,22 @@ struct Renderer::Impl {
   // Whole-element mesh (plain, envmap and impostor modes, and elements drawn dark at the depth limit):
   // position relative to the element's origin, normal; for an envmap lens the exact exit direction of each
   // vertex's ray in a_st0 and its Fresnel transmittance in a_w0 (the "refraction vectors" baseline); the
-  // vertex's surface parameters (u, v) in a_st1 (the impostor mirror's start on its surface maps).
+  // vertex's surface parameters (u, v), normalised to the surface's domain, in a_st1 (the impostor mirror's
+  // start on its surface maps).
   void uploadElementGrid(MeshBuffers& mb, const ElementFrame& f, const Vec3& anchor) {
     std::vector<float> data;
     data.reserve(f.world_pos.size() * kElementFloats);
     const bool has_rays = !f.rays.empty();
+    const cad::ParamDomain domain = scene.elements[size_t(f.element)].frontSurface().domain();
     for (size_t i = 0; i < f.world_pos.size(); ++i) {
       glm::vec3 p(f.world_pos[i] - anchor), n(f.world_normal[i]);
       const glm::vec3 d = has_rays ? glm::vec3(f.rays[0][i].dir) : glm::vec3(0, 0, 1);
       const glm::vec3 tr = has_rays ? glm::vec3(f.rays[0][i].transmittance) : glm::vec3(1);
-      const glm::vec2 uv = i < f.grid.params.size() ? glm::vec2(f.grid.params[i]) : glm::vec2(0);
+      // The surface parameters normalised to the domain in double (pvrr/surface_map.h).
+      const glm::vec2 uv = i < f.grid.params.size()
+                               ? glm::vec2((f.grid.params[i].x - domain.u0) / (domain.u1 - domain.u0),
+                                           (f.grid.params[i].y - domain.v0) / (domain.v1 - domain.v0))
+                               : glm::vec2(0.5f);
       data.insert(data.end(), {p.x, p.y, p.z, n.x, n.y, n.z, d.x, d.y, d.z, uv.x, uv.y, 1, 0, 0, 1, tr.x, tr.y, tr.z,
                                0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0});
     }

@@ -42,9 +42,6 @@ struct RasterFrame {
 
 struct RendererOptions {
   int map_size = 1024;              // first-pass map's longer side at most (pvrr), cube face size (envmap, impostor)
-  // impostor: the false-position steps of each fragment's search of the distance impostor, after the two
-  // first guesses (the search stops early where it has converged to float precision).
-  int impostor_iterations = 8;
   // impostor: the longer side (texels) of a lens's refractor height maps (pvrr/lens_height_map.h), and the
   // side of a mirror's surface maps (pvrr/surface_map.h); each built once per renderer.
   int lens_height_map_size = 512;

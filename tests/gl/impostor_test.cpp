@@ -26,6 +26,14 @@ namespace {
 
 using test::medianArcmin;
 
+// Pixels where the reference sees an element but the frame does not (the impostor drops mirror fragments whose
+// view ray misses the surface, or whose search does not converge).
+size_t holes(const TracedFrame& ref, const gl::RasterFrame& f) {
+  size_t n = 0;
+  for (size_t i = 0; i < ref.color.size(); ++i) n += ref.element[i] >= 0 && f.element[i] != ref.element[i];
+  return n;
+}
+
 // Per-pixel angular errors (arcmin) where both the reference and the frame see element `element`.
 std::vector<double> elementErrors(const TracedFrame& ref, const std::vector<Vec3>& ref_seen, const gl::RasterFrame& f) {
   std::vector<double> e;
@@ -143,6 +151,10 @@ TEST_P(ImpostorTest, CarMirrorFarBelowTheCubeMap) {
     perr += (dp.x + dp.y + dp.z) / 3;
     csum += (ref.color[i].x + ref.color[i].y + ref.color[i].z) / 3;
   }
+  // Holes: mirror pixels of the reference the impostor drops (measured 19 of 6,847 at the rim, where pvrr's
+  // element pixels differ from the reference's at 11).
+  std::cout << "[ measured ] car mirror: " << holes(ref, f) << " holes against pvrr's " << holes(ref, pf) << "\n";
+  EXPECT_LE(holes(ref, f), agree / 200);
   std::cout << "[ measured ] car mirror: impostor median " << impostor << "', envmap " << envmap << "'; colour error "
             << cerr / csum << " of the colour over " << agree << " px (pvrr " << perr / csum << ")\n";
   EXPECT_LE(impostor, 0.03);
@@ -159,10 +171,9 @@ TEST_P(ImpostorTest, CarMirrorFarBelowTheCubeMap) {
   EXPECT_NE(fp->note.find("distance impostors"), std::string::npos) << fp->note;
 }
 
-// render.impostor_iterations: the false-position steps after the two first guesses. On a planar environment
-// the first guesses are exact already (the reading lens's page: the same error at 0 as at 8); where the street
-// has depth edges the steps matter: the car mirror's p95 falls from thousands of arcminutes with none to tens
-// with the default 8 (measured at 320 x 240: 5,500' -> 54-140').
+// render.impostor_iterations (read from the scene by the renderer): the false-position steps after the two
+// first guesses. Where the street has depth edges they matter: the car mirror's p95 at 160 x 120 falls from
+// 5,455' with none to 32' with the default 8 (the median stays ~0.04').
 TEST_P(ImpostorTest, SearchStepsConvergeAtDepthEdges) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
@@ -174,7 +185,6 @@ TEST_P(ImpostorTest, SearchStepsConvergeAtDepthEdges) {
     const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
     gl::RendererOptions o;
     o.map_size = 512;
-    o.impostor_iterations = s.render.impostor_iterations;
     const gl::RasterFrame f = gl::Renderer(s, rays, o).render(gl::RasterMode::Impostor);
     expectFinite(f);
     const std::vector<double> e = elementErrors(ref, ref.seen, f);
@@ -203,6 +213,7 @@ TEST_P(ImpostorTest, MirrorAccuracyDoesNotDependOnTheMesh) {
     const gl::RasterFrame f = gl::Renderer(s, rays, o).render(gl::RasterMode::Impostor);
     expectFinite(f);
     const std::vector<double> e = elementErrors(ref, ref.seen, f);
+    EXPECT_EQ(holes(ref, f), 0u) << tess;  // measured: none
     std::cout << "[ measured ] saddle at " << tess << " x " << tess << ": median " << quantile(e, 0.5) << "', p95 "
               << quantile(e, 0.95) << "' over " << e.size() << " px\n";
     ASSERT_GT(e.size(), 1000u);

@@ -96,7 +96,7 @@ void expectSameFarAway(gl::RasterMode mode, bool lens) {
       ++differ;
       continue;
     }
-    ++pixels;
+    pixels += near.element[i] >= 0;
     // Colours: the same shading of the same relative geometry; float rounding of the camera-relative
     // positions (~1e-7 relative) moves an edge by a pixel at most, so compare the bulk.
     if (glm::length(near.color[i] - far.color[i]) > 1e-3) ++differ;
@@ -113,7 +113,7 @@ void expectSameFarAway(gl::RasterMode mode, bool lens) {
     EXPECT_LT(far.median_arcmin, 1.0) << gl::modeName(mode);
     EXPECT_NEAR(far.median_arcmin, near.median_arcmin, 0.01 + 0.05 * near.median_arcmin) << gl::modeName(mode);
   }
-  EXPECT_GT(pixels, 0u);
+  EXPECT_GT(pixels, 500u);  // element pixels compared
 }
 
 TEST_P(LargeCoordinatesTest, SceneMillionsOfMetresAwayRendersAsAtTheOrigin) {

@@ -71,6 +71,9 @@ TEST(LensHeightMap, SamplesLieOnTheExactSurfacesWithOutwardNormals) {
     const double expected = kPi / 4 / ((1 + 2 * kHeightMapMargin) * (1 + 2 * kHeightMapMargin));
     EXPECT_NEAR(share, expected, 2.0 / std::min(m.nx, m.ny)) << name;
     EXPECT_EQ(m.clamped_texels, 0) << name;
+    // The shader's search stops at the map's reach: no straight path inside the outline is longer than the
+    // diagonal of the outline's box.
+    EXPECT_GE(m.reach, glm::length(hi - lo)) << name;
   }
 }
 

@@ -9,6 +9,7 @@
 #include <random>
 
 #include "cad/error.h"
+#include "cad/sag.h"
 #include "pvrr/surface_map.h"
 #include "support/scenes.h"
 
@@ -40,8 +41,10 @@ TEST(SurfaceMap, SamplesLieOnTheExactSurface) {
       const SurfaceMapSample got = sampleSurfaceMap(m, u, v);
       worst_p = std::max(worst_p, glm::length(got.position - exact.p));
       worst_n = std::max(worst_n, angleBetween(got.normal, surf.normal(u, v)));
-      worst_d = std::max(worst_d, std::max(glm::length(got.du - exact.du), glm::length(got.dv - exact.dv)));
-      scale_d = std::max(scale_d, std::max(glm::length(exact.du), glm::length(exact.dv)));
+      // Stored with respect to the normalised parameters.
+      const Vec3 du = exact.du * (d.u1 - d.u0), dv = exact.dv * (d.v1 - d.v0);
+      worst_d = std::max(worst_d, std::max(glm::length(got.du - du), glm::length(got.dv - dv)));
+      scale_d = std::max(scale_d, std::max(glm::length(du), glm::length(dv)));
     }
     std::printf("[ measured ] %s: position %.3g m, normal %.3g rad, derivatives %.3g of %.3g\n", c.scene, worst_p,
                 worst_n, worst_d, scale_d);
@@ -50,7 +53,7 @@ TEST(SurfaceMap, SamplesLieOnTheExactSurface) {
     // The derivatives only steer the shader's Gauss-Newton steps: a few per cent would do; they are far better.
     EXPECT_LE(worst_d, 0.01 * scale_d) << c.scene;
     // The mask: where the four samples around (u, v) are all inside the outline the map says inside, where all
-    // are outside it says outside.
+    // are outside it says outside. (Between, the shader's 0.5 threshold places the rim to half a sample.)
     if (el.has_outline) {
       int wrong = 0, checked = 0;
       const double su = (d.u1 - d.u0) / 511, sv = (d.v1 - d.v0) / 511;
@@ -68,6 +71,25 @@ TEST(SurfaceMap, SamplesLieOnTheExactSurface) {
       EXPECT_EQ(wrong, 0) << c.scene;
     }
   }
+}
+
+// A sphere mirror (radius 0.12 m) whose circular outline (0.2 m across) has its box's corners beyond the
+// radius, where the sag is undefined: those samples are taken from points moved towards the centre, marked
+// outside the outline, and the map builds.
+TEST(SurfaceMap, SamplesWhereTheSurfaceIsUndefinedMoveInwards) {
+  const cad::Outline disc = cad::Outline::circle(0.2);
+  const cad::SagSurfacePtr sphere = cad::makeSphere(0.12, disc);
+  const SurfaceMap m = buildSurfaceMap(*sphere, 64, &disc);
+  EXPECT_GT(m.moved_samples, 0);
+  EXPECT_LT(m.moved_samples, 64 * 64 / 4);
+  // The corner sample (u0, v0) was moved, and lies outside the outline.
+  EXPECT_EQ(m.position[3], 0.0f);
+  for (float x : m.position) EXPECT_TRUE(std::isfinite(x));
+  // The centre is evaluated where it lies, inside (to the interpolation between samples 3.2 mm apart:
+  // h^2/8 (2/R) = 2.1e-5 m).
+  const SurfaceMapSample c = sampleSurfaceMap(m, 0.0, 0.0);
+  EXPECT_NEAR(c.position.z, sphere->evaluate(0, 0).p.z, 3e-5);
+  EXPECT_GE(c.inside, 0.5);
 }
 
 TEST(SurfaceMap, RejectsBadSizes) {
