@@ -224,9 +224,9 @@ float glassExit(vec3 p, vec3 d, out bool back) {
   int side = 0;
   for (int i = 0; i < 16; ++i) {
     t = (t0 * g1 - t1 * g0) / (g1 - g0);
-    vec2 hh = insideHeights(p + t * d);
-    float g = back ? hh.x : hh.y;
-    if (abs(g) < 1e-9) break;  // a nanometre (float heights resolve ~1e-9 m at lens scale)
+    vec3 q = p + t * d;
+    float zs = lensTexel(back, q.xy).x, g = back ? q.z - zs : zs - q.z;  // the crossed surface's only
+    if (abs(g) < 1e-8) break;  // 10 nm: float heights at lens scale resolve ~1e-9 m, no finer
     if (g > 0.0) {
       t0 = t, g0 = g;
       if (side == 1) g1 *= 0.5;
@@ -249,7 +249,7 @@ vec3 entryPoint(vec3 x, vec3 v, bool back) {
   float tb = -ga / v.z;
   vec3 q = x + tb * v;
   float gb = q.z - lensTexel(back, q.xy).x;
-  for (int i = 0; i < 6 && abs(gb) > 1e-9 && gb != ga; ++i) {
+  for (int i = 0; i < 6 && abs(gb) > 1e-8 && gb != ga; ++i) {  // to 10 nm, as glassExit
     float tc = tb - gb * (tb - ta) / (gb - ga);
     ta = tb, ga = gb, tb = tc;
     q = x + tb * v;
