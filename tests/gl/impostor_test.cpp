@@ -67,14 +67,14 @@ std::pair<double, double> colourError(const TracedFrame& ref, const gl::RasterFr
   return {err / double(std::max<size_t>(n, 1)), sum / double(std::max<size_t>(n, 1))};
 }
 
-// The reference frame, an impostor frame (finite everywhere) and its errors, and envmap's median.
+// The reference frame, an impostor frame (finite everywhere) and its errors, and envmap's median (when asked).
 struct ImpostorRun {
   TracedFrame ref;
   gl::RasterFrame f;
   std::vector<double> errors;  // sorted, arcmin
   double envmap_median = 0;
 };
-ImpostorRun runImpostor(const Scene& s) {
+ImpostorRun runImpostor(const Scene& s, bool with_envmap = true) {
   ImpostorRun run;
   RayScene rays(s);
   TraceOptions to;
@@ -86,7 +86,7 @@ ImpostorRun runImpostor(const Scene& s) {
   run.f = r.render(gl::RasterMode::Impostor);
   expectFinite(run.f);
   run.errors = elementErrors(run.ref, run.ref.seen, run.f);
-  run.envmap_median = medianArcmin(run.ref, r.render(gl::RasterMode::Envmap));
+  if (with_envmap) run.envmap_median = medianArcmin(run.ref, r.render(gl::RasterMode::Envmap));
   return run;
 }
 
@@ -179,15 +179,9 @@ TEST_P(ImpostorTest, SearchStepsConvergeAtDepthEdges) {
   if (!ctx) return;
   std::vector<double> p95;
   for (const int iterations : {0, 8}) {
-    Scene s = test::shippedScene("car-mirror", {"observer.image_size=[160,120]",
-                                                "render.impostor_iterations=" + std::to_string(iterations)});
-    RayScene rays(s);
-    const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
-    gl::RendererOptions o;
-    o.map_size = 512;
-    const gl::RasterFrame f = gl::Renderer(s, rays, o).render(gl::RasterMode::Impostor);
-    expectFinite(f);
-    const std::vector<double> e = elementErrors(ref, ref.seen, f);
+    const ImpostorRun run = runImpostor(test::shippedScene(
+        "car-mirror", {"observer.image_size=[160,120]", "render.impostor_iterations=" + std::to_string(iterations)}), false);
+    const std::vector<double>& e = run.errors;
     std::cout << "[ measured ] car mirror, " << iterations << " search steps: median " << quantile(e, 0.5)
               << "', p95 " << quantile(e, 0.95) << "'\n";
     p95.push_back(quantile(e, 0.95));
@@ -204,16 +198,10 @@ TEST_P(ImpostorTest, MirrorAccuracyDoesNotDependOnTheMesh) {
   if (!ctx) return;
   std::vector<double> medians;
   for (const int tess : {5, 15}) {
-    Scene s = test::shippedScene("saddle-mirror", {"observer.image_size=[160,120]",
-                                                   "elements[0].tessellation=" + std::to_string(tess)});
-    RayScene rays(s);
-    const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
-    gl::RendererOptions o;
-    o.map_size = 512;
-    const gl::RasterFrame f = gl::Renderer(s, rays, o).render(gl::RasterMode::Impostor);
-    expectFinite(f);
-    const std::vector<double> e = elementErrors(ref, ref.seen, f);
-    EXPECT_EQ(holes(ref, f), 0u) << tess;  // measured: none
+    const ImpostorRun run = runImpostor(test::shippedScene(
+        "saddle-mirror", {"observer.image_size=[160,120]", "elements[0].tessellation=" + std::to_string(tess)}), false);
+    const std::vector<double>& e = run.errors;
+    EXPECT_EQ(holes(run.ref, run.f), 0u) << tess;  // measured: none
     std::cout << "[ measured ] saddle at " << tess << " x " << tess << ": median " << quantile(e, 0.5) << "', p95 "
               << quantile(e, 0.95) << "' over " << e.size() << " px\n";
     ASSERT_GT(e.size(), 1000u);
