@@ -6,6 +6,7 @@
 #include <tbb/parallel_for.h>
 
 #include "cad/error.h"
+#include "pvrr/bilinear.h"
 
 namespace pvrr {
 
@@ -74,20 +75,8 @@ LensHeightMap buildLensHeightMap(const Element& lens, int n) {
 }
 
 Vec4 sampleHeightMap(const LensHeightMap& m, bool back, double x, double y) {
-  const std::vector<float>& data = back ? m.back : m.front;
-  // GL_LINEAR: texel centres at (i + 0.5); clamp to edge.
-  const double u = (x - m.x0) / m.dx - 0.5, v = (y - m.y0) / m.dy - 0.5;
-  const double fu = std::floor(u), fv = std::floor(v);
-  const double a = u - fu, b = v - fv;
-  auto texel = [&](int i, int j) {
-    i = std::clamp(i, 0, m.nx - 1);
-    j = std::clamp(j, 0, m.ny - 1);
-    const size_t k = 4 * (size_t(j) * size_t(m.nx) + size_t(i));
-    return Vec4(data[k], data[k + 1], data[k + 2], data[k + 3]);
-  };
-  const int i = int(fu), j = int(fv);
-  Vec4 s = (1 - a) * (1 - b) * texel(i, j) + a * (1 - b) * texel(i + 1, j) + (1 - a) * b * texel(i, j + 1) +
-           a * b * texel(i + 1, j + 1);
+  // Texel centres at (i + 0.5) texels from the map's corner.
+  const Vec4 s = bilinearSample(back ? m.back : m.front, m.nx, m.ny, (x - m.x0) / m.dx - 0.5, (y - m.y0) / m.dy - 0.5);
   const Vec3 nrm = glm::normalize(Vec3(s.y, s.z, s.w));
   return Vec4(s.x, nrm.x, nrm.y, nrm.z);
 }

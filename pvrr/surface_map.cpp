@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 
 #include "cad/error.h"
+#include "pvrr/bilinear.h"
 
 namespace pvrr {
 
@@ -64,23 +65,12 @@ SurfaceMap buildSurfaceMap(const cad::Surface& surface, int n, const cad::Outlin
 }
 
 SurfaceMapSample sampleSurfaceMap(const SurfaceMap& m, double u, double v) {
-  // Sample coordinates: the samples sit at texel centres.
+  // The domain's corners are samples: sample coordinates run from 0 to n - 1 across it.
   const double x = std::clamp((u - m.u0) / (m.u1 - m.u0), 0.0, 1.0) * (m.n - 1);
   const double y = std::clamp((v - m.v0) / (m.v1 - m.v0), 0.0, 1.0) * (m.n - 1);
-  const int i = std::min(int(x), m.n - 2), j = std::min(int(y), m.n - 2);
-  const double a = x - i, b = y - j;
-  auto at = [&](const std::vector<float>& data, int ii, int jj) {
-    const size_t k = 4 * (size_t(jj) * size_t(m.n) + size_t(ii));
-    return Vec3(data[k], data[k + 1], data[k + 2]);
-  };
-  auto lerp = [&](const std::vector<float>& data) {
-    return (1 - a) * (1 - b) * at(data, i, j) + a * (1 - b) * at(data, i + 1, j) + (1 - a) * b * at(data, i, j + 1) +
-           a * b * at(data, i + 1, j + 1);
-  };
-  const size_t k0 = 4 * (size_t(j) * size_t(m.n) + size_t(i)) + 3, k1 = k0 + 4, k2 = k0 + 4 * size_t(m.n), k3 = k2 + 4;
-  const double inside = (1 - a) * (1 - b) * m.position[k0] + a * (1 - b) * m.position[k1] +
-                        (1 - a) * b * m.position[k2] + a * b * m.position[k3];
-  return {lerp(m.position), lerp(m.du), lerp(m.dv), glm::normalize(lerp(m.normal)), inside};
+  auto at = [&](const std::vector<float>& data) { return bilinearSample(data, m.n, m.n, x, y); };
+  const Vec4 p = at(m.position);
+  return {Vec3(p), Vec3(at(m.du)), Vec3(at(m.dv)), glm::normalize(Vec3(at(m.normal))), p.w};
 }
 
 }  // namespace pvrr

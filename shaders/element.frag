@@ -176,7 +176,7 @@ vec2 insideHeights(vec3 q) { return vec2(q.z - lensTexel(true, q.xy).x, lensTexe
 // and which (back or front, the nearer crossing, as the tracer takes the nearer of its two surfaces). It steps
 // out, doubling, to where it leaves the slab between the surfaces' extreme heights or the maps' reach; then
 // false position with the Illinois halving on the crossed surface's filtered height, between the last step
-// inside and the first outside (so the root at p itself is never taken). The first step covers half the
+// inside and the first outside (past the root at p itself, see below). The first step covers half the
 // height of the surface ahead (in d.z's direction) above or below p, or 1 um when p lies on that surface
 // (after a reflection off it). -1: no crossing.
 float glassExit(vec3 p, vec3 d, out bool back) {
@@ -202,10 +202,9 @@ float glassExit(vec3 p, vec3 d, out bool back) {
   if (t1 < 0.0) return -1.0;
   if (t0 > 0.0) h0 = insideHeights(p + t0 * d);
   float g0 = back ? h0.x : h0.y;
-  // Outside already at the first step, from a point on the crossed surface itself (g0 ~ 0: a reflection off
-  // it at a grazing angle): halve the step until the ray is inside, so that false position does not return
-  // the root at p.
-  // (g0 below 1e-8 m: p's own height, which the searches leave within ~1e-9 m of the surface.)
+  // Outside already at the first step, from a point on the crossed surface itself (g0 below 1e-8 m: p's own
+  // height, which the searches leave within ~1e-9 m of the surface; a reflection off it at a grazing angle):
+  // halve the step until the ray is inside, so that false position does not return the root at p.
   for (int k = 0; k < 16 && t0 == 0.0 && g0 < 1e-8; ++k) {
     float th = 0.5 * t1;
     vec2 hh = insideHeights(p + th * d);
@@ -261,8 +260,7 @@ vec3 entryPoint(vec3 x, vec3 v, bool back) {
 // One wavelength's path through the lens (local frame) from the entry point x, where the view direction v
 // meets the surface with outward normal n. It refracts in, then follows the events inside the glass as the
 // tracer does up to its depth limit (u_max_events; render.max_depth is at most 64): each is an exit
-// (refraction, exact Fresnel)
-// or a total internal reflection. Returns the exit point and sets the exit direction and the transmittance;
+// (refraction, exact Fresnel) or a total internal reflection. Returns the exit point and sets the exit direction and the transmittance;
 // transmittance 0: absorbed, at the returned point (the depth limit) or, with `rim`, where the ray left the
 // outline (the tracer's lens has no rim surface: its seen point lies u_far along `dir`, the ray inside).
 vec3 throughLens(vec3 x, vec3 v, vec3 n, float eta, out vec3 dir, out float transmittance, out bool rim) {

@@ -604,22 +604,14 @@ struct Renderer::Impl {
     return count;
   }
 
-  LensMaps& lensMaps(size_t e) {
+  // Lens e's height maps (RGBA32F: z and the outward normal) and outline mask (R32F), rebuilt when missing or
+  // built from other surfaces or another outline; returns 1 when built.
+  int updateLensMaps(size_t e) {
     if (lens_maps.size() < scene.elements.size()) lens_maps.resize(scene.elements.size());
-    return lens_maps[e];
-  }
-  // Lens e's maps: whether they are missing or were built from other surfaces.
-  bool lensMapsStale(size_t e) {
-    const LensMaps& m = lensMaps(e);
+    LensMaps& m = lens_maps[e];
     const Element& el = scene.elements[e];
-    return !m.front || m.front_surface != el.lens.front || m.back_surface != el.lens.back ||
-           m.outline != el.lens.outline;
-  }
-  // Builds and uploads lens e's height maps (RGBA32F: z and the outward normal) and its outline mask (R32F);
-  // returns 1.
-  int createLensMaps(size_t e) {
-    LensMaps& m = lensMaps(e);
-    const Element& el = scene.elements[e];
+    if (m.front && m.front_surface == el.lens.front && m.back_surface == el.lens.back && m.outline == el.lens.outline)
+      return 0;
     m.map = buildLensHeightMap(el, options.lens_height_map_size);
     m.front_surface = el.lens.front;
     m.back_surface = el.lens.back;
@@ -666,7 +658,7 @@ struct Renderer::Impl {
   // and outline mask on units 2 to 4, their placement, its pose, its index at the R, G and B wavelengths, and
   // the tracer's depth limit and far distance.
   void setLensMaps(const Program& p, size_t e) {
-    const LensMaps& m = lensMaps(e);
+    const LensMaps& m = lens_maps.at(e);
     const Element& el = scene.elements[e];
     bindDataTextures(p, 2, {{"u_lens_front", m.front}, {"u_lens_back", m.back}, {"u_lens_mask", m.mask}});
     p.set("u_hm_reach", float(m.map.reach));
@@ -1550,8 +1542,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
         culled.add(drawEnvironment(glm::lookAt(centre, centre + kCubeDir[face], kCubeUp[face]), proj, centre, false,
                                    nullptr, false, with_seen));
       }
-      if (mode == RasterMode::Impostor && scene.elements[e].type == ElementType::Lens && lensMapsStale(e))
-        height_maps += createLensMaps(e);
+      if (mode == RasterMode::Impostor && scene.elements[e].type == ElementType::Lens) height_maps += updateLensMaps(e);
       if (mode == RasterMode::Impostor && scene.elements[e].type == ElementType::Mirror) surface_maps += updateMirrorMaps(e);
     }
     glFinish();
