@@ -15,6 +15,11 @@
 //                traced per fragment in the lens's refractor height maps (pvrr/lens_height_map.h).
 //                IMPOSTOR_ITERATIONS: the search's false-position steps; IMPOSTOR_CHANNELS 3: a lens's R, G
 //                and B each refracted with its own index (u_index), else the middle one only.
+//                CUBE_ELEMENTS n (2 to 4): the scene's n elements each have cube maps in which the other mirrors
+//                are drawn with their surface point and normal (distance-normal impostors, seeds 000): a search
+//                that meets one reflects there and goes on in that mirror's cube (followCubes).
+//                CUBE_GEOMETRY: a mirror drawn into another element's cube: its exact surface point as the
+//                seen point, and its normal and element id in the surface output.
 //   MODE_PLAIN   a plain grey shaded surface (raster mode); u_dark: black, an element met at the depth limit
 //                inside another element's map (the tracer absorbs there)
 //   LENS         the element is a lens (transmission) rather than a mirror (reflection)
@@ -56,6 +61,20 @@ uniform samplerCube u_seen_cube;
 uniform samplerCube u_cube;       // the environment's colour from the element's origin (the envmap cube)
 uniform samplerCube u_seen_cube;  // its seen points relative to that origin (u_seen_offset): the distances
 uniform mat3 u_to_local;          // world directions -> the element's local frame (whose origin is the cube's)
+#if defined(CUBE_ELEMENTS)
+// Per element (index): its cubes (colour; seen points, whose lengths are the distances; normal and index + 1
+// of a mirror drawn in them, 0 elsewhere), their origin relative to the camera origin, and its mirror material.
+uniform samplerCube u_cubes[CUBE_ELEMENTS];
+uniform samplerCube u_seen_cubes[CUBE_ELEMENTS];
+uniform samplerCube u_normal_cubes[CUBE_ELEMENTS];
+uniform vec3 u_cube_centre[CUBE_ELEMENTS];
+uniform bool u_el_metal[CUBE_ELEMENTS];
+uniform vec3 u_el_reflectance[CUBE_ELEMENTS];
+uniform vec3 u_el_metal_n[CUBE_ELEMENTS];
+uniform vec3 u_el_metal_k[CUBE_ELEMENTS];
+uniform int u_self;               // this element's index
+uniform int u_max_depth;          // render.max_depth: the tracer absorbs at an element met after that many events
+#endif
 #if !defined(LENS)
 uniform sampler2D u_surf_p;       // surface maps over the parameter domain (pvrr/surface_map.h), local frame:
 uniform sampler2D u_surf_du;      // position, first derivatives and unit normal
@@ -95,24 +114,24 @@ vec4 bilinear(sampler2D t, vec2 st) {
 
 // The distance from the cube's origin to what it sees in direction dir (the sky's seen point lies u_far along
 // its ray: a sure overshoot for every nearer point).
-float envDistance(vec3 dir) { return length(texture(u_seen_cube, dir).xyz); }
+float envDistance(samplerCube seen, vec3 dir) { return length(texture(seen, dir).xyz); }
 
 // Seeds 003, section 2.2: the point of the ray x + d R (x relative to the cube's origin, R unit, d >= 0) at the
 // distance the impostor holds for its own direction. The first guesses assume a surface perpendicular to R at
 // the distance seen along R, then a plane through the two samples; then false position between the last
 // undershooting (in front of the surface) and overshooting parameters, 0 while there is none (the direction
 // R itself, at infinity, stands in for a missing overshoot, as in the paper).
-vec3 impostorHit(vec3 x, vec3 R) {
-  float r1 = envDistance(R);
+vec3 impostorHit(samplerCube seen, vec3 x, vec3 R) {
+  float r1 = envDistance(seen, R);
   float dp = r1 - dot(x, R);
   vec3 p = x + R * dp;
-  float ppp = length(p) / envDistance(p);
+  float ppp = length(p) / envDistance(seen, p);
   float dun = 0.0, dov = 0.0, pun = ppp, pov = ppp;
   if (ppp < 1.0) dun = dp; else dov = dp;
   float dl = max(dp + r1 * (1.0 - ppp), 0.0);
   vec3 l = x + R * dl;
   for (int i = 0; i < IMPOSTOR_ITERATIONS; ++i) {
-    float llp = length(l) / envDistance(l);
+    float llp = length(l) / envDistance(seen, l);
     if (abs(1.0 - llp) < 1e-6) break;  // as close as float distances resolve
     float ddl;
     if (llp < 1.0) {  // undershooting
@@ -260,10 +279,12 @@ vec3 entryPoint(vec3 x, vec3 v, bool back) {
 // One wavelength's path through the lens (local frame) from the entry point x, where the view direction v
 // meets the surface with outward normal n. It refracts in, then follows the events inside the glass as the
 // tracer does up to its depth limit (u_max_events; render.max_depth is at most 64): each is an exit
-// (refraction, exact Fresnel) or a total internal reflection. Returns the exit point and sets the exit direction and the transmittance;
+// (refraction, exact Fresnel) or a total internal reflection. Returns the exit point and sets the exit
+// direction, the transmittance and the tracer's events spent on the way (entry, inside, exit);
 // transmittance 0: absorbed, at the returned point (the depth limit) or, with `rim`, where the ray left the
 // outline (the tracer's lens has no rim surface: its seen point lies u_far along `dir`, the ray inside).
-vec3 throughLens(vec3 x, vec3 v, vec3 n, float eta, out vec3 dir, out float transmittance, out bool rim) {
+vec3 throughLens(vec3 x, vec3 v, vec3 n, float eta, out vec3 dir, out float transmittance, out bool rim,
+                 out int spent) {
   float cos_i = -dot(v, n);
   vec3 d = refract(v, n, 1.0 / eta);
   transmittance = 1.0 - fresnelDielectric(cos_i, 1.0, eta);
@@ -285,12 +306,14 @@ vec3 throughLens(vec3 x, vec3 v, vec3 n, float eta, out vec3 dir, out float tran
     if (out_dir != vec3(0.0)) {
       dir = out_dir;
       transmittance *= 1.0 - fresnelDielectric(c, eta, 1.0);
+      spent = event + 2;  // the entry, the events inside, the exit
       return p;
     }
     d = reflect(d, nout);  // total internal reflection
   }
   dir = d;
   transmittance = 0.0;
+  spent = 0;
   return p;
 }
 #endif
@@ -307,6 +330,59 @@ float fresnelConductor(float cos_i, float n, float k) {
   float rp = rs * (c2 * a2b2 + s2 * s2 - 2.0 * A * cos_i * s2) / (c2 * a2b2 + s2 * s2 + 2.0 * A * cos_i * s2);
   return 0.5 * (rs + rp);
 }
+
+#if defined(CUBE_ELEMENTS)
+// Seeds 000 and 001's multi-bounce loop over distance-normal impostors. The ray from x (relative to the camera
+// origin) along R, with `depth` of the tracer's events spent, is searched in the cubes of element `cur`; where
+// it meets another mirror drawn there, it reflects at the found point with that mirror's normal and material
+// (exact Fresnel) and goes on in that mirror's cubes, as the tracer does: absorbed at an element met after
+// u_max_depth events, dark at a mirror's back. Returns the colour; `seen`: the last point, relative to the
+// camera origin (w 0: escaping).
+#define CUBE_LOOKUP(k)                                                                                              \
+  if (cur == k) {                                                                                                  \
+    centre = u_cube_centre[k];                                                                                     \
+    l = impostorHit(u_seen_cubes[k], x - centre, R);                                                               \
+    c = texture(u_cubes[k], l).rgb;                                                                                \
+    s = texture(u_seen_cubes[k], l);                                                                               \
+    nid = texture(u_normal_cubes[k], l);                                                                           \
+  }
+vec3 followCubes(int cur, vec3 x, vec3 R, int depth, out vec4 seen) {
+  vec3 throughput = vec3(1.0);
+  for (int bounce = 0; bounce < 64; ++bounce) {
+    vec3 centre = vec3(0.0), l = R, c = vec3(0.0);
+    vec4 s = vec4(0.0), nid = vec4(0.0);
+    CUBE_LOOKUP(0)
+    CUBE_LOOKUP(1)
+#if CUBE_ELEMENTS > 2
+    CUBE_LOOKUP(2)
+#endif
+#if CUBE_ELEMENTS > 3
+    CUBE_LOOKUP(3)
+#endif
+    // The index is filtered like the rest: where texels of a mirror and of what lies behind it blend, the
+    // nearer half decides.
+    int hit = int(floor(nid.w + 0.5)) - 1;
+    if (hit < 0 || hit >= CUBE_ELEMENTS || hit == cur) {
+      seen = vec4(s.xyz + centre, s.w);
+      return throughput * c;
+    }
+    vec3 p = centre + l, n = normalize(nid.xyz);
+    seen = vec4(p, 1.0);
+    if (depth >= u_max_depth) return vec3(0.0);  // the tracer's depth limit: absorbed
+    float cos_i = -dot(R, n);
+    if (cos_i <= 0.0) return throughput * 0.05 * shadeDiffuse(vec3(1.0), p, -n);  // the mirror's back
+    throughput *= u_el_metal[hit] ? vec3(fresnelConductor(cos_i, u_el_metal_n[hit].r, u_el_metal_k[hit].r),
+                                         fresnelConductor(cos_i, u_el_metal_n[hit].g, u_el_metal_k[hit].g),
+                                         fresnelConductor(cos_i, u_el_metal_n[hit].b, u_el_metal_k[hit].b))
+                                  : u_el_reflectance[hit];
+    R = reflect(R, n);
+    x = p;
+    cur = hit;
+    ++depth;
+  }
+  return vec3(0.0);
+}
+#endif
 
 void main() {
   vec3 n = normalize(v_normal);
@@ -329,6 +405,13 @@ void main() {
   n = normalize(bilinear(u_surf_n, st).xyz * u_to_local);
   view = normalize(pos - u_view_origin);
   cos_i = -dot(view, n);
+  o_surface = vec4(pos, u_element_id);
+#if defined(CUBE_GEOMETRY)
+  o_color = vec4(0.0);
+  o_seen = vec4(pos, 1.0);
+  o_surface = vec4(n, u_element_id);
+  return;
+#endif
 #endif
 #if defined(MODE_PLAIN)
   vec3 nf = cos_i < 0.0 ? -n : n;
@@ -364,25 +447,38 @@ void main() {
         vec3 dir;
         float tr;
         bool rim;
-        vec3 q = throughLens(entry, v, n_in, u_index[k], dir, tr, rim);
+        int spent;
+        vec3 q = throughLens(entry, v, n_in, u_index[k], dir, tr, rim, spent);
         bool seen_here = ch == (IMPOSTOR_CHANNELS == 3 ? u_seen_channel : 0);
         if (tr <= 0.0) {  // absorbed, as in the tracer: dark
           if (seen_here) seen = rim ? vec4((q + u_far * dir) * u_to_local, 0.0) : vec4(q * u_to_local, 1.0);
           continue;
         }
         // Back to world axes: the local frame's origin is the cube's.
-        vec3 l = impostorHit(q * u_to_local, dir * u_to_local);
+#if defined(CUBE_ELEMENTS)
+        vec4 s;
+        vec3 rgb = tr * followCubes(u_self, q * u_to_local + u_seen_offset, dir * u_to_local, spent, s);
+        if (seen_here) seen = vec4(s.xyz - u_seen_offset, s.w);
+#else
+        vec3 l = impostorHit(u_seen_cube, q * u_to_local, dir * u_to_local);
         vec3 rgb = tr * texture(u_cube, l).rgb;
+        if (seen_here) seen = texture(u_seen_cube, l);
+#endif
         if (IMPOSTOR_CHANNELS == 3) c[ch] = rgb[ch];
         else c = rgb;
-        if (seen_here) seen = texture(u_seen_cube, l);
       }
     }
   }
 #else
-  vec3 l = impostorHit(pos - u_seen_offset, reflect(view, n));
+#if defined(CUBE_ELEMENTS)
+  vec4 seen;
+  vec3 c = followCubes(u_self, pos, reflect(view, n), 1, seen);
+  seen.xyz -= u_seen_offset;
+#else
+  vec3 l = impostorHit(u_seen_cube, pos - u_seen_offset, reflect(view, n));
   vec3 c = texture(u_cube, l).rgb;
   vec4 seen = texture(u_seen_cube, l);
+#endif
 #endif
 #elif defined(MODE_PVRR)
 #if CHANNELS == 3 && defined(RGB_CHANNELS)

@@ -344,13 +344,20 @@ struct Renderer::Impl {
     return planes ? planesVariant("sky.vert", "sky.frag", {}) : sky_program;
   }
   // Distance-impostor elements (shaders/element.frag, MODE_IMPOSTOR): a mirror, or a lens with one or three
-  // wavelengths.
-  const Program& impostorProgram(bool lens, int channels) const {
+  // wavelengths; cube_elements > 0: searches that meet a mirror in a cube go on in its cubes (CUBE_ELEMENTS).
+  const Program& impostorProgram(bool lens, int channels, int cube_elements) const {
     std::vector<std::string> d{"#define MODE_IMPOSTOR",
                                "#define IMPOSTOR_ITERATIONS " + std::to_string(scene.render.impostor_iterations),
                                "#define IMPOSTOR_CHANNELS " + std::to_string(channels)};
     if (lens) d.push_back("#define LENS");
+    if (cube_elements > 0) d.push_back("#define CUBE_ELEMENTS " + std::to_string(cube_elements));
     return builtProgram("element.vert", "element.frag", d);
+  }
+  // A mirror drawn into another element's impostor cubes: its surface point and normal (CUBE_GEOMETRY).
+  const Program& cubeGeometryProgram() const {
+    return builtProgram("element.vert", "element.frag",
+                        {"#define MODE_IMPOSTOR", "#define IMPOSTOR_ITERATIONS 0", "#define IMPOSTOR_CHANNELS 1",
+                         "#define CUBE_GEOMETRY", kWithSeenPoints});
   }
   const Program& plainProgram(bool planes) const {
     return planes ? planesVariant("element.vert", "element.frag", {"#define MODE_PLAIN"}) : plain_program;
@@ -367,6 +374,7 @@ struct Renderer::Impl {
   GLuint empty_vao = 0;
   GLuint mask_vao = 0, mask_vbo = 0;  // closeUnreadTexels' quads
   int max_texture_size = 0;  // GL_MAX_TEXTURE_SIZE
+  int max_texture_units = 0;  // GL_MAX_TEXTURE_IMAGE_UNITS
   std::vector<MeshBuffers> env_meshes;
   std::vector<bool> env_faceted;  // per environment mesh: every triangle has one normal at its three corners
   std::vector<bool> env_textured;  // per environment mesh: its material has a texture
@@ -414,6 +422,7 @@ struct Renderer::Impl {
   Impl(const Scene& s, const RayScene& r, RendererOptions o) : scene(s), rays(r), options(std::move(o)) {
     glGenVertexArrays(1, &empty_vao);
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture_size);
+    glGetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &max_texture_units);
     for (const pvrr::Texture& t : scene.textures) {
       ImageRGB8 image;
       image.width = t.width;
@@ -671,6 +680,67 @@ struct Renderer::Impl {
     const double* wl = kRgbWavelengths_nm;
     p.set("u_index", glm::vec3(float(el.dispersion.index(wl[0])), float(el.dispersion.index(wl[1])),
                                float(el.dispersion.index(wl[2]))));
+  }
+
+  // Impostor mode with several elements (seeds 000's distance-normal impostors): each element's cubes also show
+  // the other mirrors, with their surface points and normals, and a search that meets one goes on in that
+  // mirror's cubes. The number of elements the fragment loop switches between (CUBE_ELEMENTS), or 0: one
+  // element, no mirror to meet, or more elements than kMaxCubeElements or the texture units allow (then each
+  // cube shows the environment only). Lenses are not drawn in other elements' cubes.
+  static constexpr int kMaxCubeElements = 4;
+  static constexpr int kFirstCubeUnit = 6;  // after a cube pair (0, 1) and the element's own maps (2 to 5)
+  int cubeElements(RasterMode mode) const {
+    const int n = int(scene.elements.size());
+    const bool mirror = std::any_of(scene.elements.begin(), scene.elements.end(),
+                                    [](const Element& e) { return e.type == ElementType::Mirror; });
+    if (mode != RasterMode::Impostor || n < 2 || !mirror || n > kMaxCubeElements ||
+        kFirstCubeUnit + 3 * n > max_texture_units)
+      return 0;
+    return n;
+  }
+  // The uniforms of the fragment loop over every element's cubes (CUBE_ELEMENTS), for element e drawn from a
+  // camera at `origin`: three cubes per element on units from kFirstCubeUnit, their origins, the mirrors'
+  // materials, and the tracer's depth limit.
+  void setCubeElements(const Program& p, size_t e, const Vec3& origin) const {
+    for (size_t k = 0; k < scene.elements.size(); ++k) {
+      const Element& el = scene.elements[k];
+      const std::string i = "[" + std::to_string(k) + "]";
+      const char* names[3] = {"u_cubes", "u_seen_cubes", "u_normal_cubes"};
+      for (int a = 0; a < 3; ++a) {
+        const int unit = kFirstCubeUnit + 3 * int(k) + a;
+        glActiveTexture(GLenum(GL_TEXTURE0 + unit));
+        glBindTexture(GL_TEXTURE_CUBE_MAP, cubes[k]->colors[size_t(a)]);
+        p.set(names[a] + i, unit);
+      }
+      p.set("u_cube_centre" + i, glm::vec3(Vec3(el.local_to_world[3]) - origin));
+      p.set("u_el_metal" + i, el.mirror.metal ? 1 : 0);
+      p.set("u_el_reflectance" + i, glm::vec3(el.mirror.reflectance));
+      p.set("u_el_metal_n" + i, glm::vec3(el.mirror.n));
+      p.set("u_el_metal_k" + i, glm::vec3(el.mirror.k));
+    }
+    glActiveTexture(GL_TEXTURE0);
+    p.set("u_self", int(e));
+    p.set("u_max_depth", scene.render.max_depth);
+  }
+
+  // Mirror m drawn into a face of another element's impostor cubes, from a camera at `origin` (view_proj
+  // relative to it): its exact surface point and normal per fragment (CUBE_GEOMETRY), before the environment.
+  void drawCubeMirror(size_t m, const Mat4& view_proj, const Vec3& origin, const MeshBuffers& mesh) {
+    const Element& el = scene.elements[m];
+    const Vec3 anchor = Vec3(el.local_to_world[3]);
+    const Program& p = cubeGeometryProgram();
+    p.use();
+    p.set("u_view_proj", toFloat(view_proj));
+    p.set("u_offset", glm::vec3(anchor - origin));
+    p.set("u_view_origin", glm::vec3(0.0f));
+    p.set("u_seen_offset", glm::vec3(anchor - origin));
+    setElementMaterial(p, el, int(m));
+    setMirrorMaps(p, m);
+    glDisable(GL_CULL_FACE);
+    glEnable(GL_DEPTH_TEST);
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_LESS);
+    draw(mesh);
   }
 
   void setElementMaterial(const Program& p, const Element& el, int index) const {
@@ -1526,11 +1596,27 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   } else if ((mode == RasterMode::Envmap || mode == RasterMode::Impostor) && n_el > 0) {
     while (cubes.size() < n_el) cubes.push_back(std::make_unique<CubeTarget>());
     CullCount culled;
-    // Impostor cube maps hold the seen points (each direction's distance) even in a colour-only frame.
+    // Impostor cube maps hold the seen points (each direction's distance) even in a colour-only frame, and with
+    // other mirrors in them (cubeElements) a third cube of their normals and indices.
     const bool with_seen = mode == RasterMode::Impostor;
-    const std::vector<GLenum> formats = options.seen_points || with_seen ? std::vector<GLenum>{GL_RGBA16F, GL_RGBA32F}
-                                                                         : std::vector<GLenum>{GL_RGBA16F};
+    const int follow = cubeElements(mode);
+    std::vector<GLenum> formats{GL_RGBA16F};
+    if (options.seen_points || with_seen) formats.push_back(GL_RGBA32F);
+    if (follow > 0) formats.push_back(GL_RGBA32F);
     int height_maps = 0, surface_maps = 0;
+    for (size_t e = 0; e < n_el && mode == RasterMode::Impostor; ++e) {
+      if (scene.elements[e].type == ElementType::Lens) height_maps += updateLensMaps(e);
+      else surface_maps += updateMirrorMaps(e);
+    }
+    // The mirrors other cubes show: each mesh uploaded once (element_meshes slots).
+    std::vector<size_t> cube_mesh(n_el, 0);
+    int drawn_in_cubes = 0;
+    for (size_t m = 0; m < n_el && follow > 0; ++m) {
+      if (scene.elements[m].type != ElementType::Mirror) continue;
+      const ElementFrame f = prepareElement(scene, int(m), &grid_cache.get(scene, int(m)));
+      cube_mesh[m] = next_mesh;
+      uploadElementGrid(meshSlot(), f, Vec3(scene.elements[m].local_to_world[3]));
+    }
     for (size_t e = 0; e < n_el; ++e) {
       CubeTarget& c = *cubes[e];
       if (c.size != options.map_size || c.colors.size() != formats.size()) c.create(options.map_size, formats);
@@ -1539,19 +1625,41 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       const Mat4 proj = glm::perspective(kPi / 2, 1.0, near_m, far_m);
       for (int face = 0; face < 6; ++face) {
         c.selectFace(face);
-        culled.add(drawEnvironment(glm::lookAt(centre, centre + kCubeDir[face], kCubeUp[face]), proj, centre, false,
-                                   nullptr, false, with_seen));
+        const Mat4 view = glm::lookAt(centre, centre + kCubeDir[face], kCubeUp[face]);
+        for (size_t m = 0; m < n_el && follow > 0; ++m)
+          if (m != e && scene.elements[m].type == ElementType::Mirror) {
+            drawCubeMirror(m, relativeViewProj(proj, view, centre), centre, element_meshes[cube_mesh[m]]);
+            drawn_in_cubes += face == 0;
+          }
+        culled.add(drawEnvironment(view, proj, centre, false, nullptr, false, with_seen));
       }
-      if (mode == RasterMode::Impostor && scene.elements[e].type == ElementType::Lens) height_maps += updateLensMaps(e);
-      if (mode == RasterMode::Impostor && scene.elements[e].type == ElementType::Mirror) surface_maps += updateMirrorMaps(e);
     }
     glFinish();
     std::string note = mode == RasterMode::Impostor ? "distance impostors: colour and seen-point cube maps" : "";
+    if (follow > 0) appendNote(note, "normal and index cube maps of the mirrors in them");
     if (height_maps > 0) appendNote(note, "refractor height maps of " + std::to_string(height_maps) + " lens(es) built");
     if (surface_maps > 0) appendNote(note, "surface maps of " + std::to_string(surface_maps) + " mirror(s) built");
     appendNote(note, cullNote(culled));
     out.stages.ran("first-pass", msSince(t0), -1, note);
-    out.stages.skipped("nested-passes", "mode " + modeName(mode) + ": other elements are absent from the cube maps");
+    const bool lenses = std::any_of(scene.elements.begin(), scene.elements.end(),
+                                    [](const Element& el) { return el.type == ElementType::Lens; });
+    if (follow > 0)
+      out.stages.ran("nested-passes", 0, drawn_in_cubes,
+                     std::to_string(drawn_in_cubes) + " mirror(s) drawn in other elements' cube maps with their normals "
+                     "(distance-normal impostors), followed per fragment up to render.max_depth = " +
+                         std::to_string(scene.render.max_depth) +
+                         (lenses ? "; lenses are absent from other elements' cube maps" : ""));
+    else if (n_el == 1)
+      out.stages.skipped("nested-passes", std::string("one ") + (has_lens ? "lens" : "mirror") + ": no nesting");
+    else if (mode == RasterMode::Impostor && !std::any_of(scene.elements.begin(), scene.elements.end(), [](const Element& el) {
+               return el.type == ElementType::Mirror;
+             }))
+      out.stages.skipped("nested-passes", "mode impostor: lenses are absent from other elements' cube maps");
+    else if (mode == RasterMode::Impostor)
+      out.stages.skipped("nested-passes", "mode impostor: more than " + std::to_string(kMaxCubeElements) +
+                                              " elements (or texture units): other elements are absent from the cube maps");
+    else
+      out.stages.skipped("nested-passes", "mode " + modeName(mode) + ": other elements are absent from the cube maps");
   } else {
     out.stages.skipped("first-pass", n_el == 0 ? "no mirror or lens in the scene" : "mode " + modeName(mode));
     out.stages.skipped("nested-passes", n_el == 0 ? "no mirror or lens in the scene" : "mode raster");
@@ -1609,9 +1717,10 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     } else {
       ElementFrame f = prepareElement(scene, int(e), &grid_cache.get(scene, int(e)));
       if (lens && mode == RasterMode::Envmap) traceVertexRays(rays, f, ob.eye, VertexStageOptions{});
+      const int follow = cubeElements(mode);
       const Program& p = mode == RasterMode::Raster ? plain_program
                          : mode == RasterMode::Impostor
-                             ? impostorProgram(lens, dispersionChannels(scene, int(e)).size() > 1 ? 3 : 1)
+                             ? impostorProgram(lens, dispersionChannels(scene, int(e)).size() > 1 ? 3 : 1, follow)
                              : (lens ? lens_envmap_program : envmap_program);
       p.use();
       p.set("u_view_proj", toFloat(vp));
@@ -1631,6 +1740,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
         p.set("u_seen_offset", glm::vec3(anchor - ob.eye));
       }
       if (mode == RasterMode::Impostor && !lens) setMirrorMaps(p, e);
+      if (follow > 0) setCubeElements(p, e, ob.eye);
       if (mode == RasterMode::Impostor && lens) {
         setLensMaps(p, e);
         p.set("u_seen_channel", options.seen_channel < 0 ? 1 : std::min(options.seen_channel, 2));
