@@ -17,6 +17,7 @@
 #include "app/report.h"
 #include "cad/error.h"
 #include "pvrr/gl/context.h"
+#include "pvrr/gl/gl.h"
 #include "pvrr/format.h"
 #include "pvrr/image.h"
 #include "pvrr/scene_json.h"
@@ -159,9 +160,14 @@ int cmdGlInfo(const std::vector<std::string>& argv) {
   Args a("gl-info", argv, {"gl"});
   if (!a.positional().empty()) usageError("gl-info", "unexpected argument \"" + a.positional()[0] + "\"");
   auto ctx = gl::GlContext::create(backendArg(a));
-  std::printf("backend: %s\nGL_VERSION: %s\nGL_RENDERER: %s\nGL_VENDOR: %s\nGLSL: %s\nhardware: %s\n",
+  // The limits the renderer adapts to: map sizes, and the texture units of impostor mode's several elements.
+  GLint max_size = 0, units = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+  glGetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &units);
+  std::printf("backend: %s\nGL_VERSION: %s\nGL_RENDERER: %s\nGL_VENDOR: %s\nGLSL: %s\nhardware: %s\n"
+              "GL_MAX_TEXTURE_SIZE: %d\nGL_MAX_TEXTURE_IMAGE_UNITS: %d\n",
               ctx->backendName().c_str(), ctx->glVersion().c_str(), ctx->glRenderer().c_str(), ctx->glVendor().c_str(),
-              ctx->glslVersion().c_str(), ctx->isHardware() ? "yes" : "no");
+              ctx->glslVersion().c_str(), ctx->isHardware() ? "yes" : "no", max_size, units);
   return 0;
 }
 

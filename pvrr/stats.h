@@ -2,7 +2,7 @@
 // "note" where a stage sets them).
 // Stage names later issues rely on: vertex-rays, refraction, viewpoint-fit, first-pass, second-pass,
 // colour-channels (count: the most channels of an element), nested-passes (count: first passes of
-// elements seen inside other elements' maps).
+// elements seen inside other elements' maps; impostor mode: draws of a mirror in another element's cubes).
 #pragma once
 #include <string>
 #include <vector>

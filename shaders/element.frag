@@ -359,14 +359,16 @@ vec3 followCubes(int cur, vec3 x, vec3 R, int depth, out vec4 seen) {
 #if CUBE_ELEMENTS > 3
     CUBE_LOOKUP(3)
 #endif
-    // The index is filtered like the rest: where texels of a mirror and of what lies behind it blend, the
-    // nearer half decides.
-    int hit = int(floor(nid.w + 0.5)) - 1;
+    // The normal and index are filtered like the rest, and the texels of what is not a mirror hold zero:
+    // where a mirror's texels blend with those of what lies behind it, |normal| is the mirror's weight, the
+    // larger weight decides, and the index divided by it is the mirror's.
+    float weight = length(nid.xyz);
+    int hit = weight >= 0.5 ? int(floor(nid.w / weight + 0.5)) - 1 : -1;
     if (hit < 0 || hit >= CUBE_ELEMENTS || hit == cur) {
       seen = vec4(s.xyz + centre, s.w);
       return throughput * c;
     }
-    vec3 p = centre + l, n = normalize(nid.xyz);
+    vec3 p = centre + l, n = nid.xyz / weight;
     seen = vec4(p, 1.0);
     if (depth >= u_max_depth) return vec3(0.0);  // the tracer's depth limit: absorbed
     float cos_i = -dot(R, n);

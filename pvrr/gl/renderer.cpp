@@ -1617,6 +1617,12 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       cube_mesh[m] = next_mesh;
       uploadElementGrid(meshSlot(), f, Vec3(scene.elements[m].local_to_world[3]));
     }
+    // No cube stays bound to the units the element programs read while cubes are drawn into.
+    for (GLenum unit : {GL_TEXTURE0, GL_TEXTURE1}) {
+      glActiveTexture(unit);
+      glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
+    }
+    glActiveTexture(GL_TEXTURE0);
     for (size_t e = 0; e < n_el; ++e) {
       CubeTarget& c = *cubes[e];
       if (c.size != options.map_size || c.colors.size() != formats.size()) c.create(options.map_size, formats);
@@ -1645,8 +1651,8 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
                                     [](const Element& el) { return el.type == ElementType::Lens; });
     if (follow > 0)
       out.stages.ran("nested-passes", 0, drawn_in_cubes,
-                     std::to_string(drawn_in_cubes) + " mirror(s) drawn in other elements' cube maps with their normals "
-                     "(distance-normal impostors), followed per fragment up to render.max_depth = " +
+                     std::to_string(drawn_in_cubes) + " draw(s) of a mirror in another element's cube maps, with its "
+                     "normals (distance-normal impostors), followed per fragment up to render.max_depth = " +
                          std::to_string(scene.render.max_depth) +
                          (lenses ? "; lenses are absent from other elements' cube maps" : ""));
     else if (n_el == 1)

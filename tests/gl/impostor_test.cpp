@@ -423,81 +423,95 @@ TEST_P(ImpostorTest, DepthLimitAbsorbsInsideTheGlassAsTheTracerDoes) {
 TEST_P(ImpostorTest, MirrorsFollowedThroughEachOthersCubes) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
-  Scene s = test::shippedScene("mirror-pair", {"observer.image_size=[320,240]"});
-  RayScene rays(s);
-  auto trace = [&](int max_depth) {
-    TraceOptions to;
-    to.max_depth = max_depth;
-    return Tracer(rays, to).render();
-  };
-  auto render = [&](int max_depth) {
-    s.render.max_depth = max_depth;
-    gl::RendererOptions o;
-    o.map_size = 512;
-    gl::RasterFrame f = gl::Renderer(s, rays, o).render(gl::RasterMode::Impostor);
-    expectFinite(f);
-    return f;
-  };
-  const TracedFrame ref4 = trace(4), ref2 = trace(2);
-  const gl::RasterFrame f4 = render(4), f2 = render(2);
-  // Errors (arcmin, sorted) and mean colour error relative to the reference's mean, over the pixels whose
-  // reference path meets `bounces` mirrors (0: two or more).
-  auto errors = [&](int bounces) {
-    std::vector<double> e;
-    double cerr = 0, csum = 0;
-    for (size_t i = 0; i < ref4.color.size(); ++i) {
-      if (ref4.element[i] < 0 || f4.element[i] != ref4.element[i]) continue;
-      if (bounces > 0 ? ref4.bounces[i] != bounces : ref4.bounces[i] < 2) continue;
-      e.push_back(arcminutes(angleBetween(ref4.seen[i] - ref4.element_point[i], f4.seen[i] - ref4.element_point[i])));
-      const Vec3 d = glm::abs(f4.color[i] - ref4.color[i]);
-      cerr += d.x + d.y + d.z;
-      csum += ref4.color[i].x + ref4.color[i].y + ref4.color[i].z;
+  // As shipped (the mirrors are elements 0 and 1), and with a lens first, out of sight below the floor: the
+  // mirrors are then elements 1 and 2, whose indices the cubes' filtered texels must still name at their rims.
+  for (const bool lens_first : {false, true}) {
+    Scene s = test::shippedScene("mirror-pair", {"observer.image_size=[320,240]"});
+    if (lens_first) {
+      const cad::Outline disc = cad::Outline::circle(0.04);
+      Element lens = test::roomLensScene("lens", cad::makeSphere(-0.1, disc), cad::makeSphere(0.1, disc), 0.0015, disc)
+                         .elements[0];
+      lens.local_to_world = test::pose(Vec3(0, -50, 0), Vec3(0, 0, 1));
+      lens.world_to_local = glm::inverse(lens.local_to_world);
+      s.elements.insert(s.elements.begin(), lens);
+      s.updateBounds();
     }
-    std::sort(e.begin(), e.end());
-    return std::make_pair(e, cerr / std::max(csum, 1e-30));
-  };
-  const auto [nested, nested_colour] = errors(0);
-  std::cout << "[ measured ] mirror pair on " << gl::glBackendName(GetParam()) << ": two or more mirrors median "
-            << quantile(nested, 0.5) << "', p90 " << quantile(nested, 0.9) << "' (" << nested.size()
-            << " px), colour error " << 100 * nested_colour << " %; by mirrors met:";
-  for (int b = 1; b <= 4; ++b) {
-    const auto [e, c] = errors(b);
-    std::cout << " " << b << ": " << quantile(e, 0.5) << "' (" << e.size() << " px, colour " << 100 * c << " %)";
+    const std::string label = lens_first ? "mirror pair after a lens" : "mirror pair";
+    RayScene rays(s);
+    auto trace = [&](int max_depth) {
+      TraceOptions to;
+      to.max_depth = max_depth;
+      return Tracer(rays, to).render();
+    };
+    auto render = [&](int max_depth) {
+      s.render.max_depth = max_depth;
+      gl::RendererOptions o;
+      o.map_size = 512;
+      gl::RasterFrame f = gl::Renderer(s, rays, o).render(gl::RasterMode::Impostor);
+      expectFinite(f);
+      return f;
+    };
+    const TracedFrame ref4 = trace(4), ref2 = trace(2);
+    const gl::RasterFrame f4 = render(4), f2 = render(2);
+    // Errors (arcmin, sorted) and mean colour error relative to the reference's mean, over the pixels whose
+    // reference path meets `bounces` mirrors (0: two or more).
+    auto errors = [&](int bounces) {
+      std::vector<double> e;
+      double cerr = 0, csum = 0;
+      for (size_t i = 0; i < ref4.color.size(); ++i) {
+        if (ref4.element[i] < 0 || f4.element[i] != ref4.element[i]) continue;
+        if (bounces > 0 ? ref4.bounces[i] != bounces : ref4.bounces[i] < 2) continue;
+        e.push_back(arcminutes(angleBetween(ref4.seen[i] - ref4.element_point[i], f4.seen[i] - ref4.element_point[i])));
+        const Vec3 d = glm::abs(f4.color[i] - ref4.color[i]);
+        cerr += d.x + d.y + d.z;
+        csum += ref4.color[i].x + ref4.color[i].y + ref4.color[i].z;
+      }
+      std::sort(e.begin(), e.end());
+      return std::make_pair(e, cerr / std::max(csum, 1e-30));
+    };
+    const auto [nested, nested_colour] = errors(0);
+    std::cout << "[ measured ] " << label << " on " << gl::glBackendName(GetParam()) << ": two or more mirrors median "
+              << quantile(nested, 0.5) << "', p90 " << quantile(nested, 0.9) << "' (" << nested.size()
+              << " px), colour error " << 100 * nested_colour << " %; by mirrors met:";
+    for (int b = 1; b <= 4; ++b) {
+      const auto [e, c] = errors(b);
+      std::cout << " " << b << ": " << quantile(e, 0.5) << "' (" << e.size() << " px, colour " << 100 * c << " %)";
+    }
+    std::cout << "; holes " << holes(ref4, f4) << "\n";
+    ASSERT_GT(nested.size(), 2000u) << label;
+    EXPECT_LE(quantile(nested, 0.5), 0.05) << label;
+    EXPECT_LE(quantile(nested, 0.9), 2.0) << label;
+    EXPECT_LE(quantile(errors(1).first, 0.5), 0.01) << label;
+    EXPECT_LE(nested_colour, 0.02) << label;
+    EXPECT_LE(holes(ref4, f4), ref4.color.size() / 1000) << label;  // 16 of 76,800 measured, at the rims
+    // Depth 2: where the reference path at depth 4 meets three mirrors or more, the tracer at depth 2 absorbs
+    // at the third: black, its seen point on that mirror's surface.
+    size_t deep = 0, dark = 0, same_point = 0;
+    for (size_t i = 0; i < ref4.color.size(); ++i) {
+      if (ref4.element[i] < 0 || ref4.bounces[i] < 3 || f2.element[i] != ref2.element[i]) continue;
+      ++deep;
+      dark += ref2.color[i] == Vec3(0.0) && glm::length(f2.color[i]) < 1e-6;
+      same_point += glm::length(f2.seen[i] - ref2.seen[i]) < 1e-3;
+    }
+    std::cout << "[ measured ] " << label << ", max_depth 2: " << dark << " of " << deep << " px dark in both, "
+              << same_point << " absorbed within 1 mm of the reference's point\n";
+    ASSERT_GT(deep, 50u) << label;
+    EXPECT_GE(dark, deep * 95 / 100) << label;
+    EXPECT_GE(same_point, deep * 80 / 100) << label;
+    // The stats say what was drawn in the cubes: each mirror in the other's cubes (and in the lens's).
+    const StageTiming* nest = f4.stages.find("nested-passes");
+    ASSERT_NE(nest, nullptr);
+    EXPECT_TRUE(nest->ran);
+    EXPECT_EQ(nest->count, lens_first ? 4 : 2) << nest->note;
+    EXPECT_NE(nest->note.find("render.max_depth = 4"), std::string::npos) << nest->note;
   }
-  std::cout << "; holes " << holes(ref4, f4) << "\n";
-  ASSERT_GT(nested.size(), 2000u);
-  EXPECT_LE(quantile(nested, 0.5), 0.05);
-  EXPECT_LE(quantile(nested, 0.9), 2.0);
-  EXPECT_LE(quantile(errors(1).first, 0.5), 0.01);
-  EXPECT_LE(nested_colour, 0.02);
-  EXPECT_LE(holes(ref4, f4), ref4.color.size() / 200);
-  // Depth 2: where the reference path at depth 4 meets three mirrors or more, the tracer at depth 2 absorbs at
-  // the third: black, its seen point on that mirror's surface.
-  size_t deep = 0, dark = 0, same_point = 0;
-  for (size_t i = 0; i < ref4.color.size(); ++i) {
-    if (ref4.element[i] < 0 || ref4.bounces[i] < 3 || f2.element[i] != ref2.element[i]) continue;
-    ++deep;
-    dark += ref2.color[i] == Vec3(0.0) && glm::length(f2.color[i]) < 1e-6;
-    same_point += glm::length(f2.seen[i] - ref2.seen[i]) < 1e-3;
-  }
-  std::cout << "[ measured ] max_depth 2: " << dark << " of " << deep << " px dark in both, " << same_point
-            << " absorbed within 1 mm of the reference's point\n";
-  ASSERT_GT(deep, 50u);
-  EXPECT_GE(dark, deep * 95 / 100);
-  EXPECT_GE(same_point, deep * 80 / 100);
-  // The stats say what was drawn in the cubes.
-  const StageTiming* nest = f4.stages.find("nested-passes");
-  ASSERT_NE(nest, nullptr);
-  EXPECT_TRUE(nest->ran);
-  EXPECT_EQ(nest->count, 2);  // each mirror in the other's cubes
-  EXPECT_NE(nest->note.find("render.max_depth = 4"), std::string::npos) << nest->note;
 }
 
 // A lens in front of a mirror: what the -10 D lens shows of the mirror 1 m behind it (turned 30 deg, so that it
 // sends the rays to the side wall) comes from the mirror drawn in the lens's cubes, followed from the lens's
 // exit with the events the glass spent (entry and exit) counted towards render.max_depth. Lenses are not drawn
-// in other elements' cubes, and the stats say so. Measured: median 0.0004' over the pixels whose path
-// leaves the lens for the mirror (against 5675' with the cubes showing the room only).
+// in other elements' cubes, and the stats say so. Measured: median 0.0013' and p95 0.0076' over the pixels
+// whose path leaves the lens for the mirror (against 5675' with the cubes showing the room only).
 TEST_P(ImpostorTest, LensSeesAMirrorInItsCubes) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
@@ -527,7 +541,15 @@ TEST_P(ImpostorTest, LensSeesAMirrorInItsCubes) {
     ++n;
     dark += glm::length(f2.color[i]) < 1e-6;
   }
+  ASSERT_GT(n, 1000u);
   EXPECT_GE(dark, n * 99 / 100) << dark << " of " << n;
+  // With 3 the mirror is the third event: reflected, not dark.
+  s.render.max_depth = 3;
+  const gl::RasterFrame f3 = impostorFrame(s);
+  size_t lit = 0;
+  for (size_t i = 0; i < run.ref.color.size(); ++i)
+    lit += run.ref.element[i] == 0 && f3.element[i] == 0 && run.ref.bounces[i] == 3 && glm::length(f3.color[i]) > 1e-3;
+  EXPECT_GE(lit, n * 99 / 100) << lit << " of " << n;
   const StageTiming* nest = run.f.stages.find("nested-passes");
   ASSERT_NE(nest, nullptr);
   EXPECT_TRUE(nest->ran);
