@@ -11,6 +11,7 @@
 #include "pvrr/gl/renderer.h"
 #include "pvrr/tracer.h"
 #include "support/gl_backends.h"
+#include "support/scenes.h"
 #include "support/test_scenes.h"
 
 namespace pvrr {
@@ -51,14 +52,23 @@ Scene lensInARoom(const Vec3& offset) {
   return s;
 }
 
+// The shipped mirror pair (a mirror seen in a mirror): pvrr's nested maps, impostor mode's mirrors in each
+// other's cube maps.
+Scene mirrorPair(const Vec3& offset) {
+  Scene s = test::shippedScene("mirror-pair", {"observer.image_size=[120,90]"});
+  translate(s, offset);
+  return s;
+}
+enum class Kind { Mirror, Lens, MirrorPair };
+
 struct Result {
   std::vector<Vec3> color, seen_rel;  // seen points relative to the eye
   std::vector<int> element;
   double median_arcmin = 0;
 };
 
-Result run(const Vec3& offset, gl::RasterMode mode, bool lens = false) {
-  Scene s = lens ? lensInARoom(offset) : mirrorInARoom(offset);
+Result run(const Vec3& offset, gl::RasterMode mode, Kind kind) {
+  Scene s = kind == Kind::Lens ? lensInARoom(offset) : kind == Kind::MirrorPair ? mirrorPair(offset) : mirrorInARoom(offset);
   RayScene rays(s);
   TraceOptions to;
   to.max_depth = s.render.max_depth;
@@ -84,9 +94,9 @@ Result run(const Vec3& offset, gl::RasterMode mode, bool lens = false) {
 class LargeCoordinatesTest : public ::testing::TestWithParam<gl::GlBackend> {};
 
 // The same frame at the origin and far away: the same element pixels (to 1 %), colours and seen points.
-void expectSameFarAway(gl::RasterMode mode, bool lens) {
+void expectSameFarAway(gl::RasterMode mode, Kind kind) {
   const Vec3 far_away(3.2e6, 1.5e3, -5.4e6);  // UTM-like easting/northing, metres
-  const Result near = run(Vec3(0.0), mode, lens), far = run(far_away, mode, lens);
+  const Result near = run(Vec3(0.0), mode, kind), far = run(far_away, mode, kind);
   ASSERT_EQ(near.color.size(), far.color.size());
   size_t differ = 0, pixels = 0;
   double worst_seen = 0;
@@ -104,7 +114,7 @@ void expectSameFarAway(gl::RasterMode mode, bool lens) {
     // ones (which would be ~0.5 m).
     if (near.element[i] >= 0) worst_seen = std::max(worst_seen, glm::length(near.seen_rel[i] - far.seen_rel[i]));
   }
-  std::cout << "[ measured ] " << (lens ? "lens" : "mirror") << ", mode " << gl::modeName(mode) << ": " << differ
+  std::cout << "[ measured ] " << (kind == Kind::Lens ? "lens" : kind == Kind::MirrorPair ? "mirror pair" : "mirror") << ", mode " << gl::modeName(mode) << ": " << differ
             << " of " << near.color.size() << " pixels differ, seen points within " << worst_seen << " m, median "
             << near.median_arcmin << "' at the origin, " << far.median_arcmin << "' far away\n";
   EXPECT_LE(differ, near.color.size() / 100) << gl::modeName(mode);
@@ -121,14 +131,22 @@ TEST_P(LargeCoordinatesTest, SceneMillionsOfMetresAwayRendersAsAtTheOrigin) {
   if (!ctx) return;
   for (gl::RasterMode mode :
        {gl::RasterMode::Pvrr, gl::RasterMode::Envmap, gl::RasterMode::Impostor, gl::RasterMode::Raster})
-    expectSameFarAway(mode, false);
+    expectSameFarAway(mode, Kind::Mirror);
 }
 
 // A lens: pvrr's refraction on the CPU in doubles, the impostor's in the lens's own frame on the GPU.
 TEST_P(LargeCoordinatesTest, LensMillionsOfMetresAwayRendersAsAtTheOrigin) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
-  for (gl::RasterMode mode : {gl::RasterMode::Pvrr, gl::RasterMode::Impostor}) expectSameFarAway(mode, true);
+  for (gl::RasterMode mode : {gl::RasterMode::Pvrr, gl::RasterMode::Impostor}) expectSameFarAway(mode, Kind::Lens);
+}
+
+// A mirror seen in a mirror: pvrr's nested first passes from virtual viewpoints, the impostor's search
+// continued in the other mirror's cube maps, both in camera-relative coordinates.
+TEST_P(LargeCoordinatesTest, MirrorPairMillionsOfMetresAwayRendersAsAtTheOrigin) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  for (gl::RasterMode mode : {gl::RasterMode::Pvrr, gl::RasterMode::Impostor}) expectSameFarAway(mode, Kind::MirrorPair);
 }
 
 PVRR_GL_BACKENDS(LargeCoordinatesTest);
