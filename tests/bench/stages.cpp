@@ -75,6 +75,10 @@ BENCHMARK_CAPTURE(BM_RasterFrame, car_mirror_raster, "car-mirror", gl::RasterMod
 BENCHMARK_CAPTURE(BM_RasterFrame, car_mirror_impostor, "car-mirror", gl::RasterMode::Impostor)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_RasterFrame, spectacle_lens_impostor, "spectacle-lens", gl::RasterMode::Impostor)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_RasterFrame, spectacle_lens_pvrr, "spectacle-lens", gl::RasterMode::Pvrr)->Unit(benchmark::kMillisecond)->UseRealTime();
+// A mirror seen in a mirror: pvrr's nested first passes, and the impostor's two elements' cubes with the other
+// mirror drawn in each (a third cube of normals), followed per fragment.
+BENCHMARK_CAPTURE(BM_RasterFrame, mirror_pair_pvrr, "mirror-pair", gl::RasterMode::Pvrr)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_RasterFrame, mirror_pair_impostor, "mirror-pair", gl::RasterMode::Impostor)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 
