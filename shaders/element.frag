@@ -81,17 +81,26 @@ uniform sampler2D u_surf_du;      // position, first derivatives and unit normal
 uniform sampler2D u_surf_dv;
 uniform sampler2D u_surf_n;
 uniform vec2 u_sm;                // texture coordinate = (s, t) * u_sm.x + u_sm.y ((s, t): normalised parameters)
-#else
+#endif
+#if defined(LENS) || defined(LENS_IN_CUBES)
+// A lens's maps: this element's (LENS), or those of the scene's one lens, which other elements' cubes show
+// (LENS_IN_CUBES: followCubes refracts through it).
 uniform sampler2D u_lens_front;   // refractor height maps (pvrr/lens_height_map.h): z, outward unit normal
 uniform sampler2D u_lens_back;
 uniform sampler2D u_lens_mask;    // 1 inside the outline, 0 outside
 uniform vec4 u_hm;                // the maps' x0, y0, 1 / width, 1 / height (lens local, metres)
 uniform vec2 u_hm_z;              // the back surface's lowest z and the front surface's highest z
 uniform float u_hm_reach;         // the maps' diagonal: no straight path inside the glass is longer
-uniform int u_max_events;         // the events inside the glass the tracer follows: render.max_depth - 1
 uniform float u_far;              // render.far_distance_m: where a ray absorbed at the rim puts its seen point
 uniform vec3 u_index;             // the glass's index at the R, G and B wavelengths (.y: the d line)
+#endif
+#if defined(LENS)
+uniform int u_max_events;         // the events inside the glass the tracer follows: render.max_depth - 1
 uniform int u_seen_channel;       // IMPOSTOR_CHANNELS 3: the channel whose ray gives the seen point
+#endif
+#if defined(LENS_IN_CUBES)
+uniform int u_cube_lens;          // the lens's element index
+uniform mat3 u_lens_to_local;     // world directions -> the lens's local frame (whose origin is its cube's)
 #endif
 #elif defined(MODE_PLAIN)
 uniform bool u_dark;
@@ -173,7 +182,8 @@ vec2 surfaceHit(vec2 uv, vec3 e, vec3 v) {
   }
   return uv;
 }
-#else
+#endif
+#if defined(LENS) || defined(LENS_IN_CUBES)
 // Exact unpolarised dielectric Fresnel reflectance from index n1 into n2 (pvrr/optics.cpp fresnelDielectric).
 float fresnelDielectric(float cos_i, float n1, float n2) {
   float eta = n1 / n2, s2t = eta * eta * (1.0 - cos_i * cos_i);
@@ -278,13 +288,13 @@ vec3 entryPoint(vec3 x, vec3 v, bool back) {
 
 // One wavelength's path through the lens (local frame) from the entry point x, where the view direction v
 // meets the surface with outward normal n. It refracts in, then follows the events inside the glass as the
-// tracer does up to its depth limit (u_max_events; render.max_depth is at most 64): each is an exit
+// tracer does up to its depth limit (max_events; render.max_depth is at most 64): each is an exit
 // (refraction, exact Fresnel) or a total internal reflection. Returns the exit point and sets the exit
 // direction, the transmittance and the tracer's events spent on the way (entry, inside, exit);
 // transmittance 0: absorbed, at the returned point (the depth limit) or, with `rim`, where the ray left the
 // outline (the tracer's lens has no rim surface: its seen point lies u_far along `dir`, the ray inside).
-vec3 throughLens(vec3 x, vec3 v, vec3 n, float eta, out vec3 dir, out float transmittance, out bool rim,
-                 out int spent) {
+vec3 throughLens(vec3 x, vec3 v, vec3 n, float eta, int max_events, out vec3 dir, out float transmittance,
+                 out bool rim, out int spent) {
   float cos_i = -dot(v, n);
   vec3 d = refract(v, n, 1.0 / eta);
   transmittance = 1.0 - fresnelDielectric(cos_i, 1.0, eta);
@@ -298,7 +308,7 @@ vec3 throughLens(vec3 x, vec3 v, vec3 n, float eta, out vec3 dir, out float tran
       break;
     }
     p += t * d;
-    if (event >= u_max_events) break;  // absorbed at p
+    if (event >= max_events) break;  // absorbed at p
     vec3 nout = normalize(lensTexel(back, p.xy).yzw);
     float c = dot(d, nout);
     if (c <= 0.0) break;  // met from outside: a path the maps cannot represent
@@ -336,7 +346,9 @@ float fresnelConductor(float cos_i, float n, float k) {
 // origin) along R, with `depth` of the tracer's events spent, is searched in the cubes of element `cur`; where
 // it meets another mirror drawn there, it reflects at the found point with that mirror's normal and material
 // (exact Fresnel) and goes on in that mirror's cubes, as the tracer does: absorbed at an element met after
-// u_max_depth events, dark at a mirror's back. Returns the colour; `seen`: the last point, relative to the
+// u_max_depth events, dark at a mirror's back. LENS_IN_CUBES: where it meets the scene's lens, it enters the
+// lens's height maps where the ray meets the surface, refracts through the glass (throughLens, the d line)
+// and goes on from the exit in the lens's cubes. Returns the colour; `seen`: the last point, relative to the
 // camera origin (w 0: escaping).
 #define CUBE_LOOKUP(k)                                                                                              \
   if (cur == k) {                                                                                                  \
@@ -371,6 +383,35 @@ vec3 followCubes(int cur, vec3 x, vec3 R, int depth, out vec4 seen) {
     vec3 p = centre + l, n = nid.xyz / weight;
     seen = vec4(p, 1.0);
     if (depth >= u_max_depth) return vec3(0.0);  // the tracer's depth limit: absorbed
+#if defined(LENS_IN_CUBES)
+    if (hit == u_cube_lens) {
+      // The lens's frame: its origin is its cube's. The front surface faces +z, the back -z.
+      vec3 lens_centre = u_cube_centre[hit];
+      vec3 xl = u_lens_to_local * (p - lens_centre), vl = u_lens_to_local * R;
+      bool from_back = vl.z > 0.0;
+      vec3 entry = entryPoint(xl, vl, from_back);
+      seen = vec4(lens_centre + entry * u_lens_to_local, 1.0);
+      vec3 n_in = normalize(lensTexel(from_back, entry.xy).yzw);
+      // Past the outline (the cube's texels blend the lens's rim with what lies behind it), or along the
+      // surface: nothing to refract, dark as the lens's rim in the cube.
+      if (!inOutline(entry.xy) || dot(vl, n_in) >= 0.0) return vec3(0.0);
+      vec3 dir;
+      float tr;
+      bool rim;
+      int spent;
+      vec3 q = throughLens(entry, vl, n_in, u_index.y, u_max_depth - 1 - depth, dir, tr, rim, spent);
+      if (tr <= 0.0) {  // absorbed inside the glass, or at its rim
+        seen = rim ? vec4(lens_centre + (q + u_far * dir) * u_lens_to_local, 0.0) : vec4(lens_centre + q * u_lens_to_local, 1.0);
+        return vec3(0.0);
+      }
+      throughput *= tr;
+      depth += spent;
+      x = lens_centre + q * u_lens_to_local;
+      R = dir * u_lens_to_local;
+      cur = hit;
+      continue;
+    }
+#endif
     float cos_i = -dot(R, n);
     if (cos_i <= 0.0) return throughput * 0.05 * shadeDiffuse(vec3(1.0), p, -n);  // the mirror's back
     throughput *= u_el_metal[hit] ? vec3(fresnelConductor(cos_i, u_el_metal_n[hit].r, u_el_metal_k[hit].r),
@@ -391,6 +432,14 @@ void main() {
   vec3 view = normalize(v_pos - u_view_origin);
   float cos_i = -dot(view, n);
   o_surface = vec4(v_pos, u_element_id);
+#if defined(CUBE_GEOMETRY) && defined(LENS)
+  // A lens in another element's cube: where the ray from the cube's origin meets its mesh, and its index (the
+  // normal only carries the texel's weight: the search enters the lens's own height maps).
+  o_color = vec4(0.0);
+  o_seen = vec4(v_pos, 1.0);
+  o_surface = vec4(n, u_element_id);
+  return;
+#endif
 #if defined(MODE_IMPOSTOR) && !defined(LENS)
   // The exact surface point on this fragment's view ray (relative to the camera origin) and the exact normal
   // there, from the surface maps, in place of the triangle's point and the interpolated vertex normals.
@@ -450,7 +499,7 @@ void main() {
         float tr;
         bool rim;
         int spent;
-        vec3 q = throughLens(entry, v, n_in, u_index[k], dir, tr, rim, spent);
+        vec3 q = throughLens(entry, v, n_in, u_index[k], u_max_events, dir, tr, rim, spent);
         bool seen_here = ch == (IMPOSTOR_CHANNELS == 3 ? u_seen_channel : 0);
         if (tr <= 0.0) {  // absorbed, as in the tracer: dark
           if (seen_here) seen = rim ? vec4((q + u_far * dir) * u_to_local, 0.0) : vec4(q * u_to_local, 1.0);

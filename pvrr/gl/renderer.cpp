@@ -345,19 +345,23 @@ struct Renderer::Impl {
   }
   // Distance-impostor elements (shaders/element.frag, MODE_IMPOSTOR): a mirror, or a lens with one or three
   // wavelengths; cube_elements > 0: searches that meet a mirror in a cube go on in its cubes (CUBE_ELEMENTS).
-  const Program& impostorProgram(bool lens, int channels, int cube_elements) const {
+  // lens_in_cubes: the scene's one lens is drawn in the other elements' cubes and refracted through there.
+  const Program& impostorProgram(bool lens, int channels, int cube_elements, bool lens_in_cubes) const {
     std::vector<std::string> d{"#define MODE_IMPOSTOR",
                                "#define IMPOSTOR_ITERATIONS " + std::to_string(scene.render.impostor_iterations),
                                "#define IMPOSTOR_CHANNELS " + std::to_string(channels)};
     if (lens) d.push_back("#define LENS");
     if (cube_elements > 0) d.push_back("#define CUBE_ELEMENTS " + std::to_string(cube_elements));
+    if (cube_elements > 0 && lens_in_cubes && !lens) d.push_back("#define LENS_IN_CUBES");
     return builtProgram("element.vert", "element.frag", d);
   }
-  // A mirror drawn into another element's impostor cubes: its surface point and normal (CUBE_GEOMETRY).
-  const Program& cubeGeometryProgram() const {
-    return builtProgram("element.vert", "element.frag",
-                        {"#define MODE_IMPOSTOR", "#define IMPOSTOR_ITERATIONS 0", "#define IMPOSTOR_CHANNELS 1",
-                         "#define CUBE_GEOMETRY", kWithSeenPoints});
+  // An element drawn into another element's impostor cubes (CUBE_GEOMETRY): a mirror's exact surface point
+  // and normal, a lens's mesh point; and its index.
+  const Program& cubeGeometryProgram(bool lens) const {
+    std::vector<std::string> d{"#define MODE_IMPOSTOR", "#define IMPOSTOR_ITERATIONS 0", "#define IMPOSTOR_CHANNELS 1",
+                               "#define CUBE_GEOMETRY", kWithSeenPoints};
+    if (lens) d.push_back("#define LENS");
+    return builtProgram("element.vert", "element.frag", d);
   }
   const Program& plainProgram(bool planes) const {
     return planes ? planesVariant("element.vert", "element.frag", {"#define MODE_PLAIN"}) : plain_program;
@@ -666,17 +670,19 @@ struct Renderer::Impl {
   // The uniforms of a lens's impostor draw (shaders/element.frag, MODE_IMPOSTOR with LENS): its height maps
   // and outline mask on units 2 to 4, their placement, its pose, its index at the R, G and B wavelengths, and
   // the tracer's depth limit and far distance.
-  void setLensMaps(const Program& p, size_t e) {
+  // first_unit and rotation: where a mirror's program that meets the lens in its cubes takes them
+  // (LENS_IN_CUBES: after the cubes, u_lens_to_local).
+  void setLensMaps(const Program& p, size_t e, int first_unit = 2, const char* rotation = "u_to_local") {
     const LensMaps& m = lens_maps.at(e);
     const Element& el = scene.elements[e];
-    bindDataTextures(p, 2, {{"u_lens_front", m.front}, {"u_lens_back", m.back}, {"u_lens_mask", m.mask}});
+    bindDataTextures(p, first_unit, {{"u_lens_front", m.front}, {"u_lens_back", m.back}, {"u_lens_mask", m.mask}});
     p.set("u_hm_reach", float(m.map.reach));
     p.set("u_max_events", scene.render.max_depth - 1);
     p.set("u_far", float(scene.render.far_distance_m));
     p.set("u_hm", glm::vec4(float(m.map.x0), float(m.map.y0), float(1.0 / (m.map.nx * m.map.dx)),
                             float(1.0 / (m.map.ny * m.map.dy))));
     p.set("u_hm_z", glm::vec2(float(m.map.back_z_min), float(m.map.front_z_max)));
-    p.set("u_to_local", glm::mat3(Mat3(el.world_to_local)));
+    p.set(rotation, glm::mat3(Mat3(el.world_to_local)));
     const double* wl = kRgbWavelengths_nm;
     p.set("u_index", glm::vec3(float(el.dispersion.index(wl[0])), float(el.dispersion.index(wl[1])),
                                float(el.dispersion.index(wl[2]))));
@@ -684,24 +690,32 @@ struct Renderer::Impl {
 
   // Impostor mode with several elements (seeds 000's distance-normal impostors): each element's cubes also show
   // the other mirrors, with their surface points and normals, and a search that meets one goes on in that
-  // mirror's cubes. The number of elements the fragment loop switches between (CUBE_ELEMENTS), or 0: one
-  // element, no mirror to meet, or more elements than kMaxCubeElements or the texture units allow (then each
-  // cube shows the environment only). Lenses are not drawn in other elements' cubes.
+  // mirror's cubes; and the scene's lens, if it has one only (lensInCubes), through which the search refracts
+  // with the lens's height maps. The number of elements the fragment loop switches between (CUBE_ELEMENTS), or
+  // 0: one element, no mirror to meet, or more elements than kMaxCubeElements or the texture units allow (then
+  // each cube shows the environment only).
   static constexpr int kMaxCubeElements = 4;
   static constexpr int kFirstCubeUnit = 6;  // after a cube pair (0, 1) and the element's own maps (2 to 5)
+  size_t lensCount() const {
+    return size_t(std::count_if(scene.elements.begin(), scene.elements.end(),
+                                [](const Element& e) { return e.type == ElementType::Lens; }));
+  }
   int cubeElements(RasterMode mode) const {
     const int n = int(scene.elements.size());
-    const bool mirror = std::any_of(scene.elements.begin(), scene.elements.end(),
-                                    [](const Element& e) { return e.type == ElementType::Mirror; });
+    const bool mirror = lensCount() < size_t(n);
+    // Three cubes per element, and a lens's three height maps for the mirrors that meet it.
     if (mode != RasterMode::Impostor || n < 2 || !mirror || n > kMaxCubeElements ||
-        kFirstCubeUnit + 3 * n > max_texture_units)
+        kFirstCubeUnit + 3 * n + 3 > max_texture_units)
       return 0;
     return n;
   }
+  // Whether the lens is drawn in the other elements' cubes: the scene has one (its program never meets a lens,
+  // and the mirrors' programs take its maps).
+  bool lensInCubes(RasterMode mode) const { return cubeElements(mode) > 0 && lensCount() == 1; }
   // The uniforms of the fragment loop over every element's cubes (CUBE_ELEMENTS), for element e drawn from a
   // camera at `origin`: three cubes per element on units from kFirstCubeUnit, their origins, the mirrors'
   // materials, and the tracer's depth limit.
-  void setCubeElements(const Program& p, size_t e, const Vec3& origin) const {
+  void setCubeElements(const Program& p, size_t e, const Vec3& origin) {
     for (size_t k = 0; k < scene.elements.size(); ++k) {
       const Element& el = scene.elements[k];
       const std::string i = "[" + std::to_string(k) + "]";
@@ -721,21 +735,30 @@ struct Renderer::Impl {
     glActiveTexture(GL_TEXTURE0);
     p.set("u_self", int(e));
     p.set("u_max_depth", scene.render.max_depth);
+    // A mirror that can meet the scene's lens: its maps after the cubes.
+    if (scene.elements[e].type == ElementType::Mirror && lensInCubes(RasterMode::Impostor))
+      for (size_t k = 0; k < scene.elements.size(); ++k)
+        if (scene.elements[k].type == ElementType::Lens) {
+          setLensMaps(p, k, kFirstCubeUnit + 3 * int(scene.elements.size()), "u_lens_to_local");
+          p.set("u_cube_lens", int(k));
+        }
   }
 
-  // Mirror m drawn into a face of another element's impostor cubes, from a camera at `origin` (view_proj
-  // relative to it): its exact surface point and normal per fragment (CUBE_GEOMETRY), before the environment.
-  void drawCubeMirror(size_t m, const Mat4& view_proj, const Vec3& origin, const MeshBuffers& mesh) {
+  // Element m drawn into a face of another element's impostor cubes, from a camera at `origin` (view_proj
+  // relative to it), before the environment (CUBE_GEOMETRY): a mirror's exact surface point and normal per
+  // fragment, a lens's mesh.
+  void drawCubeElement(size_t m, const Mat4& view_proj, const Vec3& origin, const MeshBuffers& mesh) {
     const Element& el = scene.elements[m];
     const Vec3 anchor = Vec3(el.local_to_world[3]);
-    const Program& p = cubeGeometryProgram();
+    const bool lens = el.type == ElementType::Lens;
+    const Program& p = cubeGeometryProgram(lens);
     p.use();
     p.set("u_view_proj", toFloat(view_proj));
     p.set("u_offset", glm::vec3(anchor - origin));
     p.set("u_view_origin", glm::vec3(0.0f));
     p.set("u_seen_offset", glm::vec3(anchor - origin));
     setElementMaterial(p, el, int(m));
-    setMirrorMaps(p, m);
+    if (!lens) setMirrorMaps(p, m);
     glDisable(GL_CULL_FACE);
     glEnable(GL_DEPTH_TEST);
     glDepthMask(GL_TRUE);
@@ -1597,9 +1620,12 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     while (cubes.size() < n_el) cubes.push_back(std::make_unique<CubeTarget>());
     CullCount culled;
     // Impostor cube maps hold the seen points (each direction's distance) even in a colour-only frame, and with
-    // other mirrors in them (cubeElements) a third cube of their normals and indices.
+    // other elements in them (cubeElements) a third cube of their normals and indices.
     const bool with_seen = mode == RasterMode::Impostor;
     const int follow = cubeElements(mode);
+    const bool lens_in_cubes = lensInCubes(mode);
+    // The elements drawn in other elements' cubes: the mirrors, and the lens if it is the only one.
+    auto inCubes = [&](size_t m) { return follow > 0 && (scene.elements[m].type == ElementType::Mirror || lens_in_cubes); };
     std::vector<GLenum> formats{GL_RGBA16F};
     if (options.seen_points || with_seen) formats.push_back(GL_RGBA32F);
     if (follow > 0) formats.push_back(GL_RGBA32F);
@@ -1608,11 +1634,11 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       if (scene.elements[e].type == ElementType::Lens) height_maps += updateLensMaps(e);
       else surface_maps += updateMirrorMaps(e);
     }
-    // The mirrors other cubes show: each mesh uploaded once (element_meshes slots).
+    // The elements other cubes show: each mesh uploaded once (element_meshes slots).
     std::vector<size_t> cube_mesh(n_el, 0);
     int drawn_in_cubes = 0;
-    for (size_t m = 0; m < n_el && follow > 0; ++m) {
-      if (scene.elements[m].type != ElementType::Mirror) continue;
+    for (size_t m = 0; m < n_el; ++m) {
+      if (!inCubes(m)) continue;
       const ElementFrame f = prepareElement(scene, int(m), &grid_cache.get(scene, int(m)));
       cube_mesh[m] = next_mesh;
       uploadElementGrid(meshSlot(), f, Vec3(scene.elements[m].local_to_world[3]));
@@ -1632,9 +1658,9 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       for (int face = 0; face < 6; ++face) {
         c.selectFace(face);
         const Mat4 view = glm::lookAt(centre, centre + kCubeDir[face], kCubeUp[face]);
-        for (size_t m = 0; m < n_el && follow > 0; ++m)
-          if (m != e && scene.elements[m].type == ElementType::Mirror) {
-            drawCubeMirror(m, relativeViewProj(proj, view, centre), centre, element_meshes[cube_mesh[m]]);
+        for (size_t m = 0; m < n_el; ++m)
+          if (m != e && inCubes(m)) {
+            drawCubeElement(m, relativeViewProj(proj, view, centre), centre, element_meshes[cube_mesh[m]]);
             drawn_in_cubes += face == 0;
           }
         culled.add(drawEnvironment(view, proj, centre, false, nullptr, false, with_seen));
@@ -1642,19 +1668,19 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     }
     glFinish();
     std::string note = mode == RasterMode::Impostor ? "distance impostors: colour and seen-point cube maps" : "";
-    if (follow > 0) appendNote(note, "normal and index cube maps of the mirrors in them");
+    if (follow > 0) appendNote(note, "normal and index cube maps of the elements in them");
     if (height_maps > 0) appendNote(note, "refractor height maps of " + std::to_string(height_maps) + " lens(es) built");
     if (surface_maps > 0) appendNote(note, "surface maps of " + std::to_string(surface_maps) + " mirror(s) built");
     appendNote(note, cullNote(culled));
     out.stages.ran("first-pass", msSince(t0), -1, note);
-    const bool lenses = std::any_of(scene.elements.begin(), scene.elements.end(),
-                                    [](const Element& el) { return el.type == ElementType::Lens; });
     if (follow > 0)
       out.stages.ran("nested-passes", 0, drawn_in_cubes,
-                     std::to_string(drawn_in_cubes) + " draw(s) of a mirror in another element's cube maps, with its "
-                     "normals (distance-normal impostors), followed per fragment up to render.max_depth = " +
-                         std::to_string(scene.render.max_depth) +
-                         (lenses ? "; lenses are absent from other elements' cube maps" : ""));
+                     std::to_string(drawn_in_cubes) + " draw(s) of an element in another element's cube maps, with "
+                     "its normals and index (distance-normal impostors), followed per fragment up to "
+                     "render.max_depth = " + std::to_string(scene.render.max_depth) +
+                         (lens_in_cubes ? "; the lens refracted through its height maps there (d line)"
+                          : lensCount() > 0 ? "; lenses are absent from other elements' cube maps (more than one)"
+                                            : ""));
     else if (n_el == 1)
       out.stages.skipped("nested-passes", std::string("one ") + (has_lens ? "lens" : "mirror") + ": no nesting");
     else if (mode == RasterMode::Impostor && !std::any_of(scene.elements.begin(), scene.elements.end(), [](const Element& el) {
@@ -1726,7 +1752,8 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       const int follow = cubeElements(mode);
       const Program& p = mode == RasterMode::Raster ? plain_program
                          : mode == RasterMode::Impostor
-                             ? impostorProgram(lens, dispersionChannels(scene, int(e)).size() > 1 ? 3 : 1, follow)
+                             ? impostorProgram(lens, dispersionChannels(scene, int(e)).size() > 1 ? 3 : 1, follow,
+                                               lensInCubes(mode))
                              : (lens ? lens_envmap_program : envmap_program);
       p.use();
       p.set("u_view_proj", toFloat(vp));
