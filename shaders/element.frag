@@ -15,11 +15,13 @@
 //                traced per fragment in the lens's refractor height maps (pvrr/lens_height_map.h).
 //                IMPOSTOR_ITERATIONS: the search's false-position steps; IMPOSTOR_CHANNELS 3: a lens's R, G
 //                and B each refracted with its own index (u_index), else the middle one only.
-//                CUBE_ELEMENTS n (2 to 4): the scene's n elements each have cube maps in which the other mirrors
-//                are drawn with their surface point and normal (distance-normal impostors, seeds 000): a search
-//                that meets one reflects there and goes on in that mirror's cube (followCubes).
-//                CUBE_GEOMETRY: a mirror drawn into another element's cube: its exact surface point as the
-//                seen point, and its normal and element id in the surface output.
+//                CUBE_ELEMENTS n (2 to 4): the scene's n elements each have cube maps in which the other
+//                elements are drawn with their surface point, normal and index (distance-normal impostors,
+//                seeds 000): a search that meets a mirror reflects there and goes on in that mirror's cubes
+//                (followCubes); LENS_IN_CUBES: the other elements' cubes show the scene's one lens too, and a
+//                search that meets it refracts through its height maps and goes on in the lens's cubes.
+//                CUBE_GEOMETRY: an element drawn into another element's cube: a mirror's exact surface point
+//                (a lens's mesh point) as the seen point, and its normal and element id in the surface output.
 //   MODE_PLAIN   a plain grey shaded surface (raster mode); u_dark: black, an element met at the depth limit
 //                inside another element's map (the tracer absorbs there)
 //   LENS         the element is a lens (transmission) rather than a mirror (reflection)
@@ -63,7 +65,8 @@ uniform samplerCube u_seen_cube;  // its seen points relative to that origin (u_
 uniform mat3 u_to_local;          // world directions -> the element's local frame (whose origin is the cube's)
 #if defined(CUBE_ELEMENTS)
 // Per element (index): its cubes (colour; seen points, whose lengths are the distances; normal and index + 1
-// of a mirror drawn in them, 0 elsewhere), their origin relative to the camera origin, and its mirror material.
+// of an element drawn in them, 0 elsewhere), their origin relative to the camera origin, and its mirror
+// material.
 uniform samplerCube u_cubes[CUBE_ELEMENTS];
 uniform samplerCube u_seen_cubes[CUBE_ELEMENTS];
 uniform samplerCube u_normal_cubes[CUBE_ELEMENTS];
@@ -347,9 +350,10 @@ float fresnelConductor(float cos_i, float n, float k) {
 // it meets another mirror drawn there, it reflects at the found point with that mirror's normal and material
 // (exact Fresnel) and goes on in that mirror's cubes, as the tracer does: absorbed at an element met after
 // u_max_depth events, dark at a mirror's back. LENS_IN_CUBES: where it meets the scene's lens, it enters the
-// lens's height maps where the ray meets the surface, refracts through the glass (throughLens, the d line)
-// and goes on from the exit in the lens's cubes. Returns the colour; `seen`: the last point, relative to the
-// camera origin (w 0: escaping).
+// lens's height maps where the ray meets the surface (a ray past its outline goes on in the lens's cubes,
+// which do not show the lens), refracts through the glass (throughLens, with the index of `channel`: 0-2 R,
+// G, B) and goes on from the exit in the lens's cubes. Returns the colour; `seen`: the last point, relative
+// to the camera origin (w 0: escaping).
 #define CUBE_LOOKUP(k)                                                                                              \
   if (cur == k) {                                                                                                  \
     centre = u_cube_centre[k];                                                                                     \
@@ -358,7 +362,7 @@ float fresnelConductor(float cos_i, float n, float k) {
     s = texture(u_seen_cubes[k], l);                                                                               \
     nid = texture(u_normal_cubes[k], l);                                                                           \
   }
-vec3 followCubes(int cur, vec3 x, vec3 R, int depth, out vec4 seen) {
+vec3 followCubes(int cur, vec3 x, vec3 R, int depth, int channel, out vec4 seen) {
   vec3 throughput = vec3(1.0);
   for (int bounce = 0; bounce < 64; ++bounce) {
     vec3 centre = vec3(0.0), l = R, c = vec3(0.0);
@@ -371,9 +375,9 @@ vec3 followCubes(int cur, vec3 x, vec3 R, int depth, out vec4 seen) {
 #if CUBE_ELEMENTS > 3
     CUBE_LOOKUP(3)
 #endif
-    // The normal and index are filtered like the rest, and the texels of what is not a mirror hold zero:
-    // where a mirror's texels blend with those of what lies behind it, |normal| is the mirror's weight, the
-    // larger weight decides, and the index divided by it is the mirror's.
+    // The normal and index are filtered like the rest, and the texels of the environment hold zero: where an
+    // element's texels blend with those of what lies behind it, |normal| is the element's weight, the larger
+    // weight decides, and the index divided by it is the element's.
     float weight = length(nid.xyz);
     int hit = weight >= 0.5 ? int(floor(nid.w / weight + 0.5)) - 1 : -1;
     if (hit < 0 || hit >= CUBE_ELEMENTS || hit == cur) {
@@ -381,27 +385,33 @@ vec3 followCubes(int cur, vec3 x, vec3 R, int depth, out vec4 seen) {
       return throughput * c;
     }
     vec3 p = centre + l, n = nid.xyz / weight;
-    seen = vec4(p, 1.0);
-    if (depth >= u_max_depth) return vec3(0.0);  // the tracer's depth limit: absorbed
 #if defined(LENS_IN_CUBES)
     if (hit == u_cube_lens) {
-      // The lens's frame: its origin is its cube's. The front surface faces +z, the back -z.
+      // The lens's frame: its origin is its cube's. The cube holds the front mesh's outward normal: a ray
+      // along it meets the lens from behind (as the second pass decides).
       vec3 lens_centre = u_cube_centre[hit];
       vec3 xl = u_lens_to_local * (p - lens_centre), vl = u_lens_to_local * R;
-      bool from_back = vl.z > 0.0;
+      bool from_back = dot(R, n) >= 0.0;
       vec3 entry = entryPoint(xl, vl, from_back);
+      // Past the outline (the cube's texels blend the lens's rim with what lies behind it): the ray misses
+      // the lens and goes on, unchanged, in its cubes.
+      if (!inOutline(entry.xy)) {
+        x = p;
+        cur = hit;
+        continue;
+      }
       seen = vec4(lens_centre + entry * u_lens_to_local, 1.0);
+      if (depth >= u_max_depth) return vec3(0.0);  // the tracer's depth limit: absorbed at the surface
       vec3 n_in = normalize(lensTexel(from_back, entry.xy).yzw);
-      // Past the outline (the cube's texels blend the lens's rim with what lies behind it), or along the
-      // surface: nothing to refract, dark as the lens's rim in the cube.
-      if (!inOutline(entry.xy) || dot(vl, n_in) >= 0.0) return vec3(0.0);
+      if (dot(vl, n_in) >= 0.0) return vec3(0.0);  // along the surface: nothing to refract
       vec3 dir;
       float tr;
       bool rim;
       int spent;
-      vec3 q = throughLens(entry, vl, n_in, u_index.y, u_max_depth - 1 - depth, dir, tr, rim, spent);
+      vec3 q = throughLens(entry, vl, n_in, u_index[channel], u_max_depth - 1 - depth, dir, tr, rim, spent);
       if (tr <= 0.0) {  // absorbed inside the glass, or at its rim
-        seen = rim ? vec4(lens_centre + (q + u_far * dir) * u_lens_to_local, 0.0) : vec4(lens_centre + q * u_lens_to_local, 1.0);
+        seen = rim ? vec4(lens_centre + (q + u_far * dir) * u_lens_to_local, 0.0)
+                   : vec4(lens_centre + q * u_lens_to_local, 1.0);
         return vec3(0.0);
       }
       throughput *= tr;
@@ -412,6 +422,8 @@ vec3 followCubes(int cur, vec3 x, vec3 R, int depth, out vec4 seen) {
       continue;
     }
 #endif
+    seen = vec4(p, 1.0);
+    if (depth >= u_max_depth) return vec3(0.0);  // the tracer's depth limit: absorbed
     float cos_i = -dot(R, n);
     if (cos_i <= 0.0) return throughput * 0.05 * shadeDiffuse(vec3(1.0), p, -n);  // the mirror's back
     throughput *= u_el_metal[hit] ? vec3(fresnelConductor(cos_i, u_el_metal_n[hit].r, u_el_metal_k[hit].r),
@@ -438,8 +450,7 @@ void main() {
   o_color = vec4(0.0);
   o_seen = vec4(v_pos, 1.0);
   o_surface = vec4(n, u_element_id);
-  return;
-#endif
+#else
 #if defined(MODE_IMPOSTOR) && !defined(LENS)
   // The exact surface point on this fragment's view ray (relative to the camera origin) and the exact normal
   // there, from the surface maps, in place of the triangle's point and the interpolated vertex normals.
@@ -508,7 +519,7 @@ void main() {
         // Back to world axes: the local frame's origin is the cube's.
 #if defined(CUBE_ELEMENTS)
         vec4 s;
-        vec3 rgb = tr * followCubes(u_self, q * u_to_local + u_seen_offset, dir * u_to_local, spent, s);
+        vec3 rgb = tr * followCubes(u_self, q * u_to_local + u_seen_offset, dir * u_to_local, spent, k, s);
         if (seen_here) seen = vec4(s.xyz - u_seen_offset, s.w);
 #else
         vec3 l = impostorHit(u_seen_cube, q * u_to_local, dir * u_to_local);
@@ -523,7 +534,7 @@ void main() {
 #else
 #if defined(CUBE_ELEMENTS)
   vec4 seen;
-  vec3 c = followCubes(u_self, pos, reflect(view, n), 1, seen);
+  vec3 c = followCubes(u_self, pos, reflect(view, n), 1, 1, seen);
   seen.xyz -= u_seen_offset;
 #else
   vec3 l = impostorHit(u_seen_cube, pos - u_seen_offset, reflect(view, n));
@@ -566,4 +577,5 @@ void main() {
   o_color = vec4(weight * c, 1.0);
   o_seen = vec4(seen.xyz + u_seen_offset, seen.w);
 #endif
+#endif  // CUBE_GEOMETRY && LENS
 }

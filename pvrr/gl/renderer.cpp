@@ -352,7 +352,7 @@ struct Renderer::Impl {
                                "#define IMPOSTOR_CHANNELS " + std::to_string(channels)};
     if (lens) d.push_back("#define LENS");
     if (cube_elements > 0) d.push_back("#define CUBE_ELEMENTS " + std::to_string(cube_elements));
-    if (cube_elements > 0 && lens_in_cubes && !lens) d.push_back("#define LENS_IN_CUBES");
+    if (cube_elements > 0 && lens_in_cubes) d.push_back("#define LENS_IN_CUBES");
     return builtProgram("element.vert", "element.frag", d);
   }
   // An element drawn into another element's impostor cubes (CUBE_GEOMETRY): a mirror's exact surface point
@@ -703,14 +703,14 @@ struct Renderer::Impl {
   int cubeElements(RasterMode mode) const {
     const int n = int(scene.elements.size());
     const bool mirror = lensCount() < size_t(n);
-    // Three cubes per element, and a lens's three height maps for the mirrors that meet it.
+    // Three cubes per element, and the lens's three height maps for the mirrors that meet it.
     if (mode != RasterMode::Impostor || n < 2 || !mirror || n > kMaxCubeElements ||
-        kFirstCubeUnit + 3 * n + 3 > max_texture_units)
+        kFirstCubeUnit + 3 * n + (lensCount() == 1 ? 3 : 0) > max_texture_units)
       return 0;
     return n;
   }
-  // Whether the lens is drawn in the other elements' cubes: the scene has one (its program never meets a lens,
-  // and the mirrors' programs take its maps).
+  // Whether the lens is drawn in the other elements' cubes: the scene has one (the mirrors' programs take its
+  // maps; its own program, which meets it again through a mirror, has them already).
   bool lensInCubes(RasterMode mode) const { return cubeElements(mode) > 0 && lensCount() == 1; }
   // The uniforms of the fragment loop over every element's cubes (CUBE_ELEMENTS), for element e drawn from a
   // camera at `origin`: three cubes per element on units from kFirstCubeUnit, their origins, the mirrors'
@@ -735,13 +735,15 @@ struct Renderer::Impl {
     glActiveTexture(GL_TEXTURE0);
     p.set("u_self", int(e));
     p.set("u_max_depth", scene.render.max_depth);
-    // A mirror that can meet the scene's lens: its maps after the cubes.
-    if (scene.elements[e].type == ElementType::Mirror && lensInCubes(RasterMode::Impostor))
-      for (size_t k = 0; k < scene.elements.size(); ++k)
-        if (scene.elements[k].type == ElementType::Lens) {
-          setLensMaps(p, k, kFirstCubeUnit + 3 * int(scene.elements.size()), "u_lens_to_local");
-          p.set("u_cube_lens", int(k));
-        }
+    // The scene's lens, which the search can meet: a mirror's program takes its maps after the cubes; the
+    // lens's own has them (setLensMaps) and needs its rotation under the loop's name too.
+    if (lensInCubes(RasterMode::Impostor))
+      for (size_t k = 0; k < scene.elements.size(); ++k) {
+        if (scene.elements[k].type != ElementType::Lens) continue;
+        if (k == e) p.set("u_lens_to_local", glm::mat3(Mat3(scene.elements[k].world_to_local)));
+        else setLensMaps(p, k, kFirstCubeUnit + 3 * int(scene.elements.size()), "u_lens_to_local");
+        p.set("u_cube_lens", int(k));
+      }
   }
 
   // Element m drawn into a face of another element's impostor cubes, from a camera at `origin` (view_proj
