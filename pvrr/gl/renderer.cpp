@@ -1627,7 +1627,9 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     const int follow = cubeElements(mode);
     const bool lens_in_cubes = lensInCubes(mode);
     // The elements drawn in other elements' cubes: the mirrors, and the lens if it is the only one.
-    auto inCubes = [&](size_t m) { return follow > 0 && (scene.elements[m].type == ElementType::Mirror || lens_in_cubes); };
+    auto inCubes = [&](size_t m) {
+      return follow > 0 && (scene.elements[m].type == ElementType::Mirror || lens_in_cubes);
+    };
     std::vector<GLenum> formats{GL_RGBA16F};
     if (options.seen_points || with_seen) formats.push_back(GL_RGBA32F);
     if (follow > 0) formats.push_back(GL_RGBA32F);
@@ -1685,13 +1687,12 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
                                             : ""));
     else if (n_el == 1)
       out.stages.skipped("nested-passes", std::string("one ") + (has_lens ? "lens" : "mirror") + ": no nesting");
-    else if (mode == RasterMode::Impostor && !std::any_of(scene.elements.begin(), scene.elements.end(), [](const Element& el) {
-               return el.type == ElementType::Mirror;
-             }))
+    else if (mode == RasterMode::Impostor && lensCount() == n_el)
       out.stages.skipped("nested-passes", "mode impostor: lenses are absent from other elements' cube maps");
     else if (mode == RasterMode::Impostor)
       out.stages.skipped("nested-passes", "mode impostor: more than " + std::to_string(kMaxCubeElements) +
-                                              " elements (or texture units): other elements are absent from the cube maps");
+                                              " elements (or texture units): other elements are absent from "
+                                              "the cube maps");
     else
       out.stages.skipped("nested-passes", "mode " + modeName(mode) + ": other elements are absent from the cube maps");
   } else {

@@ -510,8 +510,9 @@ TEST_P(ImpostorTest, MirrorsFollowedThroughEachOthersCubes) {
 
 // A lens in front of a mirror: what the -10 D lens shows of the mirror 1 m behind it (turned 30 deg, so that it
 // sends the rays to the side wall) comes from the mirror drawn in the lens's cubes, followed from the lens's
-// exit with the events the glass spent (entry and exit) counted towards render.max_depth. Measured: median 0.0013' and p95 0.0076' over the pixels
-// whose path leaves the lens for the mirror (against 5675' with the cubes showing the room only).
+// exit with the events the glass spent (entry and exit) counted towards render.max_depth. Measured: median
+// 0.0013' and p95 0.0076' over the pixels whose path leaves the lens for the mirror (against 5675' with the
+// cubes showing the room only).
 TEST_P(ImpostorTest, LensSeesAMirrorInItsCubes) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
@@ -584,13 +585,15 @@ TEST_P(ImpostorTest, MirrorShowsALensThroughItsHeightMaps) {
     const std::string label = turned ? "turned round" : "facing the mirror";
     const ImpostorRun run = runImpostor(s, false);
     // Pixels of the mirror whose reference path crosses the lens: the mirror, the entry, the exit.
-    auto through = [&](size_t i) { return run.ref.element[i] == 0 && run.f.element[i] == 0 && run.ref.bounces[i] == 3; };
+    auto through = [&](size_t i) {
+      return run.ref.element[i] == 0 && run.f.element[i] == 0 && run.ref.bounces[i] == 3;
+    };
     std::vector<double> e;
     double cerr = 0, csum = 0;
     for (size_t i = 0; i < run.ref.color.size(); ++i) {
       if (!through(i)) continue;
-      e.push_back(
-          arcminutes(angleBetween(run.ref.seen[i] - run.ref.element_point[i], run.f.seen[i] - run.ref.element_point[i])));
+      e.push_back(arcminutes(
+          angleBetween(run.ref.seen[i] - run.ref.element_point[i], run.f.seen[i] - run.ref.element_point[i])));
       const Vec3 d = glm::abs(run.f.color[i] - run.ref.color[i]);
       cerr += d.x + d.y + d.z;
       csum += run.ref.color[i].x + run.ref.color[i].y + run.ref.color[i].z;

@@ -68,7 +68,9 @@ struct Result {
 };
 
 Result run(const Vec3& offset, gl::RasterMode mode, Kind kind) {
-  Scene s = kind == Kind::Lens ? lensInARoom(offset) : kind == Kind::MirrorPair ? mirrorPair(offset) : mirrorInARoom(offset);
+  Scene s = kind == Kind::Lens         ? lensInARoom(offset)
+            : kind == Kind::MirrorPair ? mirrorPair(offset)
+                                       : mirrorInARoom(offset);
   RayScene rays(s);
   TraceOptions to;
   to.max_depth = s.render.max_depth;
@@ -114,7 +116,8 @@ void expectSameFarAway(gl::RasterMode mode, Kind kind) {
     // ones (which would be ~0.5 m).
     if (near.element[i] >= 0) worst_seen = std::max(worst_seen, glm::length(near.seen_rel[i] - far.seen_rel[i]));
   }
-  std::cout << "[ measured ] " << (kind == Kind::Lens ? "lens" : kind == Kind::MirrorPair ? "mirror pair" : "mirror") << ", mode " << gl::modeName(mode) << ": " << differ
+  const char* name = kind == Kind::Lens ? "lens" : kind == Kind::MirrorPair ? "mirror pair" : "mirror";
+  std::cout << "[ measured ] " << name << ", mode " << gl::modeName(mode) << ": " << differ
             << " of " << near.color.size() << " pixels differ, seen points within " << worst_seen << " m, median "
             << near.median_arcmin << "' at the origin, " << far.median_arcmin << "' far away\n";
   EXPECT_LE(differ, near.color.size() / 100) << gl::modeName(mode);
@@ -146,7 +149,8 @@ TEST_P(LargeCoordinatesTest, LensMillionsOfMetresAwayRendersAsAtTheOrigin) {
 TEST_P(LargeCoordinatesTest, MirrorPairMillionsOfMetresAwayRendersAsAtTheOrigin) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
-  for (gl::RasterMode mode : {gl::RasterMode::Pvrr, gl::RasterMode::Impostor}) expectSameFarAway(mode, Kind::MirrorPair);
+  for (gl::RasterMode mode : {gl::RasterMode::Pvrr, gl::RasterMode::Impostor})
+    expectSameFarAway(mode, Kind::MirrorPair);
 }
 
 PVRR_GL_BACKENDS(LargeCoordinatesTest);
