@@ -658,6 +658,42 @@ TEST_P(ImpostorTest, LightBackThroughTheSameLens) {
   EXPECT_LE(quantile(e, 0.95), 0.5);
 }
 
+// A mirror that shows the back of another: the observer faces a mirror, and a second mirror hangs behind the
+// observer facing away. The search from the first meets the second's texels with their normal pointing away:
+// dark, 0.05 of the diffuse light, its seen point there, as in the tracer.
+TEST_P(ImpostorTest, MirrorShowsAnotherMirrorsBack) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  Scene s = test::roomScene(Vec3(0, 0, 1.5), Vec3(0, 0, -3), 160, 120);
+  s.observer.fov_y_rad = radians(20);
+  const cad::Outline square = cad::Outline::rectangle(0.8, 0.8, 0.02);
+  test::addMirror(s, cad::makePlane(square), square, test::pose(Vec3(0, 0, 0), Vec3(0.02, 0.01, 1)), 7, 0.9);
+  const cad::Outline small = cad::Outline::rectangle(0.3, 0.3, 0.02);
+  test::addMirror(s, cad::makePlane(small), small, test::pose(Vec3(0.1, 0.05, 2.2), Vec3(0, 0, 1)), 5, 0.9);
+  s.updateBounds();
+  const ImpostorRun run = runImpostor(s, false);
+  size_t n = 0, close = 0, inner = 0, same_point = 0;
+  for (size_t i = 0; i < run.ref.color.size(); ++i) {
+    // Through the first mirror onto the second's back: two elements met, the second's diffuse event last.
+    if (run.ref.element[i] != 0 || run.f.element[i] != 0 || run.ref.bounces[i] != 1) continue;
+    if (std::abs(run.ref.seen[i].z - 2.2) > 1e-6) continue;  // the seen point on the second mirror
+    ++n;
+    close += glm::length(run.f.color[i] - run.ref.color[i]) <= 0.02 * glm::length(run.ref.color[i]) + 1e-4;
+    // The seen point: away from the second mirror's rim (1 cm), where the cube's distances blend it with the
+    // wall 0.8 m behind and the search stops between them (up to 0.28 m off on the outermost pixels).
+    if (std::abs(run.ref.seen[i].x - 0.1) > 0.14 || std::abs(run.ref.seen[i].y - 0.05) > 0.14) continue;
+    ++inner;
+    same_point += glm::length(run.f.seen[i] - run.ref.seen[i]) < 1e-3;
+  }
+  std::cout << "[ measured ] the back of a mirror in a mirror on " << gl::glBackendName(GetParam()) << ": " << close
+            << " of " << n << " px within 2 % of the tracer's colour; " << same_point << " of the " << inner
+            << " 1 cm inside its rim at its seen point\n";
+  ASSERT_GT(n, 300u);
+  EXPECT_GE(close, n * 95 / 100);
+  ASSERT_GT(inner, n / 2);
+  EXPECT_GE(same_point, inner * 99 / 100);
+}
+
 PVRR_GL_BACKENDS(ImpostorTest);
 
 }  // namespace
