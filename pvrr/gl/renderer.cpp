@@ -1682,7 +1682,8 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
                      std::to_string(drawn_in_cubes) + " draw(s) of an element in another element's cube maps, with "
                      "its normals and index (distance-normal impostors), followed per fragment up to "
                      "render.max_depth = " + std::to_string(scene.render.max_depth) +
-                         (lens_in_cubes ? "; the lens refracted through its height maps there (d line)"
+                         (lens_in_cubes ? "; the lens refracted through its height maps there (at the d line "
+                                          "when a mirror shows it)"
                           : lensCount() > 0 ? "; lenses are absent from other elements' cube maps (more than one)"
                                             : ""));
     else if (n_el == 1)
