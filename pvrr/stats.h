@@ -2,7 +2,8 @@
 // "note" where a stage sets them).
 // Stage names later issues rely on: vertex-rays, refraction, viewpoint-fit, first-pass, second-pass,
 // colour-channels (count: the most channels of an element), nested-passes (count: first passes of
-// elements seen inside other elements' maps; impostor mode: draws of a mirror in another element's cubes).
+// elements seen inside other elements' maps; impostor mode: (cube, element) pairs, each element drawn into
+// another element's cubes: the mirrors, and the scene's lens if it has only one).
 #pragma once
 #include <string>
 #include <vector>

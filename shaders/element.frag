@@ -16,7 +16,7 @@
 //                IMPOSTOR_ITERATIONS: the search's false-position steps; IMPOSTOR_CHANNELS 3: a lens's R, G
 //                and B each refracted with its own index (u_index), else the middle one only.
 //                CUBE_ELEMENTS n (2 to 4): the scene's n elements each have cube maps in which the other
-//                elements are drawn with their surface point, normal and index (distance-normal impostors,
+//                mirrors are drawn with their surface point, normal and index (distance-normal impostors,
 //                seeds 000): a search that meets a mirror reflects there and goes on in that mirror's cubes
 //                (followCubes); LENS_IN_CUBES: the other elements' cubes show the scene's one lens too, and a
 //                search that meets it refracts through its height maps and goes on in the lens's cubes.
@@ -364,6 +364,7 @@ float fresnelConductor(float cos_i, float n, float k) {
   }
 vec3 followCubes(int cur, vec3 x, vec3 R, int depth, int channel, out vec4 seen) {
   vec3 throughput = vec3(1.0);
+  seen = vec4(x, 1.0);  // 64 passes past the lens's outline without an event: no seen point of its own
   for (int bounce = 0; bounce < 64; ++bounce) {
     vec3 centre = vec3(0.0), l = R, c = vec3(0.0);
     vec4 s = vec4(0.0), nid = vec4(0.0);
@@ -445,8 +446,9 @@ void main() {
   float cos_i = -dot(view, n);
   o_surface = vec4(v_pos, u_element_id);
 #if defined(CUBE_GEOMETRY) && defined(LENS)
-  // A lens in another element's cube: where the ray from the cube's origin meets its mesh, and its index (the
-  // normal only carries the texel's weight: the search enters the lens's own height maps).
+  // A lens in another element's cube: where the ray from the cube's origin meets its mesh, its outward normal
+  // (the texel's weight, and the side the search enters, which then refracts in the lens's own height maps)
+  // and its index.
   o_color = vec4(0.0);
   o_seen = vec4(v_pos, 1.0);
   o_surface = vec4(n, u_element_id);

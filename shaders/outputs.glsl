@@ -1,6 +1,8 @@
 // The fragment outputs of every program that draws into a pass (env.frag, sky.frag, element.frag), by
 // variant. The shader writes o_color, o_seen and o_surface; what they become:
-//   default          location 0 colour, 1 seen point, 2 surface point (second pass; maps have no 2)
+//   default          location 0 colour, 1 seen point, 2 surface point (second pass; pvrr maps have no 2; the
+//                    impostor cubes of a scene of several elements take there the normal and index of the
+//                    elements drawn in them, 0 elsewhere)
 //   NO_SEEN_POINTS   colour only: o_seen and o_surface are locals the compiler drops, with what only they need
 //   PLANES           a map of a lens with RGB dispersion: R, G and B in three R32F attachments (locations 0-2),
 //                    the seen point at 3. The second pass reads each channel's plane at that channel's

@@ -82,7 +82,8 @@ struct CubeTarget {
       glBindTexture(GL_TEXTURE_CUBE_MAP, colors[i]);
       for (int f = 0; f < 6; ++f)
         glTexImage2D(GLenum(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f), 0, GLint(formats[i]), n, n, 0, GL_RGBA, GL_FLOAT, nullptr);
-      // Colour and seen points both filter linearly (see the 2D maps below).
+      // Colour, seen points (and the normals and indices of impostor mode's elements) filter linearly (see the
+      // 2D maps below; followCubes decodes the blended index).
       glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
       glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
       glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
@@ -1679,8 +1680,8 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     out.stages.ran("first-pass", msSince(t0), -1, note);
     if (follow > 0)
       out.stages.ran("nested-passes", 0, drawn_in_cubes,
-                     std::to_string(drawn_in_cubes) + " draw(s) of an element in another element's cube maps, with "
-                     "its normals and index (distance-normal impostors), followed per fragment up to "
+                     std::to_string(drawn_in_cubes) + " element(s) drawn into other elements' cube maps, with "
+                     "their normals and index (distance-normal impostors), followed per fragment up to "
                      "render.max_depth = " + std::to_string(scene.render.max_depth) +
                          (lens_in_cubes ? "; the lens refracted through its height maps there (at the d line "
                                           "when a mirror shows it)"
@@ -1692,7 +1693,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       out.stages.skipped("nested-passes", "mode impostor: lenses are absent from other elements' cube maps");
     else if (mode == RasterMode::Impostor)
       out.stages.skipped("nested-passes", "mode impostor: more than " + std::to_string(kMaxCubeElements) +
-                                              " elements (or texture units): other elements are absent from "
+                                              " elements (or too few texture units): other elements are absent from "
                                               "the cube maps");
     else
       out.stages.skipped("nested-passes", "mode " + modeName(mode) + ": other elements are absent from the cube maps");

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <functional>
 #include <iostream>
 #include <vector>
 
@@ -411,12 +412,77 @@ TEST_P(ImpostorTest, DepthLimitAbsorbsInsideTheGlassAsTheTracerDoes) {
   EXPECT_GE(near, ring * 95 / 100);
 }
 
+// --- several elements: each element's cubes show the others (followCubes) ---
+
+// Over the pixels `keep` selects (the reference and the frame see the same element there): the angular
+// errors (arcmin, sorted) and the summed colour error relative to the reference's summed colour.
+struct PathErrors {
+  std::vector<double> arcmin;
+  double colour = 0;
+};
+PathErrors pathErrors(const TracedFrame& ref, const gl::RasterFrame& f, const std::function<bool(size_t)>& keep) {
+  PathErrors out;
+  double cerr = 0, csum = 0;
+  for (size_t i = 0; i < ref.color.size(); ++i) {
+    if (ref.element[i] < 0 || f.element[i] != ref.element[i] || !keep(i)) continue;
+    const Vec3& at = ref.element_point[i];
+    out.arcmin.push_back(arcminutes(angleBetween(ref.seen[i] - at, f.seen[i] - at)));
+    const Vec3 d = glm::abs(f.color[i] - ref.color[i]);
+    cerr += d.x + d.y + d.z;
+    csum += ref.color[i].x + ref.color[i].y + ref.color[i].z;
+  }
+  std::sort(out.arcmin.begin(), out.arcmin.end());
+  out.colour = cerr / std::max(csum, 1e-30);
+  return out;
+}
+// The pixels `keep` selects where element 0 is drawn at render.max_depth `dark_depth` and one more: how many
+// of them are dark at the first (the tracer absorbs there) and lit at the second.
+struct DarkAndLit {
+  size_t n = 0, dark = 0, lit = 0;
+};
+DarkAndLit darkThenLit(Scene s, int dark_depth, const std::function<bool(size_t)>& keep) {
+  s.render.max_depth = dark_depth;
+  const gl::RasterFrame fd = impostorFrame(s);
+  s.render.max_depth = dark_depth + 1;
+  const gl::RasterFrame fl = impostorFrame(s);
+  DarkAndLit out;
+  for (size_t i = 0; i < fd.color.size(); ++i) {
+    if (!keep(i) || fd.element[i] != 0 || fl.element[i] != 0) continue;
+    ++out.n;
+    out.dark += glm::length(fd.color[i]) < 1e-6;
+    out.lit += glm::length(fl.color[i]) > 1e-3;
+  }
+  return out;
+}
+// A lens of roomLensScene's kind (n = 1.5) posed at `local_to_world`.
+Element posedLens(const char* name, cad::SagSurfacePtr front, cad::SagSurfacePtr back, double thickness,
+                  const cad::Outline& disc, const Mat4& local_to_world) {
+  Element lens = test::roomLensScene(name, std::move(front), std::move(back), thickness, disc).elements[0];
+  lens.local_to_world = local_to_world;
+  lens.world_to_local = glm::inverse(local_to_world);
+  return lens;
+}
+// The +2 D lens 0.2 m across (R = 0.5 m both sides, 25 mm thick at the centre).
+Element plusTwoLens(const Mat4& local_to_world) {
+  const cad::Outline disc = cad::Outline::circle(0.2);  // across
+  return posedLens("+2 D", cad::makeSphere(0.5, disc), cad::makeSphere(-0.5, disc), 0.025, disc, local_to_world);
+}
+// The stage note of the drawing into other elements' cubes, with its count of (cube, element) pairs.
+void expectNested(const gl::RasterFrame& f, int count, const std::string& phrase) {
+  const StageTiming* nest = f.stages.find("nested-passes");
+  ASSERT_NE(nest, nullptr);
+  EXPECT_TRUE(nest->ran);
+  EXPECT_EQ(nest->count, count) << nest->note;
+  EXPECT_NE(nest->note.find(phrase), std::string::npos) << nest->note;
+}
+
 // Mirrors in each other's cubes (models/mirror-pair.json): the back-wall mirror seen in the convex mirror, the
 // convex mirror again in that, down to render.max_depth = 4. Each element's cubes show the other mirror with
 // its exact surface point and normal; a search that meets it reflects there (the mirror's Fresnel) and goes on
 // in that mirror's cubes (seeds 000 and 001). Before, the cubes held the room only: median 7473' over the
 // convex mirror. Measured at 320 x 240 with 512^2 faces: median 0.0011' and p90 0.18' over the 3560 pixels
-// that meet two mirrors or more (pvrr's nested maps: 1.2' at 160 x 120), colour within 1.3 % of the tracer's.
+// that meet two mirrors or more (pvrr's nested maps: 1.2' at 160 x 120), colour within 1.2 % of the tracer's;
+// 16 pixels of 76,800 where the tracer sees a mirror and the impostor does not (rims).
 // With the depth limited to 2, the third copy is absorbed at its own surface, as in the tracer: dark in both
 // at all 74 of its pixels, at the same point (within 1 mm) at 63; the others lie on the copy's rim, where the
 // cube's distances blend the mirror's with the wall's behind it and the search stops between them.
@@ -429,63 +495,39 @@ TEST_P(ImpostorTest, MirrorsFollowedThroughEachOthersCubes) {
     Scene s = test::shippedScene("mirror-pair", {"observer.image_size=[320,240]"});
     if (lens_first) {
       const cad::Outline disc = cad::Outline::circle(0.04);
-      Element lens = test::roomLensScene("lens", cad::makeSphere(-0.1, disc), cad::makeSphere(0.1, disc), 0.0015, disc)
-                         .elements[0];
-      lens.local_to_world = test::pose(Vec3(0, -50, 0), Vec3(0, 0, 1));
-      lens.world_to_local = glm::inverse(lens.local_to_world);
-      s.elements.insert(s.elements.begin(), lens);
+      s.elements.insert(s.elements.begin(), posedLens("lens", cad::makeSphere(-0.1, disc), cad::makeSphere(0.1, disc),
+                                                      0.0015, disc, test::pose(Vec3(0, -50, 0), Vec3(0, 0, 1))));
       s.updateBounds();
     }
     const std::string label = lens_first ? "mirror pair after a lens" : "mirror pair";
-    RayScene rays(s);
-    auto trace = [&](int max_depth) {
-      TraceOptions to;
-      to.max_depth = max_depth;
-      return Tracer(rays, to).render();
-    };
-    auto render = [&](int max_depth) {
-      s.render.max_depth = max_depth;
-      gl::RendererOptions o;
-      o.map_size = 512;
-      gl::RasterFrame f = gl::Renderer(s, rays, o).render(gl::RasterMode::Impostor);
-      expectFinite(f);
-      return f;
-    };
-    const TracedFrame ref4 = trace(4), ref2 = trace(2);
-    const gl::RasterFrame f4 = render(4), f2 = render(2);
-    // Errors (arcmin, sorted) and mean colour error relative to the reference's mean, over the pixels whose
-    // reference path meets `bounces` mirrors (0: two or more).
+    const ImpostorRun run = runImpostor(s, false);
+    const TracedFrame& ref4 = run.ref;
+    // Over the pixels whose reference path meets `bounces` mirrors (0: two or more).
     auto errors = [&](int bounces) {
-      std::vector<double> e;
-      double cerr = 0, csum = 0;
-      for (size_t i = 0; i < ref4.color.size(); ++i) {
-        if (ref4.element[i] < 0 || f4.element[i] != ref4.element[i]) continue;
-        if (bounces > 0 ? ref4.bounces[i] != bounces : ref4.bounces[i] < 2) continue;
-        e.push_back(arcminutes(angleBetween(ref4.seen[i] - ref4.element_point[i], f4.seen[i] - ref4.element_point[i])));
-        const Vec3 d = glm::abs(f4.color[i] - ref4.color[i]);
-        cerr += d.x + d.y + d.z;
-        csum += ref4.color[i].x + ref4.color[i].y + ref4.color[i].z;
-      }
-      std::sort(e.begin(), e.end());
-      return std::make_pair(e, cerr / std::max(csum, 1e-30));
+      return pathErrors(ref4, run.f,
+                        [&](size_t i) { return bounces > 0 ? ref4.bounces[i] == bounces : ref4.bounces[i] >= 2; });
     };
-    const auto [nested, nested_colour] = errors(0);
+    const PathErrors nested = errors(0);
     std::cout << "[ measured ] " << label << " on " << gl::glBackendName(GetParam()) << ": two or more mirrors median "
-              << quantile(nested, 0.5) << "', p90 " << quantile(nested, 0.9) << "' (" << nested.size()
-              << " px), colour error " << 100 * nested_colour << " %; by mirrors met:";
+              << quantile(nested.arcmin, 0.5) << "', p90 " << quantile(nested.arcmin, 0.9) << "' ("
+              << nested.arcmin.size() << " px), colour error " << 100 * nested.colour << " %; by mirrors met:";
     for (int b = 1; b <= 4; ++b) {
-      const auto [e, c] = errors(b);
-      std::cout << " " << b << ": " << quantile(e, 0.5) << "' (" << e.size() << " px, colour " << 100 * c << " %)";
+      const PathErrors e = errors(b);
+      std::cout << " " << b << ": " << quantile(e.arcmin, 0.5) << "' (" << e.arcmin.size() << " px, colour "
+                << 100 * e.colour << " %)";
     }
-    std::cout << "; holes " << holes(ref4, f4) << "\n";
-    ASSERT_GT(nested.size(), 2000u) << label;
-    EXPECT_LE(quantile(nested, 0.5), 0.05) << label;
-    EXPECT_LE(quantile(nested, 0.9), 2.0) << label;
-    EXPECT_LE(quantile(errors(1).first, 0.5), 0.01) << label;
-    EXPECT_LE(nested_colour, 0.02) << label;
-    EXPECT_LE(holes(ref4, f4), ref4.color.size() / 1000) << label;  // 16 of 76,800 measured, at the rims
+    std::cout << "; holes " << holes(ref4, run.f) << "\n";
+    ASSERT_GT(nested.arcmin.size(), 2000u) << label;
+    EXPECT_LE(quantile(nested.arcmin, 0.5), 0.05) << label;
+    EXPECT_LE(quantile(nested.arcmin, 0.9), 2.0) << label;
+    EXPECT_LE(quantile(errors(1).arcmin, 0.5), 0.01) << label;
+    EXPECT_LE(nested.colour, 0.02) << label;
+    EXPECT_LE(holes(ref4, run.f), ref4.color.size() / 1000) << label;
     // Depth 2: where the reference path at depth 4 meets three mirrors or more, the tracer at depth 2 absorbs
     // at the third: black, its seen point on that mirror's surface.
+    s.render.max_depth = 2;
+    const TracedFrame ref2 = reference(s);
+    const gl::RasterFrame f2 = impostorFrame(s);
     size_t deep = 0, dark = 0, same_point = 0;
     for (size_t i = 0; i < ref4.color.size(); ++i) {
       if (ref4.element[i] < 0 || ref4.bounces[i] < 3 || f2.element[i] != ref2.element[i]) continue;
@@ -498,21 +540,16 @@ TEST_P(ImpostorTest, MirrorsFollowedThroughEachOthersCubes) {
     ASSERT_GT(deep, 50u) << label;
     EXPECT_GE(dark, deep * 95 / 100) << label;
     EXPECT_GE(same_point, deep * 80 / 100) << label;
-    // The stats say what was drawn in the cubes: each mirror in the other's cubes (and in the lens's, and the
-    // lens in both mirrors').
-    const StageTiming* nest = f4.stages.find("nested-passes");
-    ASSERT_NE(nest, nullptr);
-    EXPECT_TRUE(nest->ran);
-    EXPECT_EQ(nest->count, lens_first ? 6 : 2) << nest->note;
-    EXPECT_NE(nest->note.find("render.max_depth = 4"), std::string::npos) << nest->note;
+    // Each mirror in the other's cubes (and in the lens's, and the lens in both mirrors').
+    expectNested(run.f, lens_first ? 6 : 2, "render.max_depth = 4");
   }
 }
 
 // A lens in front of a mirror: what the -10 D lens shows of the mirror 1 m behind it (turned 30 deg, so that it
 // sends the rays to the side wall) comes from the mirror drawn in the lens's cubes, followed from the lens's
 // exit with the events the glass spent (entry and exit) counted towards render.max_depth. Measured: median
-// 0.0013' and p95 0.0076' over the pixels whose path leaves the lens for the mirror (against 5675' with the
-// cubes showing the room only).
+// 0.0013' and p95 0.0076' over the 2046 pixels whose path leaves the lens for the mirror (against 5675' with
+// the cubes showing the room only); at depth 2 all of them dark (the mirror is the third event), at 3 lit.
 TEST_P(ImpostorTest, LensSeesAMirrorInItsCubes) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
@@ -521,41 +558,20 @@ TEST_P(ImpostorTest, LensSeesAMirrorInItsCubes) {
   const cad::Outline square = cad::Outline::rectangle(0.4, 0.4, 0.02);
   test::addMirror(s, cad::makePlane(square), square, test::pose(Vec3(0.1, 0, 1.0), Vec3(0.5, 0, 0.866)), 7, 0.9);
   const ImpostorRun run = runImpostor(s, false);
-  std::vector<double> e;
-  for (size_t i = 0; i < run.ref.color.size(); ++i)
-    if (run.ref.element[i] == 0 && run.f.element[i] == 0 && run.ref.bounces[i] == 3)  // entry, exit, mirror
-      e.push_back(arcminutes(angleBetween(run.ref.seen[i] - run.ref.element_point[i],
-                                          run.f.seen[i] - run.ref.element_point[i])));
-  std::sort(e.begin(), e.end());
+  auto to_mirror = [&](size_t i) { return run.ref.element[i] == 0 && run.ref.bounces[i] == 3; };  // entry, exit, mirror
+  const PathErrors e = pathErrors(run.ref, run.f, to_mirror);
+  const DarkAndLit d = darkThenLit(s, 2, to_mirror);
   std::cout << "[ measured ] -10 D lens before a mirror on " << gl::glBackendName(GetParam()) << ": median "
-            << quantile(e, 0.5) << "', p95 " << quantile(e, 0.95) << "' over " << e.size()
-            << " px whose path meets the mirror; all lens px median " << quantile(run.errors, 0.5) << "'\n";
-  ASSERT_GT(e.size(), 1000u);
-  EXPECT_LE(quantile(e, 0.5), 0.01);
-  EXPECT_LE(quantile(e, 0.95), 0.5);
-  // With render.max_depth = 2 the glass spends the budget: the tracer absorbs at the mirror, dark.
-  s.render.max_depth = 2;
-  const gl::RasterFrame f2 = impostorFrame(s);
-  size_t dark = 0, n = 0;
-  for (size_t i = 0; i < run.ref.color.size(); ++i) {
-    if (run.ref.element[i] != 0 || f2.element[i] != 0 || run.ref.bounces[i] != 3) continue;
-    ++n;
-    dark += glm::length(f2.color[i]) < 1e-6;
-  }
-  ASSERT_GT(n, 1000u);
-  EXPECT_GE(dark, n * 99 / 100) << dark << " of " << n;
-  // With 3 the mirror is the third event: reflected, not dark.
-  s.render.max_depth = 3;
-  const gl::RasterFrame f3 = impostorFrame(s);
-  size_t lit = 0;
-  for (size_t i = 0; i < run.ref.color.size(); ++i)
-    lit += run.ref.element[i] == 0 && f3.element[i] == 0 && run.ref.bounces[i] == 3 && glm::length(f3.color[i]) > 1e-3;
-  EXPECT_GE(lit, n * 99 / 100) << lit << " of " << n;
-  const StageTiming* nest = run.f.stages.find("nested-passes");
-  ASSERT_NE(nest, nullptr);
-  EXPECT_TRUE(nest->ran);
-  EXPECT_EQ(nest->count, 2);  // the mirror in the lens's cubes, the lens in the mirror's
-  EXPECT_NE(nest->note.find("the lens refracted"), std::string::npos) << nest->note;
+            << quantile(e.arcmin, 0.5) << "', p95 " << quantile(e.arcmin, 0.95) << "' over " << e.arcmin.size()
+            << " px whose path meets the mirror; max_depth 2: " << d.dark << " of " << d.n << " dark, 3: " << d.lit
+            << " lit\n";
+  ASSERT_GT(e.arcmin.size(), 1500u);
+  EXPECT_LE(quantile(e.arcmin, 0.5), 0.01);
+  EXPECT_LE(quantile(e.arcmin, 0.95), 0.5);
+  ASSERT_GT(d.n, 1500u);
+  EXPECT_GE(d.dark, d.n * 99 / 100);
+  EXPECT_GE(d.lit, d.n * 99 / 100);
+  expectNested(run.f, 2, "the lens refracted");  // the mirror in the lens's cubes, the lens in the mirror's
 }
 
 // A mirror that shows a lens: the observer faces a plane mirror, and a +2 D lens 0.2 m across hangs behind
@@ -575,58 +591,26 @@ TEST_P(ImpostorTest, MirrorShowsALensThroughItsHeightMaps) {
     s.observer.fov_y_rad = radians(10);
     const cad::Outline square = cad::Outline::rectangle(0.5, 0.5, 0.02);
     test::addMirror(s, cad::makePlane(square), square, test::pose(Vec3(0, 0, 0), Vec3(0.02, 0.01, 1)), 7, 0.9);
-    const cad::Outline disc = cad::Outline::circle(0.2);  // across
-    Element lens = test::roomLensScene("+2 D", cad::makeSphere(0.5, disc), cad::makeSphere(-0.5, disc), 0.025, disc)
-                       .elements[0];
-    lens.local_to_world = test::pose(Vec3(0.05, 0.0, 2.2), Vec3(0, 0, turned ? 1 : -1));
-    lens.world_to_local = glm::inverse(lens.local_to_world);
-    s.elements.push_back(lens);
+    s.elements.push_back(plusTwoLens(test::pose(Vec3(0.05, 0.0, 2.2), Vec3(0, 0, turned ? 1 : -1))));
     s.updateBounds();
     const std::string label = turned ? "turned round" : "facing the mirror";
     const ImpostorRun run = runImpostor(s, false);
     // Pixels of the mirror whose reference path crosses the lens: the mirror, the entry, the exit.
-    auto through = [&](size_t i) {
-      return run.ref.element[i] == 0 && run.f.element[i] == 0 && run.ref.bounces[i] == 3;
-    };
-    std::vector<double> e;
-    double cerr = 0, csum = 0;
-    for (size_t i = 0; i < run.ref.color.size(); ++i) {
-      if (!through(i)) continue;
-      e.push_back(arcminutes(
-          angleBetween(run.ref.seen[i] - run.ref.element_point[i], run.f.seen[i] - run.ref.element_point[i])));
-      const Vec3 d = glm::abs(run.f.color[i] - run.ref.color[i]);
-      cerr += d.x + d.y + d.z;
-      csum += run.ref.color[i].x + run.ref.color[i].y + run.ref.color[i].z;
-    }
-    std::sort(e.begin(), e.end());
+    auto through = [&](size_t i) { return run.ref.element[i] == 0 && run.ref.bounces[i] == 3; };
+    const PathErrors e = pathErrors(run.ref, run.f, through);
+    const DarkAndLit d = darkThenLit(s, 2, through);
     std::cout << "[ measured ] mirror showing a +2 D lens " << label << " on " << gl::glBackendName(GetParam())
-              << ": median " << quantile(e, 0.5) << "', p95 " << quantile(e, 0.95) << "' over " << e.size()
-              << " px whose path crosses the lens; colour error " << 100 * cerr / std::max(csum, 1e-30)
-              << " %; all mirror px median " << quantile(run.errors, 0.5) << "'\n";
-    ASSERT_GT(e.size(), 2000u) << label;
-    EXPECT_LE(quantile(e, 0.5), 0.01) << label;
-    EXPECT_LE(quantile(e, 0.95), 0.5) << label;
-    EXPECT_LE(cerr, 0.02 * csum) << label;
-    // Depth 2: the tracer absorbs at the lens's exit (its third event); depth 3: it leaves the lens.
-    size_t dark = 0, lit = 0, n = 0;
-    s.render.max_depth = 2;
-    const gl::RasterFrame f2 = impostorFrame(s);
-    s.render.max_depth = 3;
-    const gl::RasterFrame f3 = impostorFrame(s);
-    for (size_t i = 0; i < run.ref.color.size(); ++i) {
-      if (!through(i) || f2.element[i] != 0 || f3.element[i] != 0) continue;
-      ++n;
-      dark += glm::length(f2.color[i]) < 1e-6;
-      lit += glm::length(f3.color[i]) > 1e-3;
-    }
-    std::cout << "[ measured ] " << label << ": max_depth 2 " << dark << " of " << n << " px dark, 3 " << lit
-              << " lit\n";
-    ASSERT_GT(n, 2000u) << label;
-    EXPECT_GE(dark, n * 99 / 100) << label;
-    EXPECT_GE(lit, n * 99 / 100) << label;
-    const StageTiming* nest = run.f.stages.find("nested-passes");
-    ASSERT_NE(nest, nullptr);
-    EXPECT_EQ(nest->count, 2) << nest->note;  // the lens in the mirror's cubes, the mirror in the lens's
+              << ": median " << quantile(e.arcmin, 0.5) << "', p95 " << quantile(e.arcmin, 0.95) << "' over "
+              << e.arcmin.size() << " px whose path crosses the lens; colour error " << 100 * e.colour
+              << " %; max_depth 2: " << d.dark << " of " << d.n << " dark, 3: " << d.lit << " lit\n";
+    ASSERT_GT(e.arcmin.size(), 3500u) << label;
+    EXPECT_LE(quantile(e.arcmin, 0.5), 0.01) << label;
+    EXPECT_LE(quantile(e.arcmin, 0.95), 0.5) << label;
+    EXPECT_LE(e.colour, 0.02) << label;
+    ASSERT_GT(d.n, 3500u) << label;
+    EXPECT_GE(d.dark, d.n * 99 / 100) << label;
+    EXPECT_GE(d.lit, d.n * 99 / 100) << label;
+    expectNested(run.f, 2, "the lens refracted");  // the lens in the mirror's cubes, the mirror in the lens's
   }
 }
 
@@ -634,8 +618,8 @@ TEST_P(ImpostorTest, MirrorShowsALensThroughItsHeightMaps) {
 // untilted mirror. Every pixel's path crosses the lens, reflects, and meets the lens again from behind (it
 // is drawn in the mirror's cubes): the lens's own program refracts through its height maps a second time,
 // entering through the back surface. render.max_depth 6 lets the tracer follow the five events. Measured:
-// median 0.00013', p95 0.00025' (about 5000' when the lens's own program took the lens in the mirror's cubes
-// for a mirror, or entered it through the front).
+// median 0.00013', p95 0.00025' over all 19,200 pixels (about 5000' when the lens's own program took the lens
+// in the mirror's cubes for a mirror, or entered it through the front).
 TEST_P(ImpostorTest, LightBackThroughTheSameLens) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
@@ -645,22 +629,21 @@ TEST_P(ImpostorTest, LightBackThroughTheSameLens) {
   const cad::Outline square = cad::Outline::rectangle(0.6, 0.6, 0.02);
   test::addMirror(s, cad::makePlane(square), square, test::pose(Vec3(0.02, 0, 1.0), Vec3(0, 0, 1)), 7, 0.9);
   const ImpostorRun run = runImpostor(s, false);
-  std::vector<double> e;
-  for (size_t i = 0; i < run.ref.color.size(); ++i)
-    if (run.ref.element[i] == 0 && run.f.element[i] == 0 && run.ref.bounces[i] == 5)  // lens, mirror, lens
-      e.push_back(arcminutes(angleBetween(run.ref.seen[i] - run.ref.element_point[i],
-                                          run.f.seen[i] - run.ref.element_point[i])));
-  std::sort(e.begin(), e.end());
+  // The lens, the mirror, the lens again.
+  const PathErrors e = pathErrors(run.ref, run.f, [&](size_t i) { return run.ref.bounces[i] == 5; });
   std::cout << "[ measured ] +2 D lens, mirror, the lens again from behind, on " << gl::glBackendName(GetParam())
-            << ": median " << quantile(e, 0.5) << "', p95 " << quantile(e, 0.95) << "' over " << e.size() << " px\n";
-  ASSERT_GT(e.size(), 500u);
-  EXPECT_LE(quantile(e, 0.5), 0.01);
-  EXPECT_LE(quantile(e, 0.95), 0.5);
+            << ": median " << quantile(e.arcmin, 0.5) << "', p95 " << quantile(e.arcmin, 0.95) << "' over "
+            << e.arcmin.size() << " px\n";
+  ASSERT_GT(e.arcmin.size(), 15000u);
+  EXPECT_LE(quantile(e.arcmin, 0.5), 0.01);
+  EXPECT_LE(quantile(e.arcmin, 0.95), 0.5);
 }
 
 // A mirror that shows the back of another: the observer faces a mirror, and a second mirror hangs behind the
 // observer facing away. The search from the first meets the second's texels with their normal pointing away:
-// dark, 0.05 of the diffuse light, its seen point there, as in the tracer.
+// dark, 0.05 of the diffuse light, its seen point there, as in the tracer. Measured: all 753 such pixels
+// within 2 % of the tracer's colour, all 650 of them 1 cm inside the second mirror's rim at the tracer's
+// seen point (to 1 mm); reflecting there instead failed every one.
 TEST_P(ImpostorTest, MirrorShowsAnotherMirrorsBack) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
@@ -688,7 +671,7 @@ TEST_P(ImpostorTest, MirrorShowsAnotherMirrorsBack) {
   std::cout << "[ measured ] the back of a mirror in a mirror on " << gl::glBackendName(GetParam()) << ": " << close
             << " of " << n << " px within 2 % of the tracer's colour; " << same_point << " of the " << inner
             << " 1 cm inside its rim at its seen point\n";
-  ASSERT_GT(n, 300u);
+  ASSERT_GT(n, 600u);
   EXPECT_GE(close, n * 95 / 100);
   ASSERT_GT(inner, n / 2);
   EXPECT_GE(same_point, inner * 99 / 100);
