@@ -14,7 +14,8 @@
 //                point the exact reflected (or doubly refracted) ray meets. LENS: the ray through the glass is
 //                traced per fragment in the lens's refractor height maps (pvrr/lens_height_map.h).
 //                IMPOSTOR_ITERATIONS: the search's false-position steps; IMPOSTOR_CHANNELS 3: a lens's R, G
-//                and B each refracted with its own index (u_index), else the middle one only.
+//                and B each refracted with its own index (u_index), else the middle one only (for a mirror:
+//                through the scene's lens, LENS_IN_CUBES).
 //                CUBE_ELEMENTS n (2 to 4): the scene's n elements each have cube maps in which the other
 //                mirrors are drawn with their surface point, normal and index (distance-normal impostors,
 //                seeds 000): a search that meets a mirror reflects there and goes on in that mirror's cubes
@@ -99,6 +100,8 @@ uniform vec3 u_index;             // the glass's index at the R, G and B wavelen
 #endif
 #if defined(LENS)
 uniform int u_max_events;         // the events inside the glass the tracer follows: render.max_depth - 1
+#endif
+#if defined(LENS) || defined(LENS_IN_CUBES)
 uniform int u_seen_channel;       // IMPOSTOR_CHANNELS 3: the channel whose ray gives the seen point
 #endif
 #if defined(LENS_IN_CUBES)
@@ -536,7 +539,18 @@ void main() {
 #else
 #if defined(CUBE_ELEMENTS)
   vec4 seen;
+#if defined(LENS_IN_CUBES) && IMPOSTOR_CHANNELS == 3
+  // The scene's lens disperses: each channel followed with its own index (the same path but through it).
+  vec3 c;
+  for (int ch = 0; ch < 3; ++ch) {
+    vec4 s;
+    vec3 rgb = followCubes(u_self, pos, reflect(view, n), 1, ch, s);
+    c[ch] = rgb[ch];
+    if (ch == u_seen_channel) seen = s;
+  }
+#else
   vec3 c = followCubes(u_self, pos, reflect(view, n), 1, 1, seen);
+#endif
   seen.xyz -= u_seen_offset;
 #else
   vec3 l = impostorHit(u_seen_cube, pos - u_seen_offset, reflect(view, n));

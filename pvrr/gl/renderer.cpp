@@ -713,6 +713,16 @@ struct Renderer::Impl {
   // Whether the lens is drawn in the other elements' cubes: the scene has one (the mirrors' programs take its
   // maps; its own program, which meets it again through a mirror, has them already).
   bool lensInCubes(RasterMode mode) const { return cubeElements(mode) > 0 && lensCount() == 1; }
+  // The colour channels of element e's impostor program (IMPOSTOR_CHANNELS): a lens with dispersion refracts R,
+  // G and B with their own indices, and so does a mirror that can show such a lens in its cubes.
+  int impostorChannels(size_t e) const {
+    auto dispersive = [&](size_t k) { return dispersionChannels(scene, int(k)).size() > 1; };
+    if (scene.elements[e].type == ElementType::Lens) return dispersive(e) ? 3 : 1;
+    if (!lensInCubes(RasterMode::Impostor)) return 1;
+    for (size_t k = 0; k < scene.elements.size(); ++k)
+      if (scene.elements[k].type == ElementType::Lens && dispersive(k)) return 3;
+    return 1;
+  }
   // The uniforms of the fragment loop over every element's cubes (CUBE_ELEMENTS), for element e drawn from a
   // camera at `origin`: three cubes per element on units from kFirstCubeUnit, their origins, the mirrors'
   // materials, and the tracer's depth limit.
@@ -1683,8 +1693,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
                      std::to_string(drawn_in_cubes) + " element(s) drawn into other elements' cube maps, with "
                      "their normals and index (distance-normal impostors), followed per fragment up to "
                      "render.max_depth = " + std::to_string(scene.render.max_depth) +
-                         (lens_in_cubes ? "; the lens refracted through its height maps there (at the d line "
-                                          "when a mirror shows it)"
+                         (lens_in_cubes ? "; the lens refracted through its height maps there"
                           : lensCount() > 0 ? "; lenses are absent from other elements' cube maps (more than one)"
                                             : ""));
     else if (n_el == 1)
@@ -1757,8 +1766,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       const int follow = cubeElements(mode);
       const Program& p = mode == RasterMode::Raster ? plain_program
                          : mode == RasterMode::Impostor
-                             ? impostorProgram(lens, dispersionChannels(scene, int(e)).size() > 1 ? 3 : 1, follow,
-                                               lensInCubes(mode))
+                             ? impostorProgram(lens, impostorChannels(e), follow, lensInCubes(mode))
                              : (lens ? lens_envmap_program : envmap_program);
       p.use();
       p.set("u_view_proj", toFloat(vp));
@@ -1779,10 +1787,9 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       }
       if (mode == RasterMode::Impostor && !lens) setMirrorMaps(p, e);
       if (follow > 0) setCubeElements(p, e, ob.eye);
-      if (mode == RasterMode::Impostor && lens) {
-        setLensMaps(p, e);
+      if (mode == RasterMode::Impostor && lens) setLensMaps(p, e);
+      if (mode == RasterMode::Impostor)
         p.set("u_seen_channel", options.seen_channel < 0 ? 1 : std::min(options.seen_channel, 2));
-      }
       MeshBuffers& mb = meshSlot();
       uploadElementGrid(mb, f, anchor);
       draw(mb);

@@ -614,6 +614,60 @@ TEST_P(ImpostorTest, MirrorShowsALensThroughItsHeightMaps) {
   }
 }
 
+// The same mirror showing a dispersive lens (n_d 1.5, V_d 20) with render.dispersion rgb: the mirror's program
+// follows R, G and B each with its own index through the lens in its cubes, as the tracer traces each
+// channel's ray. Measured (seen points of each channel against the tracer's, over the pixels whose path
+// crosses the lens): medians 0.00006-0.00007' per channel, where red against the tracer's blue is 6.6'; with
+// the d line's index for every channel, red was 2.0' off and blue 4.6'.
+TEST_P(ImpostorTest, MirrorShowsALensColourFringes) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  Scene s = test::roomScene(Vec3(0, 0, 1.5), Vec3(0, 0, -3), 160, 120);
+  s.observer.fov_y_rad = radians(10);
+  const cad::Outline square = cad::Outline::rectangle(0.5, 0.5, 0.02);
+  test::addMirror(s, cad::makePlane(square), square, test::pose(Vec3(0, 0, 0), Vec3(0.02, 0.01, 1)), 7, 0.9);
+  s.elements.push_back(plusTwoLens(test::pose(Vec3(0.05, 0.0, 2.2), Vec3(0, 0, -1))));
+  s.elements.back().dispersion = Dispersion::fromAbbe(1.5, 20);
+  s.elements.back().dispersion_on = true;
+  s.render.dispersion = "rgb";
+  s.updateBounds();
+  RayScene rays(s);
+  TraceOptions to;
+  to.dispersion = DispersionMode::Rgb;
+  to.max_depth = s.render.max_depth;
+  const TracedFrame ref = Tracer(rays, to).render();
+  ASSERT_FALSE(ref.channel_seen[0].empty());
+  auto through = [&](size_t i) { return ref.element[i] == 0 && ref.bounces[i] == 3; };
+  // Angular errors (sorted) of frame f's seen points against the tracer's of channel c, over `through`.
+  auto errors = [&](const gl::RasterFrame& f, int c) {
+    std::vector<double> e;
+    for (size_t i = 0; i < ref.color.size(); ++i)
+      if (through(i) && f.element[i] == 0)
+        e.push_back(arcminutes(angleBetween(ref.channel_seen[size_t(c)][i] - ref.element_point[i],
+                                            f.seen[i] - ref.element_point[i])));
+    std::sort(e.begin(), e.end());
+    return e;
+  };
+  double red_against_blue = 0;
+  for (int c = 0; c < 3; ++c) {
+    gl::RendererOptions o;
+    o.map_size = 512;
+    o.seen_channel = c;
+    const gl::RasterFrame f = gl::Renderer(s, rays, o).render(gl::RasterMode::Impostor);
+    expectFinite(f);
+    const std::vector<double> e = errors(f, c);
+    if (c == 0) red_against_blue = quantile(errors(f, 2), 0.5);
+    std::cout << "[ measured ] mirror showing a dispersive lens, channel " << c << " on "
+              << gl::glBackendName(GetParam()) << ": median " << quantile(e, 0.5) << "', p95 " << quantile(e, 0.95)
+              << "' over " << e.size() << " px\n";
+    ASSERT_GT(e.size(), 800u);
+    EXPECT_LE(quantile(e, 0.5), 0.01) << "channel " << c;
+    EXPECT_LE(quantile(e, 0.95), 0.5) << "channel " << c;
+  }
+  std::cout << "[ measured ] red against the tracer's blue: median " << red_against_blue << "'\n";
+  EXPECT_GE(red_against_blue, 1.0);
+}
+
 // A lens before a mirror that sends the light back through it: a +2 D lens 0.2 m across, 1 m in front of an
 // untilted mirror. Every pixel's path crosses the lens, reflects, and meets the lens again from behind (it
 // is drawn in the mirror's cubes): the lens's own program refracts through its height maps a second time,
