@@ -232,6 +232,15 @@ TracedFrame reference(const Scene& s) {
   to.max_depth = s.render.max_depth;
   return Tracer(rays, to).render();
 }
+// The reference with R, G and B each traced with its own index (TracedFrame::channel_seen).
+TracedFrame rgbReference(const RayScene& rays, int max_depth) {
+  TraceOptions to;
+  to.dispersion = DispersionMode::Rgb;
+  to.max_depth = max_depth;
+  TracedFrame ref = Tracer(rays, to).render();
+  EXPECT_FALSE(ref.channel_seen[0].empty());
+  return ref;
+}
 gl::RasterFrame impostorFrame(const Scene& s) {
   RayScene rays(s);
   gl::RendererOptions o;
@@ -302,11 +311,7 @@ TEST_P(ImpostorTest, EachColourChannelRefractedWithItsOwnIndex) {
   if (!ctx) return;
   Scene s = test::shippedScene("reading-lens", {"observer.image_size=[160,120]", "render.dispersion=\"rgb\""});
   RayScene rays(s);
-  TraceOptions to;
-  to.dispersion = DispersionMode::Rgb;
-  to.max_depth = s.render.max_depth;
-  const TracedFrame ref = Tracer(rays, to).render();
-  ASSERT_FALSE(ref.channel_seen[0].empty());
+  const TracedFrame ref = rgbReference(rays, s.render.max_depth);
   std::array<std::vector<double>, 3> e;
   gl::RasterFrame green;
   double red_against_blue = 0;
@@ -467,6 +472,15 @@ Element plusTwoLens(const Mat4& local_to_world) {
   const cad::Outline disc = cad::Outline::circle(0.2);  // across
   return posedLens("+2 D", cad::makeSphere(0.5, disc), cad::makeSphere(-0.5, disc), 0.025, disc, local_to_world);
 }
+// The observer 1.5 m in front of a plane mirror (`side` square, reflectance 0.9, turned a little), looking at
+// it: what lies behind the observer shows in the mirror.
+Scene facingMirror(int width, int height, double fov_deg, double side) {
+  Scene s = test::roomScene(Vec3(0, 0, 1.5), Vec3(0, 0, -3), width, height);
+  s.observer.fov_y_rad = radians(fov_deg);
+  const cad::Outline square = cad::Outline::rectangle(side, side, 0.02);
+  test::addMirror(s, cad::makePlane(square), square, test::pose(Vec3(0, 0, 0), Vec3(0.02, 0.01, 1)), 7, 0.9);
+  return s;
+}
 // The stage note of the drawing into other elements' cubes, with its count of (cube, element) pairs.
 void expectNested(const gl::RasterFrame& f, int count, const std::string& phrase) {
   const StageTiming* nest = f.stages.find("nested-passes");
@@ -587,10 +601,7 @@ TEST_P(ImpostorTest, MirrorShowsALensThroughItsHeightMaps) {
   if (!ctx) return;
   // Facing the mirror, and turned round (the mirror's rays then enter through the back surface).
   for (const bool turned : {false, true}) {
-    Scene s = test::roomScene(Vec3(0, 0, 1.5), Vec3(0, 0, -3), 320, 240);
-    s.observer.fov_y_rad = radians(10);
-    const cad::Outline square = cad::Outline::rectangle(0.5, 0.5, 0.02);
-    test::addMirror(s, cad::makePlane(square), square, test::pose(Vec3(0, 0, 0), Vec3(0.02, 0.01, 1)), 7, 0.9);
+    Scene s = facingMirror(320, 240, 10, 0.5);
     s.elements.push_back(plusTwoLens(test::pose(Vec3(0.05, 0.0, 2.2), Vec3(0, 0, turned ? 1 : -1))));
     s.updateBounds();
     const std::string label = turned ? "turned round" : "facing the mirror";
@@ -622,21 +633,14 @@ TEST_P(ImpostorTest, MirrorShowsALensThroughItsHeightMaps) {
 TEST_P(ImpostorTest, MirrorShowsALensColourFringes) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
-  Scene s = test::roomScene(Vec3(0, 0, 1.5), Vec3(0, 0, -3), 160, 120);
-  s.observer.fov_y_rad = radians(10);
-  const cad::Outline square = cad::Outline::rectangle(0.5, 0.5, 0.02);
-  test::addMirror(s, cad::makePlane(square), square, test::pose(Vec3(0, 0, 0), Vec3(0.02, 0.01, 1)), 7, 0.9);
+  Scene s = facingMirror(160, 120, 10, 0.5);
   s.elements.push_back(plusTwoLens(test::pose(Vec3(0.05, 0.0, 2.2), Vec3(0, 0, -1))));
   s.elements.back().dispersion = Dispersion::fromAbbe(1.5, 20);
   s.elements.back().dispersion_on = true;
   s.render.dispersion = "rgb";
   s.updateBounds();
   RayScene rays(s);
-  TraceOptions to;
-  to.dispersion = DispersionMode::Rgb;
-  to.max_depth = s.render.max_depth;
-  const TracedFrame ref = Tracer(rays, to).render();
-  ASSERT_FALSE(ref.channel_seen[0].empty());
+  const TracedFrame ref = rgbReference(rays, s.render.max_depth);
   auto through = [&](size_t i) { return ref.element[i] == 0 && ref.bounces[i] == 3; };
   // Angular errors (sorted) of frame f's seen points against the tracer's of channel c, over `through`.
   auto errors = [&](const gl::RasterFrame& f, int c) {
@@ -701,10 +705,7 @@ TEST_P(ImpostorTest, LightBackThroughTheSameLens) {
 TEST_P(ImpostorTest, MirrorShowsAnotherMirrorsBack) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
-  Scene s = test::roomScene(Vec3(0, 0, 1.5), Vec3(0, 0, -3), 160, 120);
-  s.observer.fov_y_rad = radians(20);
-  const cad::Outline square = cad::Outline::rectangle(0.8, 0.8, 0.02);
-  test::addMirror(s, cad::makePlane(square), square, test::pose(Vec3(0, 0, 0), Vec3(0.02, 0.01, 1)), 7, 0.9);
+  Scene s = facingMirror(160, 120, 20, 0.8);
   const cad::Outline small = cad::Outline::rectangle(0.3, 0.3, 0.02);
   test::addMirror(s, cad::makePlane(small), small, test::pose(Vec3(0.1, 0.05, 2.2), Vec3(0, 0, 1)), 5, 0.9);
   s.updateBounds();
