@@ -97,12 +97,10 @@ uniform vec2 u_hm_z;              // the back surface's lowest z and the front s
 uniform float u_hm_reach;         // the maps' diagonal: no straight path inside the glass is longer
 uniform float u_far;              // render.far_distance_m: where a ray absorbed at the rim puts its seen point
 uniform vec3 u_index;             // the glass's index at the R, G and B wavelengths (.y: the d line)
+uniform int u_seen_channel;       // IMPOSTOR_CHANNELS 3: the channel whose ray gives the seen point
 #endif
 #if defined(LENS)
 uniform int u_max_events;         // the events inside the glass the tracer follows: render.max_depth - 1
-#endif
-#if defined(LENS) || defined(LENS_IN_CUBES)
-uniform int u_seen_channel;       // IMPOSTOR_CHANNELS 3: the channel whose ray gives the seen point
 #endif
 #if defined(LENS_IN_CUBES)
 uniform int u_cube_lens;          // the lens's element index
@@ -356,7 +354,7 @@ float fresnelConductor(float cos_i, float n, float k) {
 // lens's height maps where the ray meets the surface (a ray past its outline goes on in the lens's cubes,
 // which do not show the lens), refracts through the glass (throughLens, with the index of `channel`: 0-2 R,
 // G, B) and goes on from the exit in the lens's cubes. Returns the colour; `seen`: the last point, relative
-// to the camera origin (w 0: escaping).
+// to the camera origin (w 0: escaping); `refracted`: whether the path met the lens (else no channel matters).
 #define CUBE_LOOKUP(k)                                                                                              \
   if (cur == k) {                                                                                                  \
     centre = u_cube_centre[k];                                                                                     \
@@ -365,8 +363,9 @@ float fresnelConductor(float cos_i, float n, float k) {
     s = texture(u_seen_cubes[k], l);                                                                               \
     nid = texture(u_normal_cubes[k], l);                                                                           \
   }
-vec3 followCubes(int cur, vec3 x, vec3 R, int depth, int channel, out vec4 seen) {
+vec3 followCubes(int cur, vec3 x, vec3 R, int depth, int channel, out vec4 seen, out bool refracted) {
   vec3 throughput = vec3(1.0);
+  refracted = false;
   seen = vec4(x, 1.0);  // 64 passes past the lens's outline without an event: no seen point of its own
   for (int bounce = 0; bounce < 64; ++bounce) {
     vec3 centre = vec3(0.0), l = R, c = vec3(0.0);
@@ -413,6 +412,7 @@ vec3 followCubes(int cur, vec3 x, vec3 R, int depth, int channel, out vec4 seen)
       bool rim;
       int spent;
       vec3 q = throughLens(entry, vl, n_in, u_index[channel], u_max_depth - 1 - depth, dir, tr, rim, spent);
+      refracted = true;
       if (tr <= 0.0) {  // absorbed inside the glass, or at its rim
         seen = rim ? vec4(lens_centre + (q + u_far * dir) * u_lens_to_local, 0.0)
                    : vec4(lens_centre + q * u_lens_to_local, 1.0);
@@ -524,7 +524,8 @@ void main() {
         // Back to world axes: the local frame's origin is the cube's.
 #if defined(CUBE_ELEMENTS)
         vec4 s;
-        vec3 rgb = tr * followCubes(u_self, q * u_to_local + u_seen_offset, dir * u_to_local, spent, k, s);
+        bool again;  // met the lens once more, through a mirror: with this channel's index already
+        vec3 rgb = tr * followCubes(u_self, q * u_to_local + u_seen_offset, dir * u_to_local, spent, k, s, again);
         if (seen_here) seen = vec4(s.xyz - u_seen_offset, s.w);
 #else
         vec3 l = impostorHit(u_seen_cube, q * u_to_local, dir * u_to_local);
@@ -539,17 +540,19 @@ void main() {
 #else
 #if defined(CUBE_ELEMENTS)
   vec4 seen;
+  bool refracted;
+  vec3 c = followCubes(u_self, pos, reflect(view, n), 1, 1, seen, refracted);
 #if defined(LENS_IN_CUBES) && IMPOSTOR_CHANNELS == 3
-  // The scene's lens disperses: each channel followed with its own index (the same path but through it).
-  vec3 c;
-  for (int ch = 0; ch < 3; ++ch) {
-    vec4 s;
-    vec3 rgb = followCubes(u_self, pos, reflect(view, n), 1, ch, s);
-    c[ch] = rgb[ch];
-    if (ch == u_seen_channel) seen = s;
+  // The scene's lens disperses: a path that met it is followed again for R and B with their own indices
+  // (paths that did not are the same in every channel).
+  if (refracted) {
+    for (int ch = 0; ch < 3; ch += 2) {
+      vec4 s;
+      vec3 rgb = followCubes(u_self, pos, reflect(view, n), 1, ch, s, refracted);
+      c[ch] = rgb[ch];
+      if (ch == u_seen_channel) seen = s;
+    }
   }
-#else
-  vec3 c = followCubes(u_self, pos, reflect(view, n), 1, 1, seen);
 #endif
   seen.xyz -= u_seen_offset;
 #else

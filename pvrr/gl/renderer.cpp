@@ -1752,6 +1752,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   PassCamera eye_cam;
   eye_cam.origin = ob.eye;
   eye_cam.view_proj = vp;
+  const int follow = cubeElements(mode);  // impostor: the elements the fragments follow through their cubes
   for (size_t e = 0; e < n_el; ++e) {
     const Element& el = scene.elements[e];
     const Vec3 anchor = Vec3(el.local_to_world[3]);
@@ -1763,7 +1764,6 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     } else {
       ElementFrame f = prepareElement(scene, int(e), &grid_cache.get(scene, int(e)));
       if (lens && mode == RasterMode::Envmap) traceVertexRays(rays, f, ob.eye, VertexStageOptions{});
-      const int follow = cubeElements(mode);
       const Program& p = mode == RasterMode::Raster ? plain_program
                          : mode == RasterMode::Impostor
                              ? impostorProgram(lens, impostorChannels(e), follow, lensInCubes(mode))
