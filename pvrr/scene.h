@@ -109,6 +109,7 @@ struct RenderSettings {
   double map_texels_per_pixel = 4;   // a top-level map's texels per image pixel of its patch; 0: map_size
   double map_reuse_margin_deg = 2;   // maps widened this much for reuse by later frames; 0: none
   int impostor_iterations = 8;       // impostor mode: false-position steps of each fragment's search
+  int impostor_layers = 2;           // impostor mode: layers of each distance map (2: the second depth-peeled)
   std::string output;
   int max_depth = 4;
   std::string dispersion = "off";  // off | rgb | spectral

@@ -351,6 +351,7 @@ Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
   rs.map_texels_per_pixel = desc.render.map_texels_per_pixel;
   rs.map_reuse_margin_deg = desc.render.map_reuse_margin_deg;
   rs.impostor_iterations = desc.render.impostor_iterations;
+  rs.impostor_layers = desc.render.impostor_layers;
   rs.output = desc.render.output.empty() ? "out/" + scene.name + ".png" : desc.render.output;
   rs.max_depth = desc.render.max_depth;
   rs.dispersion = toString(desc.render.dispersion);

@@ -195,6 +195,7 @@ struct RenderDesc {
   double map_texels_per_pixel = 4;  // 0: every map at map_size
   double map_reuse_margin_deg = 2;  // 0: no map reuse across frames
   int impostor_iterations = 8;      // impostor mode: false-position steps of each fragment's search
+  int impostor_layers = 2;          // impostor mode: layers of each distance map (2: the second depth-peeled)
   std::string output;  // relative to the current directory, as written (default out/<scene name>.png)
   int max_depth = 4;
   Dispersion dispersion = Dispersion::Off;

@@ -887,8 +887,8 @@ RenderDesc readRender(const Ctx& c, const json* j, const std::string& source) {
   r.output = (fs::path("out") / (fs::path(source).stem().string() + ".png")).string();
   if (!j) return r;
   Obj o(c, j, "render", "an object {\"mode\", \"map_size\", \"output\", ...}",
-        {"mode", "map_size", "map_texels_per_pixel", "map_reuse_margin_deg", "impostor_iterations", "output", "max_depth",
-         "dispersion", "spectral_samples",
+        {"mode", "map_size", "map_texels_per_pixel", "map_reuse_margin_deg", "impostor_iterations", "impostor_layers", "output",
+         "max_depth", "dispersion", "spectral_samples",
          "background"});
   const std::string mode = o.choice("mode", {"pvrr", "raster", "raytrace", "envmap", "impostor"}, "pvrr");
   r.mode = mode == "pvrr"       ? RenderDesc::Mode::Pvrr
@@ -900,6 +900,7 @@ RenderDesc readRender(const Ctx& c, const json* j, const std::string& source) {
   r.map_texels_per_pixel = o.number("map_texels_per_pixel", closed(0, 1e4), 4);
   r.map_reuse_margin_deg = o.number("map_reuse_margin_deg", closed(0, 10), 2);
   r.impostor_iterations = o.integer("impostor_iterations", 0, 64, 8);
+  r.impostor_layers = o.integer("impostor_layers", 1, 2, 2);
   if (o.has("output")) {
     r.output = o.string("output");
     if (!endsWithAny(r.output, {".png"})) o.expected("output", "a file name ending in \".png\"");

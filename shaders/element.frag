@@ -21,6 +21,8 @@
 //                seeds 000): a search that meets a mirror reflects there and goes on in that mirror's cubes
 //                (followCubes); LENS_IN_CUBES: the other elements' cubes show the scene's one lens too, and a
 //                search that meets it refracts through its height maps and goes on in the lens's cubes.
+//                IMPOSTOR_LAYERS 2: each distance map has a second, depth-peeled layer (seeds 001), searched
+//                where the first layer's result lies behind a depth edge (layeredHit).
 //                CUBE_GEOMETRY: an element drawn into another element's cube: a mirror's exact surface point
 //                (a lens's mesh point) as the seen point, and its normal and element id in the surface output.
 //   MODE_PLAIN   a plain grey shaded surface (raster mode); u_dark: black, an element met at the depth limit
@@ -64,6 +66,10 @@ uniform samplerCube u_seen_cube;
 uniform samplerCube u_cube;       // the environment's colour from the element's origin (the envmap cube)
 uniform samplerCube u_seen_cube;  // its seen points relative to that origin (u_seen_offset): the distances
 uniform mat3 u_to_local;          // world directions -> the element's local frame (whose origin is the cube's)
+#if IMPOSTOR_LAYERS > 1
+uniform samplerCube u_cube1;      // the second layers (depth-peeled)
+uniform samplerCube u_seen_cube1;
+#endif
 #if defined(CUBE_ELEMENTS)
 // Per element (index): its cubes (colour; seen points, whose lengths are the distances; normal and index + 1
 // of an element drawn in them, 0 elsewhere), their origin relative to the camera origin, and its mirror
@@ -71,6 +77,11 @@ uniform mat3 u_to_local;          // world directions -> the element's local fra
 uniform samplerCube u_cubes[CUBE_ELEMENTS];
 uniform samplerCube u_seen_cubes[CUBE_ELEMENTS];
 uniform samplerCube u_normal_cubes[CUBE_ELEMENTS];
+#if IMPOSTOR_LAYERS > 1
+uniform samplerCube u_cubes1[CUBE_ELEMENTS];  // the second layers (depth-peeled)
+uniform samplerCube u_seen_cubes1[CUBE_ELEMENTS];
+uniform samplerCube u_normal_cubes1[CUBE_ELEMENTS];
+#endif
 uniform vec3 u_cube_centre[CUBE_ELEMENTS];
 uniform bool u_el_metal[CUBE_ELEMENTS];
 uniform vec3 u_el_reflectance[CUBE_ELEMENTS];
@@ -134,14 +145,9 @@ float envDistance(samplerCube seen, vec3 dir) { return length(texture(seen, dir)
 // the distance seen along R, then a plane through the two samples; then false position between the last
 // undershooting (in front of the surface) and overshooting parameters, 0 while there is none (the direction
 // R itself, at infinity, stands in for a missing overshoot, as in the paper).
-vec3 impostorHit(samplerCube seen, vec3 x, vec3 R) {
-  float r1 = envDistance(seen, R);
-  float dp = r1 - dot(x, R);
-  vec3 p = x + R * dp;
-  float ppp = length(p) / envDistance(seen, p);
-  float dun = 0.0, dov = 0.0, pun = ppp, pov = ppp;
-  if (ppp < 1.0) dun = dp; else dov = dp;
-  float dl = max(dp + r1 * (1.0 - ppp), 0.0);
+// falsePosition: that search from parameter dl, with the last undershooting (dun, ratio |l| / distance pun) and
+// overshooting (dov, pov) parameters so far (0: none); r1 the distance the impostor holds along R.
+vec3 falsePosition(samplerCube seen, vec3 x, vec3 R, float r1, float dl, float dun, float pun, float dov, float pov) {
   vec3 l = x + R * dl;
   for (int i = 0; i < IMPOSTOR_ITERATIONS; ++i) {
     float llp = length(l) / envDistance(seen, l);
@@ -159,6 +165,101 @@ vec3 impostorHit(samplerCube seen, vec3 x, vec3 R) {
   }
   return dot(l, l) > 0.0 ? l : R;  // x at the cube's origin and d = 0: the direction itself
 }
+vec3 impostorHit(samplerCube seen, vec3 x, vec3 R) {
+  float r1 = envDistance(seen, R);
+  float dp = r1 - dot(x, R);
+  vec3 p = x + R * dp;
+  float ppp = length(p) / envDistance(seen, p);
+  float dun = 0.0, dov = 0.0, pun = ppp, pov = ppp;
+  if (ppp < 1.0) dun = dp; else dov = dp;
+  float dl = max(dp + r1 * (1.0 - ppp), 0.0);
+  return falsePosition(seen, x, R, r1, dl, dun, pun, dov, pov);
+}
+
+#if IMPOSTOR_LAYERS > 1
+// Seeds 001's layered distance maps, for what an occluder near the element hides from the cube's origin (seeds
+// 003, Fig. 6): the second layer holds the nearest surfaces beyond the first (depth peeling).
+//
+// Whether l, found by a search on the ray from x along R, lies on a surface of the layer: the search came within
+// 1e-3 of the distance there, and it did not end where the ray passes behind a depth edge. There the layer's
+// distance jumps (1.5 texels to either side, across the ray's sweep, the farther more than 1.5 x the nearer),
+// the filtered distance blends the two surfaces, and the search ends between them, at a point on neither:
+// more than 1.25 x the nearer's distance and less than 0.8 x the farther's.
+bool onSurface(samplerCube seen, vec3 l, vec3 R) {
+  float len = length(l), d = envDistance(seen, l);
+  if (!(abs(len - d) <= 1e-3 * d)) return false;
+  vec3 u = l / len, t = R - dot(R, u) * u;
+  float tl = length(t);
+  if (tl < 1e-4) return true;  // the ray runs along the origin's line of sight: it sweeps no edge
+  t *= 3.0 / (float(textureSize(seen, 0).x) * tl);  // 1.5 texels at a face's centre (2 / size a texel)
+  float d0 = envDistance(seen, u - t), d1 = envDistance(seen, u + t);
+  float dn = min(d0, d1), df = max(d0, d1);
+  return !(df > 1.5 * dn && len > 1.25 * dn && len < 0.8 * df);
+}
+
+// A crossing of a layer between the march's parameters d0 (ratio r0 < 1) and d1 (ratio r1 >= 1; at_end: the
+// ray's end at infinity), refined by false position; whether it lies on the layer's surface.
+bool layerCrossing(samplerCube seen, vec3 x, vec3 R, float d0, float r0, float d1, float r1, bool at_end,
+                   out vec3 l) {
+  float rR = envDistance(seen, R);
+  float dl = at_end ? max(d0 + rR * (1.0 - r0), d0) : d0 + (d1 - d0) * (1.0 - r0) / (r1 - r0);
+  l = falsePosition(seen, x, R, rR, dl, d0, r0, at_end ? 0.0 : d1, r1);
+  return onSurface(seen, l, R);
+}
+
+// The first hit of the ray x + d R (x relative to the cube's origin, R unit) in the two layers; `layer`: which
+// holds it. The first layer's search as above; where its result is not on a surface, seeds 001's linear search:
+// LAYER_STEPS steps over both layers, uniform in the direction from the origin (from x's to R's: d = |x| t /
+// (1 - t)), each bracket of an undershooting and an overshooting sample refined by false position and kept if
+// on a surface, the nearer of the two layers' first. Nothing kept: the first layer's result.
+const int LAYER_STEPS = 16;
+float rayRatio(samplerCube seen, vec3 p) {
+  float len = length(p);
+  return len > 0.0 ? len / envDistance(seen, p) : 0.0;
+}
+vec3 layeredHit(samplerCube seen0, samplerCube seen1, vec3 x, vec3 R, out int layer) {
+  layer = 0;
+  vec3 l0 = impostorHit(seen0, x, R);
+  if (onSurface(seen0, l0, R)) return l0;
+  float a = length(x), d_prev = 0.0;
+  vec2 r_prev = vec2(rayRatio(seen0, x), rayRatio(seen1, x));
+  for (int i = 1; i <= LAYER_STEPS; ++i) {
+    bool at_end = i == LAYER_STEPS;
+    float t = float(i) / float(LAYER_STEPS), d = at_end ? 0.0 : a * t / (1.0 - t);
+    vec3 p = x + R * d;
+    vec2 r = at_end ? vec2(2.0) : vec2(rayRatio(seen0, p), rayRatio(seen1, p));
+    vec3 l, best = l0;
+    float d_best = -1.0;
+    if (r_prev.x < 1.0 && r.x >= 1.0 && layerCrossing(seen0, x, R, d_prev, r_prev.x, d, r.x, at_end, l))
+      best = l, d_best = dot(l - x, R);
+    if (r_prev.y < 1.0 && r.y >= 1.0 && layerCrossing(seen1, x, R, d_prev, r_prev.y, d, r.y, at_end, l) &&
+        (d_best < 0.0 || dot(l - x, R) < d_best)) {
+      layer = 1;
+      return l;
+    }
+    if (d_best >= 0.0) return best;
+    d_prev = d;
+    r_prev = r;
+  }
+  return l0;
+}
+#endif
+
+#if !defined(CUBE_ELEMENTS)
+// The element's own cubes: the colour and seen point (relative to the origin) where the ray x + d R meets them.
+void envHit(vec3 x, vec3 R, out vec3 colour, out vec4 seen) {
+#if IMPOSTOR_LAYERS > 1
+  int layer;
+  vec3 l = layeredHit(u_seen_cube, u_seen_cube1, x, R, layer);
+  colour = layer == 1 ? texture(u_cube1, l).rgb : texture(u_cube, l).rgb;
+  seen = layer == 1 ? texture(u_seen_cube1, l) : texture(u_seen_cube, l);
+#else
+  vec3 l = impostorHit(u_seen_cube, x, R);
+  colour = texture(u_cube, l).rgb;
+  seen = texture(u_seen_cube, l);
+#endif
+}
+#endif
 
 #if !defined(LENS)
 // The normalised parameters of the surface point on the view ray from e with direction v (both local), from
@@ -355,6 +456,17 @@ float fresnelConductor(float cos_i, float n, float k) {
 // which do not show the lens), refracts through the glass (throughLens, with the index of `channel`: 0-2 R,
 // G, B) and goes on from the exit in the lens's cubes. Returns the colour; `seen`: the last point, relative
 // to the camera origin (w 0: escaping); `refracted`: whether the path met the lens (else no channel matters).
+#if IMPOSTOR_LAYERS > 1
+#define CUBE_LOOKUP(k)                                                                                              \
+  if (cur == k) {                                                                                                  \
+    centre = u_cube_centre[k];                                                                                     \
+    int layer;                                                                                                     \
+    l = layeredHit(u_seen_cubes[k], u_seen_cubes1[k], x - centre, R, layer);                                       \
+    c = layer == 1 ? texture(u_cubes1[k], l).rgb : texture(u_cubes[k], l).rgb;                                     \
+    s = layer == 1 ? texture(u_seen_cubes1[k], l) : texture(u_seen_cubes[k], l);                                   \
+    nid = layer == 1 ? texture(u_normal_cubes1[k], l) : texture(u_normal_cubes[k], l);                             \
+  }
+#else
 #define CUBE_LOOKUP(k)                                                                                              \
   if (cur == k) {                                                                                                  \
     centre = u_cube_centre[k];                                                                                     \
@@ -363,6 +475,7 @@ float fresnelConductor(float cos_i, float n, float k) {
     s = texture(u_seen_cubes[k], l);                                                                               \
     nid = texture(u_normal_cubes[k], l);                                                                           \
   }
+#endif
 vec3 followCubes(int cur, vec3 x, vec3 R, int depth, int channel, out vec4 seen, out bool refracted) {
   vec3 throughput = vec3(1.0);
   refracted = false;
@@ -452,6 +565,7 @@ void main() {
   // A lens in another element's cube: where the ray from the cube's origin meets its mesh, its outward normal
   // (the texel's weight, and the side the search enters, which then refracts in the lens's own height maps)
   // and its index.
+  peel(v_pos);
   o_color = vec4(0.0);
   o_seen = vec4(v_pos, 1.0);
   o_surface = vec4(n, u_element_id);
@@ -474,6 +588,7 @@ void main() {
   cos_i = -dot(view, n);
   o_surface = vec4(pos, u_element_id);
 #if defined(CUBE_GEOMETRY)
+  peel(pos);
   o_color = vec4(0.0);
   o_seen = vec4(pos, 1.0);
   o_surface = vec4(n, u_element_id);
@@ -528,9 +643,11 @@ void main() {
         vec3 rgb = tr * followCubes(u_self, q * u_to_local + u_seen_offset, dir * u_to_local, spent, k, s, again);
         if (seen_here) seen = vec4(s.xyz - u_seen_offset, s.w);
 #else
-        vec3 l = impostorHit(u_seen_cube, q * u_to_local, dir * u_to_local);
-        vec3 rgb = tr * texture(u_cube, l).rgb;
-        if (seen_here) seen = texture(u_seen_cube, l);
+        vec3 rgb;
+        vec4 s;
+        envHit(q * u_to_local, dir * u_to_local, rgb, s);
+        rgb *= tr;
+        if (seen_here) seen = s;
 #endif
         if (IMPOSTOR_CHANNELS == 3) c[ch] = rgb[ch];
         else c = rgb;
@@ -556,9 +673,9 @@ void main() {
 #endif
   seen.xyz -= u_seen_offset;
 #else
-  vec3 l = impostorHit(u_seen_cube, pos - u_seen_offset, reflect(view, n));
-  vec3 c = texture(u_cube, l).rgb;
-  vec4 seen = texture(u_seen_cube, l);
+  vec3 c;
+  vec4 seen;
+  envHit(pos - u_seen_offset, reflect(view, n), c, seen);
 #endif
 #endif
 #elif defined(MODE_PVRR)

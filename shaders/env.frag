@@ -16,6 +16,7 @@ flat in vec3 v_face_normal;
 flat in vec3 v_face_light;
 #endif
 void main() {
+  peel(v_pos);
   vec3 albedo = u_albedo;
 #if defined(TEXTURED)
   albedo *= texture(u_texture, v_uv).rgb;

@@ -332,9 +332,11 @@ struct Renderer::Impl {
   }
   // Environment meshes (shaders/env.frag): FACETED (one normal per triangle), TEXTURED (a material with a
   // texture; without, no texture is sampled: llvmpipe samples inside a uniform branch all the same).
-  const Program& envProgram(bool faceted, bool textured, bool planes, bool with_seen = false) const {
+  // PEEL: the second layer of an impostor's distance map (shaders/outputs.glsl).
+  const Program& envProgram(bool faceted, bool textured, bool planes, bool with_seen = false, bool peel = false) const {
     std::vector<std::string> d;
     if (with_seen) d.push_back(kWithSeenPoints);
+    if (peel) d.push_back("#define PEEL");
     if (faceted) d.push_back("#define FACETED");
     if (textured) d.push_back("#define TEXTURED");
     if (planes) d.push_back("#define PLANES");
@@ -347,10 +349,12 @@ struct Renderer::Impl {
   // Distance-impostor elements (shaders/element.frag, MODE_IMPOSTOR): a mirror, or a lens with one or three
   // wavelengths; cube_elements > 0: searches that meet a mirror in a cube go on in its cubes (CUBE_ELEMENTS).
   // lens_in_cubes: the scene's one lens is drawn in the other elements' cubes and refracted through there.
-  const Program& impostorProgram(bool lens, int channels, int cube_elements, bool lens_in_cubes) const {
+  // layers: of each distance map (IMPOSTOR_LAYERS; 2: the second depth-peeled, searched where the first fails).
+  const Program& impostorProgram(bool lens, int channels, int cube_elements, bool lens_in_cubes, int layers) const {
     std::vector<std::string> d{"#define MODE_IMPOSTOR",
                                "#define IMPOSTOR_ITERATIONS " + std::to_string(scene.render.impostor_iterations),
-                               "#define IMPOSTOR_CHANNELS " + std::to_string(channels)};
+                               "#define IMPOSTOR_CHANNELS " + std::to_string(channels),
+                               "#define IMPOSTOR_LAYERS " + std::to_string(layers)};
     if (lens) d.push_back("#define LENS");
     if (cube_elements > 0) d.push_back("#define CUBE_ELEMENTS " + std::to_string(cube_elements));
     if (cube_elements > 0 && lens_in_cubes) d.push_back("#define LENS_IN_CUBES");
@@ -358,10 +362,11 @@ struct Renderer::Impl {
   }
   // An element drawn into another element's impostor cubes (CUBE_GEOMETRY): a mirror's exact surface point
   // and normal, a lens's mesh point; and its index.
-  const Program& cubeGeometryProgram(bool lens) const {
+  const Program& cubeGeometryProgram(bool lens, bool peel) const {
     std::vector<std::string> d{"#define MODE_IMPOSTOR", "#define IMPOSTOR_ITERATIONS 0", "#define IMPOSTOR_CHANNELS 1",
-                               "#define CUBE_GEOMETRY", kWithSeenPoints};
+                               "#define IMPOSTOR_LAYERS 1", "#define CUBE_GEOMETRY", kWithSeenPoints};
     if (lens) d.push_back("#define LENS");
+    if (peel) d.push_back("#define PEEL");
     return builtProgram("element.vert", "element.frag", d);
   }
   const Program& plainProgram(bool planes) const {
@@ -402,6 +407,7 @@ struct Renderer::Impl {
   uint64_t first_pass_serial = 0;
   std::vector<int> map_side;  // per map slot: the longer side its last first pass rendered (MapPass::side)
   std::vector<std::unique_ptr<CubeTarget>> cubes;  // envmap and impostor cubes, one per element
+  std::vector<std::unique_ptr<CubeTarget>> cubes1;  // impostor mode's second layers (impostorLayers), one per element
   // Impostor mode: each lens's refractor height maps (pvrr/lens_height_map.h), built on first use (a lens's
   // shape in its own frame never changes; its pose reaches the shader as u_to_local).
   struct LensMaps {
@@ -542,7 +548,8 @@ struct Renderer::Impl {
   // Returns how many closed convex meshes it drew and culled.
   // with_seen: write seen points even when RendererOptions::seen_points is off (impostor cube maps).
   CullCount drawEnvironment(const Mat4& view, const Mat4& proj, const Vec3& origin, bool reversed_depth = false,
-                            const Vec3* rays_from = nullptr, bool planes = false, bool with_seen = false) const {
+                            const Vec3* rays_from = nullptr, bool planes = false, bool with_seen = false,
+                            bool peel = false) const {
     const Mat4 vp = relativeViewProj(proj, view, origin);
     const Program& sky = skyProgram(planes, with_seen);
     auto drawSky = [&] {
@@ -567,8 +574,9 @@ struct Renderer::Impl {
       const bool faceted = env_faceted[m], textured = env_textured[m];
       const Program*& p = programs[faceted][textured];
       if (p) continue;
-      p = &envProgram(faceted, textured, planes, with_seen);
+      p = &envProgram(faceted, textured, planes, with_seen, peel);
       p->use();
+      if (peel) p->set("u_peel", kPeelUnit);
       p->set("u_view_proj", toFloat(vp));
       p->set("u_view_origin", rays_from ? glm::vec3(*rays_from - origin) : glm::vec3(0.0f));
       if (textured) p->set("u_texture", 0);
@@ -697,6 +705,7 @@ struct Renderer::Impl {
   // each cube shows the environment only).
   static constexpr int kMaxCubeElements = 4;
   static constexpr int kFirstCubeUnit = 6;  // after a cube pair (0, 1) and the element's own maps (2 to 5)
+  static constexpr int kPeelUnit = 1;       // the first layer's seen points while its second layer is drawn
   size_t lensCount() const {
     return size_t(std::count_if(scene.elements.begin(), scene.elements.end(),
                                 [](const Element& e) { return e.type == ElementType::Lens; }));
@@ -709,6 +718,14 @@ struct Renderer::Impl {
         kFirstCubeUnit + 3 * n + (lensCount() == 1 ? 3 : 0) > max_texture_units)
       return 0;
     return n;
+  }
+  // The layers of each impostor distance map (render.impostor_layers; seeds 001): 2 where the texture units allow
+  // the second layer's cubes (two more for one element, three more an element with CUBE_ELEMENTS), else 1.
+  int impostorLayers(RasterMode mode) const {
+    if (mode != RasterMode::Impostor || scene.render.impostor_layers < 2) return 1;
+    const int follow = cubeElements(mode);
+    const int units = follow > 0 ? kFirstCubeUnit + 6 * follow + (lensCount() == 1 ? 3 : 0) : kFirstCubeUnit + 2;
+    return units <= max_texture_units ? 2 : 1;
   }
   // Whether the lens is drawn in the other elements' cubes: the scene has one (the mirrors' programs take its
   // maps; its own program, which meets it again through a mirror, has them already).
@@ -724,19 +741,22 @@ struct Renderer::Impl {
     return 1;
   }
   // The uniforms of the fragment loop over every element's cubes (CUBE_ELEMENTS), for element e drawn from a
-  // camera at `origin`: three cubes per element on units from kFirstCubeUnit, their origins, the mirrors'
-  // materials, and the tracer's depth limit.
-  void setCubeElements(const Program& p, size_t e, const Vec3& origin) {
+  // camera at `origin`: three cubes per element on units from kFirstCubeUnit (and, with two layers, the second
+  // layer's three after them), their origins, the mirrors' materials, and the tracer's depth limit.
+  void setCubeElements(const Program& p, size_t e, const Vec3& origin, int layers) {
+    const int n = int(scene.elements.size());
     for (size_t k = 0; k < scene.elements.size(); ++k) {
       const Element& el = scene.elements[k];
       const std::string i = "[" + std::to_string(k) + "]";
-      const char* names[3] = {"u_cubes", "u_seen_cubes", "u_normal_cubes"};
-      for (int a = 0; a < 3; ++a) {
-        const int unit = kFirstCubeUnit + 3 * int(k) + a;
-        glActiveTexture(GLenum(GL_TEXTURE0 + unit));
-        glBindTexture(GL_TEXTURE_CUBE_MAP, cubes[k]->colors[size_t(a)]);
-        p.set(names[a] + i, unit);
-      }
+      const char* names[2][3] = {{"u_cubes", "u_seen_cubes", "u_normal_cubes"},
+                                 {"u_cubes1", "u_seen_cubes1", "u_normal_cubes1"}};
+      for (int layer = 0; layer < layers; ++layer)
+        for (int a = 0; a < 3; ++a) {
+          const int unit = kFirstCubeUnit + 3 * (layer * n + int(k)) + a;
+          glActiveTexture(GLenum(GL_TEXTURE0 + unit));
+          glBindTexture(GL_TEXTURE_CUBE_MAP, (layer ? cubes1 : cubes)[k]->colors[size_t(a)]);
+          p.set(names[layer][a] + i, unit);
+        }
       p.set("u_cube_centre" + i, glm::vec3(Vec3(el.local_to_world[3]) - origin));
       p.set("u_el_metal" + i, el.mirror.metal ? 1 : 0);
       p.set("u_el_reflectance" + i, glm::vec3(el.mirror.reflectance));
@@ -752,7 +772,7 @@ struct Renderer::Impl {
       for (size_t k = 0; k < scene.elements.size(); ++k) {
         if (scene.elements[k].type != ElementType::Lens) continue;
         if (k == e) p.set("u_lens_to_local", glm::mat3(Mat3(scene.elements[k].world_to_local)));
-        else setLensMaps(p, k, kFirstCubeUnit + 3 * int(scene.elements.size()), "u_lens_to_local");
+        else setLensMaps(p, k, kFirstCubeUnit + 3 * layers * n, "u_lens_to_local");
         p.set("u_cube_lens", int(k));
       }
   }
@@ -760,12 +780,13 @@ struct Renderer::Impl {
   // Element m drawn into a face of another element's impostor cubes, from a camera at `origin` (view_proj
   // relative to it), before the environment (CUBE_GEOMETRY): a mirror's exact surface point and normal per
   // fragment, a lens's mesh.
-  void drawCubeElement(size_t m, const Mat4& view_proj, const Vec3& origin, const MeshBuffers& mesh) {
+  void drawCubeElement(size_t m, const Mat4& view_proj, const Vec3& origin, const MeshBuffers& mesh, bool peel) {
     const Element& el = scene.elements[m];
     const Vec3 anchor = Vec3(el.local_to_world[3]);
     const bool lens = el.type == ElementType::Lens;
-    const Program& p = cubeGeometryProgram(lens);
+    const Program& p = cubeGeometryProgram(lens, peel);
     p.use();
+    if (peel) p.set("u_peel", kPeelUnit);
     p.set("u_view_proj", toFloat(view_proj));
     p.set("u_offset", glm::vec3(anchor - origin));
     p.set("u_view_origin", glm::vec3(0.0f));
@@ -1631,6 +1652,10 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       out.stages.skipped("nested-passes", "no element is inside another element's view volume");
   } else if ((mode == RasterMode::Envmap || mode == RasterMode::Impostor) && n_el > 0) {
     while (cubes.size() < n_el) cubes.push_back(std::make_unique<CubeTarget>());
+    const int layers = impostorLayers(mode);
+    while (layers > 1 && cubes1.size() < n_el) cubes1.push_back(std::make_unique<CubeTarget>());
+    if (layers == 1) cubes1.clear();  // a scene without the second layers holds none
+    const int layer1_size = std::max(16, options.map_size / 2);
     CullCount culled;
     // Impostor cube maps hold the seen points (each direction's distance) even in a colour-only frame, and with
     // other elements in them (cubeElements) a third cube of their normals and indices.
@@ -1665,24 +1690,41 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     }
     glActiveTexture(GL_TEXTURE0);
     for (size_t e = 0; e < n_el; ++e) {
-      CubeTarget& c = *cubes[e];
-      if (c.size != options.map_size || c.colors.size() != formats.size()) c.create(options.map_size, formats);
       const Vec3 centre = Vec3(scene.elements[e].local_to_world[3]);
       const double near_m = 1e-3, far_m = 2.0 * (scene.boundsRadius() + glm::length(centre - scene.bounds_min)) + 1.0;
       const Mat4 proj = glm::perspective(kPi / 2, 1.0, near_m, far_m);
-      for (int face = 0; face < 6; ++face) {
-        c.selectFace(face);
-        const Mat4 view = glm::lookAt(centre, centre + kCubeDir[face], kCubeUp[face]);
-        for (size_t m = 0; m < n_el; ++m)
-          if (m != e && inCubes(m)) {
-            drawCubeElement(m, relativeViewProj(proj, view, centre), centre, element_meshes[cube_mesh[m]]);
-            drawn_in_cubes += face == 0;
-          }
-        culled.add(drawEnvironment(view, proj, centre, false, nullptr, false, with_seen));
+      // Layer 0: the nearest surfaces. Layer 1 (seeds 001, depth peeling, at half the size): the nearest beyond
+      // them, what an occluder near the element hides from its origin; the sky where nothing is.
+      for (int layer = 0; layer < layers; ++layer) {
+        CubeTarget& c = layer ? *cubes1[e] : *cubes[e];
+        const int size = layer ? layer1_size : options.map_size;
+        if (c.size != size || c.colors.size() != formats.size()) c.create(size, formats);
+        if (layer) {
+          glActiveTexture(GLenum(GL_TEXTURE0 + kPeelUnit));
+          glBindTexture(GL_TEXTURE_CUBE_MAP, cubes[e]->colors[1]);
+          glActiveTexture(GL_TEXTURE0);
+        }
+        for (int face = 0; face < 6; ++face) {
+          c.selectFace(face);
+          const Mat4 view = glm::lookAt(centre, centre + kCubeDir[face], kCubeUp[face]);
+          for (size_t m = 0; m < n_el; ++m)
+            if (m != e && inCubes(m)) {
+              drawCubeElement(m, relativeViewProj(proj, view, centre), centre, element_meshes[cube_mesh[m]], layer > 0);
+              drawn_in_cubes += face == 0 && layer == 0;
+            }
+          culled.add(drawEnvironment(view, proj, centre, false, nullptr, false, with_seen, layer > 0));
+        }
       }
     }
+    glActiveTexture(GLenum(GL_TEXTURE0 + kPeelUnit));
+    glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
+    glActiveTexture(GL_TEXTURE0);
     glFinish();
     std::string note = mode == RasterMode::Impostor ? "distance impostors: colour and seen-point cube maps" : "";
+    if (layers > 1)
+      appendNote(note, "two layers each (the second depth-peeled, " + std::to_string(layer1_size) + "^2 a face)");
+    else if (mode == RasterMode::Impostor && scene.render.impostor_layers > 1)
+      appendNote(note, "one layer each: too few texture units for the second layers' cubes");
     if (follow > 0) appendNote(note, "normal and index cube maps of the elements in them");
     if (height_maps > 0) appendNote(note, "refractor height maps of " + std::to_string(height_maps) + " lens(es) built");
     if (surface_maps > 0) appendNote(note, "surface maps of " + std::to_string(surface_maps) + " mirror(s) built");
@@ -1753,6 +1795,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   eye_cam.origin = ob.eye;
   eye_cam.view_proj = vp;
   const int follow = cubeElements(mode);  // impostor: the elements the fragments follow through their cubes
+  const int layers = impostorLayers(mode);
   for (size_t e = 0; e < n_el; ++e) {
     const Element& el = scene.elements[e];
     const Vec3 anchor = Vec3(el.local_to_world[3]);
@@ -1766,7 +1809,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       if (lens && mode == RasterMode::Envmap) traceVertexRays(rays, f, ob.eye, VertexStageOptions{});
       const Program& p = mode == RasterMode::Raster ? plain_program
                          : mode == RasterMode::Impostor
-                             ? impostorProgram(lens, impostorChannels(e), follow, lensInCubes(mode))
+                             ? impostorProgram(lens, impostorChannels(e), follow, lensInCubes(mode), layers)
                              : (lens ? lens_envmap_program : envmap_program);
       p.use();
       p.set("u_view_proj", toFloat(vp));
@@ -1785,8 +1828,17 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
         p.set("u_seen_cube", 1);
         p.set("u_seen_offset", glm::vec3(anchor - ob.eye));
       }
+      if (layers > 1 && follow == 0) {  // one element: its second layer after its own maps
+        for (int a = 0; a < 2; ++a) {
+          glActiveTexture(GLenum(GL_TEXTURE0 + kFirstCubeUnit + a));
+          glBindTexture(GL_TEXTURE_CUBE_MAP, cubes1[e]->colors[size_t(a)]);
+        }
+        glActiveTexture(GL_TEXTURE0);
+        p.set("u_cube1", kFirstCubeUnit);
+        p.set("u_seen_cube1", kFirstCubeUnit + 1);
+      }
       if (mode == RasterMode::Impostor && !lens) setMirrorMaps(p, e);
-      if (follow > 0) setCubeElements(p, e, ob.eye);
+      if (follow > 0) setCubeElements(p, e, ob.eye, layers);
       if (mode == RasterMode::Impostor && lens) setLensMaps(p, e);
       if (mode == RasterMode::Impostor)
         p.set("u_seen_channel", options.seen_channel < 0 ? 1 : std::min(options.seen_channel, 2));

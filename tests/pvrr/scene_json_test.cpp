@@ -565,6 +565,9 @@ TEST(SceneJson, OverridesAreValidatedLikeTheFile) {
   EXPECT_EQ(parse(kBase).render.impostor_iterations, 8);
   EXPECT_EQ(parse(kBase, {"render.impostor_iterations=0"}).render.impostor_iterations, 0);
   expectContains(errorOf(kBase, {"render.impostor_iterations=65"}), "render.impostor_iterations: expected an integer in [0, 64]");
+  EXPECT_EQ(parse(kBase).render.impostor_layers, 2);
+  EXPECT_EQ(parse(kBase, {"render.impostor_layers=1"}).render.impostor_layers, 1);
+  expectContains(errorOf(kBase, {"render.impostor_layers=3"}), "render.impostor_layers: expected an integer in [1, 2]");
 }
 
 TEST(SceneJson, OverrideOfAnUnknownPathFailsNamingIt) {
