@@ -211,7 +211,9 @@ bool layerCrossing(samplerCube seen, vec3 x, vec3 R, float d0, float r0, float d
 // holds it. The first layer's search as above; where its result is not on a surface, seeds 001's linear search:
 // LAYER_STEPS steps over both layers, uniform in the direction from the origin (from x's to R's: d = |x| t /
 // (1 - t)), each bracket of an undershooting and an overshooting sample refined by false position and kept if
-// on a surface, the nearer of the two layers' first. Nothing kept: the first layer's result.
+// on a surface, the nearer of the two layers' first. Nothing kept: the first layer's result. The march starts
+// a quarter step out (t = 1 / (4 LAYER_STEPS)), so that no bracket starts at d = 0, which falsePosition
+// reads as no undershoot yet.
 const int LAYER_STEPS = 16;
 float rayRatio(samplerCube seen, vec3 p) {
   float len = length(p);
@@ -221,8 +223,13 @@ vec3 layeredHit(samplerCube seen0, samplerCube seen1, vec3 x, vec3 R, out int la
   layer = 0;
   vec3 l0 = impostorHit(seen0, x, R);
   if (onSurface(seen0, l0, R)) return l0;
-  float a = length(x), d_prev = 0.0;
-  vec2 r_prev = vec2(rayRatio(seen0, x), rayRatio(seen1, x));
+#if !defined(LAYER_MARCH)
+  discard;  // the second draw, LAYER_MARCH, shades this pixel (pvrr/gl/renderer.cpp)
+  return l0;
+#else
+  float a = length(x), t0 = 0.25 / float(LAYER_STEPS), d_prev = a * t0 / (1.0 - t0);
+  vec3 p0 = x + R * d_prev;
+  vec2 r_prev = vec2(rayRatio(seen0, p0), rayRatio(seen1, p0));
   for (int i = 1; i <= LAYER_STEPS; ++i) {
     bool at_end = i == LAYER_STEPS;
     float t = float(i) / float(LAYER_STEPS), d = at_end ? 0.0 : a * t / (1.0 - t);
@@ -242,6 +249,7 @@ vec3 layeredHit(samplerCube seen0, samplerCube seen1, vec3 x, vec3 R, out int la
     r_prev = r;
   }
   return l0;
+#endif
 }
 #endif
 

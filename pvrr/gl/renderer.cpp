@@ -350,7 +350,9 @@ struct Renderer::Impl {
   // wavelengths; cube_elements > 0: searches that meet a mirror in a cube go on in its cubes (CUBE_ELEMENTS).
   // lens_in_cubes: the scene's one lens is drawn in the other elements' cubes and refracted through there.
   // layers: of each distance map (IMPOSTOR_LAYERS; 2: the second depth-peeled, searched where the first fails).
-  const Program& impostorProgram(bool lens, int channels, int cube_elements, bool lens_in_cubes, int layers) const {
+  // layer_march: with two layers, the second draw (LAYER_MARCH; the first discards where it would search them).
+  const Program& impostorProgram(bool lens, int channels, int cube_elements, bool lens_in_cubes, int layers,
+                                 bool layer_march) const {
     std::vector<std::string> d{"#define MODE_IMPOSTOR",
                                "#define IMPOSTOR_ITERATIONS " + std::to_string(scene.render.impostor_iterations),
                                "#define IMPOSTOR_CHANNELS " + std::to_string(channels),
@@ -358,6 +360,7 @@ struct Renderer::Impl {
     if (lens) d.push_back("#define LENS");
     if (cube_elements > 0) d.push_back("#define CUBE_ELEMENTS " + std::to_string(cube_elements));
     if (cube_elements > 0 && lens_in_cubes) d.push_back("#define LENS_IN_CUBES");
+    if (layer_march) d.push_back("#define LAYER_MARCH");
     return builtProgram("element.vert", "element.frag", d);
   }
   // An element drawn into another element's impostor cubes (CUBE_GEOMETRY): a mirror's exact surface point
@@ -1775,13 +1778,17 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
                           return f.rays.size() > 3;
                         });
   const ColorFormat colour = options.seen_points || additive ? ColorFormat::RGBA32F : ColorFormat::RGBA16;
+  const int follow = cubeElements(mode);  // impostor: the elements the fragments follow through their cubes
+  const int layers = impostorLayers(mode);
+  // Two layers: a stencil marks each element's pixels whose first draw kept its first layer's result.
+  const DepthFormat depth_format = layers > 1 ? DepthFormat::Depth32FStencil8 : DepthFormat::Depth32F;
   if (!frame_target || frame_target->width() != ob.width || frame_target->height() != ob.height ||
-      frame_target->colorFormat(0) != colour)
+      frame_target->colorFormat(0) != colour || frame_target->depthFormat() != depth_format)
     frame_target = std::make_unique<Framebuffer>(
         ob.width, ob.height,
         options.seen_points ? std::vector<ColorFormat>{colour, ColorFormat::RGBA32F, ColorFormat::RGBA32F}
                             : std::vector<ColorFormat>{colour},
-        DepthFormat::Depth32F);
+        depth_format);
   frame_target->clearDepth();  // no colour clear: the sky covers every pixel nothing else does
   // The elements come first: the depth state must not depend on what an earlier pass (or none) left.
   glEnable(GL_DEPTH_TEST);
@@ -1794,8 +1801,6 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   PassCamera eye_cam;
   eye_cam.origin = ob.eye;
   eye_cam.view_proj = vp;
-  const int follow = cubeElements(mode);  // impostor: the elements the fragments follow through their cubes
-  const int layers = impostorLayers(mode);
   for (size_t e = 0; e < n_el; ++e) {
     const Element& el = scene.elements[e];
     const Vec3 anchor = Vec3(el.local_to_world[3]);
@@ -1807,44 +1812,62 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     } else {
       ElementFrame f = prepareElement(scene, int(e), &grid_cache.get(scene, int(e)));
       if (lens && mode == RasterMode::Envmap) traceVertexRays(rays, f, ob.eye, VertexStageOptions{});
-      const Program& p = mode == RasterMode::Raster ? plain_program
-                         : mode == RasterMode::Impostor
-                             ? impostorProgram(lens, impostorChannels(e), follow, lensInCubes(mode), layers)
-                             : (lens ? lens_envmap_program : envmap_program);
-      p.use();
-      p.set("u_view_proj", toFloat(vp));
-      p.set("u_offset", glm::vec3(anchor - ob.eye));
-      p.set("u_view_origin", glm::vec3(0.0f));
-      setLights(p, ob.eye);
-      setElementMaterial(p, el, int(e));
-      if (mode == RasterMode::Raster) p.set("u_dark", 0);
-      if (mode == RasterMode::Envmap || mode == RasterMode::Impostor) {
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_CUBE_MAP, cubes[e]->colors[0]);
-        glActiveTexture(GL_TEXTURE1);
-        if (cubes[e]->colors.size() > 1) glBindTexture(GL_TEXTURE_CUBE_MAP, cubes[e]->colors[1]);
-        glActiveTexture(GL_TEXTURE0);
-        p.set("u_cube", 0);
-        p.set("u_seen_cube", 1);
-        p.set("u_seen_offset", glm::vec3(anchor - ob.eye));
-      }
-      if (layers > 1 && follow == 0) {  // one element: its second layer after its own maps
-        for (int a = 0; a < 2; ++a) {
-          glActiveTexture(GLenum(GL_TEXTURE0 + kFirstCubeUnit + a));
-          glBindTexture(GL_TEXTURE_CUBE_MAP, cubes1[e]->colors[size_t(a)]);
-        }
-        glActiveTexture(GL_TEXTURE0);
-        p.set("u_cube1", kFirstCubeUnit);
-        p.set("u_seen_cube1", kFirstCubeUnit + 1);
-      }
-      if (mode == RasterMode::Impostor && !lens) setMirrorMaps(p, e);
-      if (follow > 0) setCubeElements(p, e, ob.eye, layers);
-      if (mode == RasterMode::Impostor && lens) setLensMaps(p, e);
-      if (mode == RasterMode::Impostor)
-        p.set("u_seen_channel", options.seen_channel < 0 ? 1 : std::min(options.seen_channel, 2));
+      // Impostor with two layers: the first draw leaves the pixels whose search ends off a surface in the first
+      // layer (LAYER_MARCH undefined: it discards them) and marks the others in the stencil; the second draw
+      // (LAYER_MARCH) shades only the unmarked ones. A renderer that runs every path of a shader with the lanes
+      // that do not take it masked off (llvmpipe) pays the second layer's search only there.
+      const int draws = mode == RasterMode::Impostor && layers > 1 ? 2 : 1;
       MeshBuffers& mb = meshSlot();
       uploadElementGrid(mb, f, anchor);
-      draw(mb);
+      for (int d = 0; d < draws; ++d) {
+        const Program& p = mode == RasterMode::Raster ? plain_program
+                           : mode == RasterMode::Impostor
+                               ? impostorProgram(lens, impostorChannels(e), follow, lensInCubes(mode), layers, d == 1)
+                               : (lens ? lens_envmap_program : envmap_program);
+        p.use();
+        p.set("u_view_proj", toFloat(vp));
+        p.set("u_offset", glm::vec3(anchor - ob.eye));
+        p.set("u_view_origin", glm::vec3(0.0f));
+        setLights(p, ob.eye);
+        setElementMaterial(p, el, int(e));
+        if (mode == RasterMode::Raster) p.set("u_dark", 0);
+        if (mode == RasterMode::Envmap || mode == RasterMode::Impostor) {
+          glActiveTexture(GL_TEXTURE0);
+          glBindTexture(GL_TEXTURE_CUBE_MAP, cubes[e]->colors[0]);
+          glActiveTexture(GL_TEXTURE1);
+          if (cubes[e]->colors.size() > 1) glBindTexture(GL_TEXTURE_CUBE_MAP, cubes[e]->colors[1]);
+          glActiveTexture(GL_TEXTURE0);
+          p.set("u_cube", 0);
+          p.set("u_seen_cube", 1);
+          p.set("u_seen_offset", glm::vec3(anchor - ob.eye));
+        }
+        if (layers > 1 && follow == 0) {  // one element: its second layer after its own maps
+          for (int a = 0; a < 2; ++a) {
+            glActiveTexture(GLenum(GL_TEXTURE0 + kFirstCubeUnit + a));
+            glBindTexture(GL_TEXTURE_CUBE_MAP, cubes1[e]->colors[size_t(a)]);
+          }
+          glActiveTexture(GL_TEXTURE0);
+          p.set("u_cube1", kFirstCubeUnit);
+          p.set("u_seen_cube1", kFirstCubeUnit + 1);
+        }
+        if (mode == RasterMode::Impostor && !lens) setMirrorMaps(p, e);
+        if (follow > 0) setCubeElements(p, e, ob.eye, layers);
+        if (mode == RasterMode::Impostor && lens) setLensMaps(p, e);
+        if (mode == RasterMode::Impostor)
+          p.set("u_seen_channel", options.seen_channel < 0 ? 1 : std::min(options.seen_channel, 2));
+        if (draws > 1) {
+          // The second draw writes no stencil: llvmpipe then tests depth and stencil before the shader (a
+          // shader that may discard and a stencil it writes would be tested after) and skips blocks of pixels
+          // that all fail.
+          glEnable(GL_STENCIL_TEST);
+          glStencilFunc(d == 0 ? GL_ALWAYS : GL_NOTEQUAL, GLint(e + 1), 0xFF);
+          glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+          glStencilMask(d == 0 ? 0xFF : 0x00);
+        }
+        draw(mb);
+      }
+      glStencilMask(0xFF);
+      glDisable(GL_STENCIL_TEST);
     }
   }
   // The environment after the elements: behind a lens or mirror it fails the early depth test, unshaded.

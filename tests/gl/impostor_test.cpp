@@ -14,6 +14,7 @@
 
 #include "cad/lens.h"
 #include "pvrr/gl/context.h"
+#include "pvrr/gl/gl.h"
 #include "pvrr/gl/renderer.h"
 #include "pvrr/spectrum.h"
 #include "pvrr/tracer.h"
@@ -197,11 +198,17 @@ TEST_P(ImpostorTest, SearchStepsConvergeAtDepthEdges) {
 // Measured at 320 x 240 with 512^2 faces: one layer p95 43.5', p99 5634'; two 0.32' and 5.5' (no peeling in
 // the second layer: 1.4' and 271'). The same with a second mirror under the road, out of sight, so that the
 // car mirror's search runs in the loop over several elements' cubes (CUBE_ELEMENTS), whose second layers
-// hold the normal and index cubes too.
+// hold the normal and index cubes too (18 texture units: GL 3.3 promises 16, llvmpipe has 32).
 TEST_P(ImpostorTest, SecondLayerShowsWhatAnOccluderHidesFromTheOrigin) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
+  GLint units = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &units);
   for (const bool several : {false, true}) {
+    if (several && units < 18) {
+      std::cout << "[ skipped  ] several elements with two layers: " << units << " texture units\n";
+      continue;
+    }
     std::vector<ImpostorRun> runs;
     for (const int layers : {1, 2}) {
       Scene s = test::shippedScene("car-mirror", {"observer.image_size=[320,240]",
