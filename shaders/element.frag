@@ -197,13 +197,29 @@ bool onSurface(samplerCube seen, vec3 l, vec3 R) {
   return !(df > 1.5 * dn && len > 1.25 * dn && len < 0.8 * df);
 }
 
+// |p| / the layer's distance in p's direction: below 1 in front of the layer, above behind it.
+float rayRatio(samplerCube seen, vec3 p) {
+  float len = length(p);
+  return len > 0.0 ? len / envDistance(seen, p) : 0.0;
+}
+
 // A crossing of a layer between the march's parameters d0 (ratio r0 < 1) and d1 (ratio r1 >= 1; at_end: the
-// ray's end at infinity), refined by false position; whether it lies on the layer's surface.
+// ray's end at infinity), refined by false position; whether it lies on the layer's surface. A bracket can hold
+// a depth edge and a crossing of the surface beyond it (the wall behind a box's edge), and false position may
+// end at the edge: then the ray is looked at 2 texels further on its sweep, and if it is in front of the layer
+// there, the bracket from there is refined too. (Behind it there, the ray passed behind an occluder.)
 bool layerCrossing(samplerCube seen, vec3 x, vec3 R, float d0, float r0, float d1, float r1, bool at_end,
                    out vec3 l) {
   float rR = envDistance(seen, R);
   float dl = at_end ? max(d0 + rR * (1.0 - r0), d0) : d0 + (d1 - d0) * (1.0 - r0) / (r1 - r0);
   l = falsePosition(seen, x, R, rR, dl, d0, r0, at_end ? 0.0 : d1, r1);
+  if (onSurface(seen, l, R)) return true;
+  float len = length(l), tl = length(R - dot(R, l) / len * l / len);
+  float de = dot(l - x, R) + 4.0 * len / (float(textureSize(seen, 0).x) * max(tl, 1e-4));
+  float re = rayRatio(seen, x + R * de);
+  if (!(de > d0) || (!at_end && de >= d1) || re >= 1.0) return false;
+  dl = at_end ? max(de + rR * (1.0 - re), de) : de + (d1 - de) * (1.0 - re) / (r1 - re);
+  l = falsePosition(seen, x, R, rR, dl, de, re, at_end ? 0.0 : d1, r1);
   return onSurface(seen, l, R);
 }
 
@@ -215,10 +231,6 @@ bool layerCrossing(samplerCube seen, vec3 x, vec3 R, float d0, float r0, float d
 // a quarter step out (t = 1 / (4 LAYER_STEPS)), so that no bracket starts at d = 0, which falsePosition
 // reads as no undershoot yet.
 const int LAYER_STEPS = 16;
-float rayRatio(samplerCube seen, vec3 p) {
-  float len = length(p);
-  return len > 0.0 ? len / envDistance(seen, p) : 0.0;
-}
 vec3 layeredHit(samplerCube seen0, samplerCube seen1, vec3 x, vec3 R, out int layer) {
   layer = 0;
   vec3 l0 = impostorHit(seen0, x, R);

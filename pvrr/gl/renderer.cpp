@@ -342,7 +342,10 @@ struct Renderer::Impl {
     if (planes) d.push_back("#define PLANES");
     return builtProgram("env.vert", "env.frag", d);
   }
-  const Program& skyProgram(bool planes, bool with_seen = false) const {
+  // first_layer: an impostor cube's second layer, where nothing lies beyond the first (shaders/sky.frag).
+  const Program& skyProgram(bool planes, bool with_seen = false, bool first_layer = false) const {
+    if (first_layer)
+      return builtProgram("sky.vert", "sky.frag", {kWithSeenPoints, "#define PEEL", "#define FIRST_LAYER"});
     if (with_seen && !options.seen_points) return builtProgram("sky.vert", "sky.frag", {kWithSeenPoints});
     return planes ? planesVariant("sky.vert", "sky.frag", {}) : sky_program;
   }
@@ -554,9 +557,14 @@ struct Renderer::Impl {
                             const Vec3* rays_from = nullptr, bool planes = false, bool with_seen = false,
                             bool peel = false) const {
     const Mat4 vp = relativeViewProj(proj, view, origin);
-    const Program& sky = skyProgram(planes, with_seen);
+    const Program& sky = skyProgram(planes, with_seen, peel);
     auto drawSky = [&] {
       sky.use();
+      if (peel) {
+        sky.set("u_peel", kPeelUnit);
+        sky.set("u_first_colour", kFirstCubeUnit);
+        sky.set("u_first_normal", kFirstCubeUnit + 1);
+      }
       sky.set("u_inv_view_proj", toFloat(glm::inverse(vp)));
       sky.set("u_background", glm::vec3(scene.render.background));
       sky.set("u_far", float(scene.render.far_distance_m));
@@ -1697,14 +1705,21 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       const double near_m = 1e-3, far_m = 2.0 * (scene.boundsRadius() + glm::length(centre - scene.bounds_min)) + 1.0;
       const Mat4 proj = glm::perspective(kPi / 2, 1.0, near_m, far_m);
       // Layer 0: the nearest surfaces. Layer 1 (seeds 001, depth peeling, at half the size): the nearest beyond
-      // them, what an occluder near the element hides from its origin; the sky where nothing is.
+      // them, what an occluder near the element hides from its origin; where nothing lies beyond, the first
+      // layer's own texel (shaders/sky.frag, FIRST_LAYER).
       for (int layer = 0; layer < layers; ++layer) {
         CubeTarget& c = layer ? *cubes1[e] : *cubes[e];
         const int size = layer ? layer1_size : options.map_size;
         if (c.size != size || c.colors.size() != formats.size()) c.create(size, formats);
-        if (layer) {
-          glActiveTexture(GLenum(GL_TEXTURE0 + kPeelUnit));
-          glBindTexture(GL_TEXTURE_CUBE_MAP, cubes[e]->colors[1]);
+        if (layer) {  // the first layer's seen points, colour and normals (shaders/sky.frag, FIRST_LAYER)
+          const std::vector<GLuint>& first = cubes[e]->colors;
+          const std::pair<int, GLuint> binds[3] = {{kPeelUnit, first[1]},
+                                                  {kFirstCubeUnit, first[0]},
+                                                  {kFirstCubeUnit + 1, first.size() > 2 ? first[2] : 0}};
+          for (const auto& [unit, tex] : binds) {
+            glActiveTexture(GLenum(GL_TEXTURE0 + unit));
+            glBindTexture(GL_TEXTURE_CUBE_MAP, tex);
+          }
           glActiveTexture(GL_TEXTURE0);
         }
         for (int face = 0; face < 6; ++face) {
@@ -1719,8 +1734,10 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
         }
       }
     }
-    glActiveTexture(GLenum(GL_TEXTURE0 + kPeelUnit));
-    glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
+    for (int unit : {kPeelUnit, kFirstCubeUnit, kFirstCubeUnit + 1}) {
+      glActiveTexture(GLenum(GL_TEXTURE0 + unit));
+      glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
+    }
     glActiveTexture(GL_TEXTURE0);
     glFinish();
     std::string note = mode == RasterMode::Impostor ? "distance impostors: colour and seen-point cube maps" : "";
