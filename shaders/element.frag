@@ -204,22 +204,12 @@ float rayRatio(samplerCube seen, vec3 p) {
 }
 
 // A crossing of a layer between the march's parameters d0 (ratio r0 < 1) and d1 (ratio r1 >= 1; at_end: the
-// ray's end at infinity), refined by false position; whether it lies on the layer's surface. A bracket can hold
-// a depth edge and a crossing of the surface beyond it (the wall behind a box's edge), and false position may
-// end at the edge: then the ray is looked at 2 texels further on its sweep, and if it is in front of the layer
-// there, the bracket from there is refined too. (Behind it there, the ray passed behind an occluder.)
+// ray's end at infinity), refined by false position; whether it lies on the layer's surface.
 bool layerCrossing(samplerCube seen, vec3 x, vec3 R, float d0, float r0, float d1, float r1, bool at_end,
                    out vec3 l) {
   float rR = envDistance(seen, R);
   float dl = at_end ? max(d0 + rR * (1.0 - r0), d0) : d0 + (d1 - d0) * (1.0 - r0) / (r1 - r0);
   l = falsePosition(seen, x, R, rR, dl, d0, r0, at_end ? 0.0 : d1, r1);
-  if (onSurface(seen, l, R)) return true;
-  float len = length(l), tl = length(R - dot(R, l) / len * l / len);
-  float de = dot(l - x, R) + 4.0 * len / (float(textureSize(seen, 0).x) * max(tl, 1e-4));
-  float re = rayRatio(seen, x + R * de);
-  if (!(de > d0) || (!at_end && de >= d1) || re >= 1.0) return false;
-  dl = at_end ? max(de + rR * (1.0 - re), de) : de + (d1 - de) * (1.0 - re) / (r1 - re);
-  l = falsePosition(seen, x, R, rR, dl, de, re, at_end ? 0.0 : d1, r1);
   return onSurface(seen, l, R);
 }
 

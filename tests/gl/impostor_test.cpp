@@ -195,7 +195,7 @@ TEST_P(ImpostorTest, SearchStepsConvergeAtDepthEdges) {
 // Layered distance maps (seeds 001): the car's own door, 0.3 m from the car mirror, hides part of the street
 // from the mirror's centre, the cube's origin, that the mirror's edge sees (seeds 003, Fig. 6). With one layer
 // the search ends on the door's edge there; the second, depth-peeled layer holds the street behind the door.
-// Measured at 320 x 240 with 512^2 faces: one layer p95 43.5', p99 5634'; two 0.32' and 5.8' (no peeling in
+// Measured at 320 x 240 with 512^2 faces: one layer p95 43.5', p99 5634'; two 0.32' and 5.5' (no peeling in
 // the second layer: 1.4' and 271'). The same with a second mirror under the road, out of sight, so that the
 // car mirror's search runs in the loop over several elements' cubes (CUBE_ELEMENTS), whose second layers
 // hold the normal and index cubes too (18 texture units: GL 3.3 promises 16, llvmpipe has 32).
