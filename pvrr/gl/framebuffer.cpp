@@ -210,9 +210,6 @@ Framebuffer::Framebuffer(int width, int height, const std::vector<ColorFormat>& 
     if (depth == DepthFormat::Depth24) {
       glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, width, height, 0, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT,
                    nullptr);
-    } else if (depth == DepthFormat::Depth32FStencil8) {
-      glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH32F_STENCIL8, width, height, 0, GL_DEPTH_STENCIL,
-                   GL_FLOAT_32_UNSIGNED_INT_24_8_REV, nullptr);
     } else {
       glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT32F, width, height, 0, GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
     }
@@ -220,10 +217,7 @@ Framebuffer::Framebuffer(int width, int height, const std::vector<ColorFormat>& 
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    glFramebufferTexture2D(GL_FRAMEBUFFER,
-                           depth == DepthFormat::Depth32FStencil8 ? GL_DEPTH_STENCIL_ATTACHMENT : GL_DEPTH_ATTACHMENT,
-                           GL_TEXTURE_2D, depth_texture_, 0);
-    depth_ = depth;
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, depth_texture_, 0);
   }
   std::vector<GLenum> draw_buffers(colors.size());
   for (std::size_t i = 0; i < colors.size(); ++i) draw_buffers[i] = GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(i);
@@ -237,10 +231,8 @@ Framebuffer::Framebuffer(int width, int height, const std::vector<ColorFormat>& 
   if (status != GL_FRAMEBUFFER_COMPLETE) {
     std::string formats;
     for (auto f : colors) formats += (formats.empty() ? "" : ", ") + std::string(formatName(f));
-    const std::string depth_name = depth == DepthFormat::None      ? "none"
-                                   : depth == DepthFormat::Depth24 ? "DEPTH24"
-                                   : depth == DepthFormat::Depth32F ? "DEPTH32F"
-                                                                    : "DEPTH32F_STENCIL8";
+    const std::string depth_name =
+        depth == DepthFormat::None ? "none" : (depth == DepthFormat::Depth24 ? "DEPTH24" : "DEPTH32F");
     release();
     throw Error(label + " (colour [" + formats + "], depth " + depth_name + ") is incomplete: " + statusName(status));
   }
@@ -269,7 +261,7 @@ void Framebuffer::release() noexcept {
 
 Framebuffer::Framebuffer(Framebuffer&& other) noexcept
     : width_(other.width_), height_(other.height_), colors_(std::move(other.colors_)), fbo_(other.fbo_),
-      color_textures_(std::move(other.color_textures_)), depth_texture_(other.depth_texture_), depth_(other.depth_),
+      color_textures_(std::move(other.color_textures_)), depth_texture_(other.depth_texture_),
       context_(other.context_) {
   other.fbo_ = 0;
   other.color_textures_.clear();
@@ -285,7 +277,6 @@ Framebuffer& Framebuffer::operator=(Framebuffer&& other) noexcept {
     fbo_ = other.fbo_;
     color_textures_ = std::move(other.color_textures_);
     depth_texture_ = other.depth_texture_;
-    depth_ = other.depth_;
     context_ = other.context_;
     other.fbo_ = 0;
     other.color_textures_.clear();
@@ -305,18 +296,12 @@ void Framebuffer::bind() const {
 void Framebuffer::clear(const std::array<float, 4>& rgba, float depth) const {
   bind();
   for (std::size_t i = 0; i < colors_.size(); ++i) glClearBufferfv(GL_COLOR, static_cast<GLint>(i), rgba.data());
-  clearDepthAttachment(depth);
+  if (depth_texture_ != 0) glClearBufferfv(GL_DEPTH, 0, &depth);
 }
 
 void Framebuffer::clearDepth(float depth) const {
   bind();
-  clearDepthAttachment(depth);
-}
-
-void Framebuffer::clearDepthAttachment(float depth) const {
-  if (depth_texture_ == 0) return;
-  if (depth_ == DepthFormat::Depth32FStencil8) glClearBufferfi(GL_DEPTH_STENCIL, 0, depth, 0);
-  else glClearBufferfv(GL_DEPTH, 0, &depth);
+  if (depth_texture_ != 0) glClearBufferfv(GL_DEPTH, 0, &depth);
 }
 
 void Framebuffer::bindRegion(int width, int height) const {
@@ -332,7 +317,7 @@ void Framebuffer::bindRegionClearDepth(int width, int height, float depth) const
   if (depth_texture_ == 0) return;
   glEnable(GL_SCISSOR_TEST);
   glScissor(0, 0, width, height);
-  clearDepthAttachment(depth);
+  glClearBufferfv(GL_DEPTH, 0, &depth);
   glDisable(GL_SCISSOR_TEST);
 }
 

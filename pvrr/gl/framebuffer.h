@@ -13,8 +13,7 @@ namespace pvrr::gl {
 class GlContext;
 
 enum class ColorFormat { RGBA8, SRGB8A8, RGBA16F, RGBA32F, R32F, RGBA16 };
-// Depth32FStencil8: float depth and an 8-bit stencil (cleared to 0 with the depth).
-enum class DepthFormat { None, Depth24, Depth32F, Depth32FStencil8 };
+enum class DepthFormat { None, Depth24, Depth32F };
 
 // How texture data from 8-bit images is interpreted when sampled: Srgb stores GL_SRGB8_ALPHA8 (sampling returns
 // linear values), Linear stores GL_RGBA8 (sampling returns code / 255); alpha is 1.
@@ -93,7 +92,6 @@ class Framebuffer {
   unsigned int fboName() const { return fbo_; }
   unsigned int colorTexture(int attachment) const;
   unsigned int depthTexture() const { return depth_texture_; }  // 0 with DepthFormat::None
-  DepthFormat depthFormat() const { return depth_; }
 
   // The attachment's pixels as RGBA8, width * height * 4 bytes, rows TOP-DOWN (GL's bottom-up rows flipped).
   // Float attachments are clamped to [0, 1] and converted by GL. Leaves this framebuffer bound for reading.
@@ -106,14 +104,12 @@ class Framebuffer {
   void checkAttachment(int attachment) const;
   void readInto(int attachment, unsigned int type, void* pixels, std::size_t bytes_per_pixel) const;
   void release() noexcept;
-  void clearDepthAttachment(float depth) const;  // and the stencil to 0, if any
 
   int width_ = 0, height_ = 0;
   std::vector<ColorFormat> colors_;
   unsigned int fbo_ = 0;
   std::vector<unsigned int> color_textures_;
   unsigned int depth_texture_ = 0;
-  DepthFormat depth_ = DepthFormat::None;
   GlContext* context_ = nullptr;
 };
 

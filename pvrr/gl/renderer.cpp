@@ -1797,15 +1797,13 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   const ColorFormat colour = options.seen_points || additive ? ColorFormat::RGBA32F : ColorFormat::RGBA16;
   const int follow = cubeElements(mode);  // impostor: the elements the fragments follow through their cubes
   const int layers = impostorLayers(mode);
-  // Two layers: a stencil marks each element's pixels whose first draw kept its first layer's result.
-  const DepthFormat depth_format = layers > 1 ? DepthFormat::Depth32FStencil8 : DepthFormat::Depth32F;
   if (!frame_target || frame_target->width() != ob.width || frame_target->height() != ob.height ||
-      frame_target->colorFormat(0) != colour || frame_target->depthFormat() != depth_format)
+      frame_target->colorFormat(0) != colour)
     frame_target = std::make_unique<Framebuffer>(
         ob.width, ob.height,
         options.seen_points ? std::vector<ColorFormat>{colour, ColorFormat::RGBA32F, ColorFormat::RGBA32F}
                             : std::vector<ColorFormat>{colour},
-        depth_format);
+        DepthFormat::Depth32F);
   frame_target->clearDepth();  // no colour clear: the sky covers every pixel nothing else does
   // The elements come first: the depth state must not depend on what an earlier pass (or none) left.
   glEnable(GL_DEPTH_TEST);
@@ -1830,9 +1828,11 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       ElementFrame f = prepareElement(scene, int(e), &grid_cache.get(scene, int(e)));
       if (lens && mode == RasterMode::Envmap) traceVertexRays(rays, f, ob.eye, VertexStageOptions{});
       // Impostor with two layers: the first draw leaves the pixels whose search ends off a surface in the first
-      // layer (LAYER_MARCH undefined: it discards them) and marks the others in the stencil; the second draw
-      // (LAYER_MARCH) shades only the unmarked ones. A renderer that runs every path of a shader with the lanes
-      // that do not take it masked off (llvmpipe) pays the second layer's search only there.
+      // layer (LAYER_MARCH undefined: it discards them, writing no depth); the second draw (LAYER_MARCH) passes
+      // the depth test (GL_LESS) only there: where the first draw kept a fragment, the same fragment has the
+      // same depth (element.vert's invariant position). A renderer that runs every path of a shader with the
+      // lanes that do not take it masked off (llvmpipe) pays the second layer's search only there: it tests
+      // depth before a shader that may discard, and skips blocks of pixels that all fail.
       const int draws = mode == RasterMode::Impostor && layers > 1 ? 2 : 1;
       MeshBuffers& mb = meshSlot();
       uploadElementGrid(mb, f, anchor);
@@ -1872,19 +1872,8 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
         if (mode == RasterMode::Impostor && lens) setLensMaps(p, e);
         if (mode == RasterMode::Impostor)
           p.set("u_seen_channel", options.seen_channel < 0 ? 1 : std::min(options.seen_channel, 2));
-        if (draws > 1) {
-          // The second draw writes no stencil: llvmpipe then tests depth and stencil before the shader (a
-          // shader that may discard and a stencil it writes would be tested after) and skips blocks of pixels
-          // that all fail.
-          glEnable(GL_STENCIL_TEST);
-          glStencilFunc(d == 0 ? GL_ALWAYS : GL_NOTEQUAL, GLint(e + 1), 0xFF);
-          glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
-          glStencilMask(d == 0 ? 0xFF : 0x00);
-        }
         draw(mb);
       }
-      glStencilMask(0xFF);
-      glDisable(GL_STENCIL_TEST);
     }
   }
   // The environment after the elements: behind a lens or mirror it fails the early depth test, unshaded.
