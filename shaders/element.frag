@@ -22,7 +22,8 @@
 //                (followCubes); LENS_IN_CUBES: the other elements' cubes show the scene's one lens too, and a
 //                search that meets it refracts through its height maps and goes on in the lens's cubes.
 //                IMPOSTOR_LAYERS 2: each distance map has a second, depth-peeled layer (seeds 001), searched
-//                where the first layer's result lies behind a depth edge (layeredHit).
+//                where the first layer's search ends off a surface (layeredHit): the element's first draw
+//                discards those pixels, LAYER_PROBE counts them, LAYER_MARCH draws them.
 //                CUBE_GEOMETRY: an element drawn into another element's cube: a mirror's exact surface point
 //                (a lens's mesh point) as the seen point, and its normal and element id in the surface output.
 //   MODE_PLAIN   a plain grey shaded surface (raster mode); u_dark: black, an element met at the depth limit
@@ -567,6 +568,9 @@ vec3 followCubes(int cur, vec3 x, vec3 R, int depth, int channel, out vec4 seen,
 #endif
 
 void main() {
+#if defined(LAYER_PROBE) && defined(LENS)
+  return;  // the probe counts the pixels the first draw left (pvrr/gl/renderer.cpp)
+#endif
   vec3 n = normalize(v_normal);
   vec3 view = normalize(v_pos - u_view_origin);
   float cos_i = -dot(view, n);
@@ -592,6 +596,9 @@ void main() {
   vec4 sp = bilinear(u_surf_p, st);  // w: 1 inside the outline
   vec3 w = sp.xyz - e;
   if (sp.w < 0.5 || length(w - dot(w, vl) * vl) > 1e-5 * length(w)) discard;
+#if defined(LAYER_PROBE)
+  return;  // the probe counts the pixels the first draw left (pvrr/gl/renderer.cpp), not the mirror's misses
+#endif
   vec3 pos = u_seen_offset + sp.xyz * u_to_local;
   n = normalize(bilinear(u_surf_n, st).xyz * u_to_local);
   view = normalize(pos - u_view_origin);

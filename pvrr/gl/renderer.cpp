@@ -353,9 +353,10 @@ struct Renderer::Impl {
   // wavelengths; cube_elements > 0: searches that meet a mirror in a cube go on in its cubes (CUBE_ELEMENTS).
   // lens_in_cubes: the scene's one lens is drawn in the other elements' cubes and refracted through there.
   // layers: of each distance map (IMPOSTOR_LAYERS; 2: the second depth-peeled, searched where the first fails).
-  // layer_march: with two layers, the second draw (LAYER_MARCH; the first discards where it would search them).
+  // layer_draw, with two layers: 0 the first draw (it discards where it would search them), 1 the second
+  // (LAYER_MARCH), 2 the probe between them (LAYER_PROBE: no search; pvrr/gl/renderer.cpp).
   const Program& impostorProgram(bool lens, int channels, int cube_elements, bool lens_in_cubes, int layers,
-                                 bool layer_march) const {
+                                 int layer_draw) const {
     std::vector<std::string> d{"#define MODE_IMPOSTOR",
                                "#define IMPOSTOR_ITERATIONS " + std::to_string(scene.render.impostor_iterations),
                                "#define IMPOSTOR_CHANNELS " + std::to_string(channels),
@@ -363,7 +364,8 @@ struct Renderer::Impl {
     if (lens) d.push_back("#define LENS");
     if (cube_elements > 0) d.push_back("#define CUBE_ELEMENTS " + std::to_string(cube_elements));
     if (cube_elements > 0 && lens_in_cubes) d.push_back("#define LENS_IN_CUBES");
-    if (layer_march) d.push_back("#define LAYER_MARCH");
+    if (layer_draw == 1) d.push_back("#define LAYER_MARCH");
+    if (layer_draw == 2) d.push_back("#define LAYER_PROBE");
     return builtProgram("element.vert", "element.frag", d);
   }
   // An element drawn into another element's impostor cubes (CUBE_GEOMETRY): a mirror's exact surface point
@@ -1563,6 +1565,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
 
   // --- first pass (and the nested passes of elements seen in other elements' maps) ---
   auto t0 = Clock::now();
+  std::function<CullCount()> second_layers;  // impostor mode with two layers: draws the second layers' cubes
   std::vector<size_t> top_slot(n_el, 0);  // map slot of frames[e].views[0] (pvrr mode)
   {
     size_t slot = 0;
@@ -1700,49 +1703,70 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
     }
     glActiveTexture(GL_TEXTURE0);
-    for (size_t e = 0; e < n_el; ++e) {
+    // Layer 0 of element e's cubes: the nearest surfaces. Layer 1 (seeds 001, depth peeling, at half the size):
+    // the nearest beyond them, what an occluder near the element hides from its origin; where nothing lies
+    // beyond, the first layer's own texel (shaders/sky.frag, FIRST_LAYER). Layer 1 is drawn in the second pass,
+    // and only if some pixel's search needs it (second_layers).
+    auto drawCubes = [this, n_el, follow, lens_in_cubes, with_seen, cube_mesh](size_t e, int layer) {
+      auto inCubes = [&](size_t m) {
+        return follow > 0 && (scene.elements[m].type == ElementType::Mirror || lens_in_cubes);
+      };
       const Vec3 centre = Vec3(scene.elements[e].local_to_world[3]);
       const double near_m = 1e-3, far_m = 2.0 * (scene.boundsRadius() + glm::length(centre - scene.bounds_min)) + 1.0;
       const Mat4 proj = glm::perspective(kPi / 2, 1.0, near_m, far_m);
-      // Layer 0: the nearest surfaces. Layer 1 (seeds 001, depth peeling, at half the size): the nearest beyond
-      // them, what an occluder near the element hides from its origin; where nothing lies beyond, the first
-      // layer's own texel (shaders/sky.frag, FIRST_LAYER).
-      for (int layer = 0; layer < layers; ++layer) {
-        CubeTarget& c = layer ? *cubes1[e] : *cubes[e];
-        const int size = layer ? layer1_size : options.map_size;
-        if (c.size != size || c.colors.size() != formats.size()) c.create(size, formats);
-        if (layer) {  // the first layer's seen points, colour and normals (shaders/sky.frag, FIRST_LAYER)
-          const std::vector<GLuint>& first = cubes[e]->colors;
-          const std::pair<int, GLuint> binds[3] = {{kPeelUnit, first[1]},
-                                                  {kFirstCubeUnit, first[0]},
-                                                  {kFirstCubeUnit + 1, first.size() > 2 ? first[2] : 0}};
-          for (const auto& [unit, tex] : binds) {
-            glActiveTexture(GLenum(GL_TEXTURE0 + unit));
-            glBindTexture(GL_TEXTURE_CUBE_MAP, tex);
-          }
-          glActiveTexture(GL_TEXTURE0);
+      CubeTarget& c = layer ? *cubes1[e] : *cubes[e];
+      if (layer) {  // the first layer's seen points, colour and normals (shaders/sky.frag, FIRST_LAYER)
+        const std::vector<GLuint>& first = cubes[e]->colors;
+        const std::pair<int, GLuint> binds[3] = {
+            {kPeelUnit, first[1]}, {kFirstCubeUnit, first[0]}, {kFirstCubeUnit + 1, first.size() > 2 ? first[2] : 0}};
+        for (const auto& [unit, tex] : binds) {
+          glActiveTexture(GLenum(GL_TEXTURE0 + unit));
+          glBindTexture(GL_TEXTURE_CUBE_MAP, tex);
         }
-        for (int face = 0; face < 6; ++face) {
-          c.selectFace(face);
-          const Mat4 view = glm::lookAt(centre, centre + kCubeDir[face], kCubeUp[face]);
-          for (size_t m = 0; m < n_el; ++m)
-            if (m != e && inCubes(m)) {
-              drawCubeElement(m, relativeViewProj(proj, view, centre), centre, element_meshes[cube_mesh[m]], layer > 0);
-              drawn_in_cubes += face == 0 && layer == 0;
-            }
-          culled.add(drawEnvironment(view, proj, centre, false, nullptr, false, with_seen, layer > 0));
-        }
+        glActiveTexture(GL_TEXTURE0);
       }
+      CullCount culled;
+      int drawn = 0;
+      for (int face = 0; face < 6; ++face) {
+        c.selectFace(face);
+        const Mat4 view = glm::lookAt(centre, centre + kCubeDir[face], kCubeUp[face]);
+        for (size_t m = 0; m < n_el; ++m)
+          if (m != e && inCubes(m)) {
+            drawCubeElement(m, relativeViewProj(proj, view, centre), centre, element_meshes[cube_mesh[m]], layer > 0);
+            drawn += face == 0;
+          }
+        culled.add(drawEnvironment(view, proj, centre, false, nullptr, false, with_seen, layer > 0));
+      }
+      if (layer) {
+        for (int unit : {kPeelUnit, kFirstCubeUnit, kFirstCubeUnit + 1}) {
+          glActiveTexture(GLenum(GL_TEXTURE0 + unit));
+          glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
+        }
+        glActiveTexture(GL_TEXTURE0);
+      }
+      return std::make_pair(culled, drawn);
+    };
+    for (size_t e = 0; e < n_el; ++e) {
+      if (cubes[e]->size != options.map_size || cubes[e]->colors.size() != formats.size())
+        cubes[e]->create(options.map_size, formats);
+      // The second layer's targets exist from here on: the element programs bind them.
+      if (layers > 1 && (cubes1[e]->size != layer1_size || cubes1[e]->colors.size() != formats.size()))
+        cubes1[e]->create(layer1_size, formats);
+      const auto [c, drawn] = drawCubes(e, 0);
+      culled.add(c);
+      drawn_in_cubes += drawn;
     }
-    for (int unit : {kPeelUnit, kFirstCubeUnit, kFirstCubeUnit + 1}) {
-      glActiveTexture(GLenum(GL_TEXTURE0 + unit));
-      glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
-    }
-    glActiveTexture(GL_TEXTURE0);
+    if (layers > 1)
+      second_layers = [this, n_el, drawCubes] {
+        CullCount culled;
+        for (size_t e = 0; e < n_el; ++e) culled.add(drawCubes(e, 1).first);
+        return culled;
+      };
     glFinish();
     std::string note = mode == RasterMode::Impostor ? "distance impostors: colour and seen-point cube maps" : "";
     if (layers > 1)
-      appendNote(note, "two layers each (the second depth-peeled, " + std::to_string(layer1_size) + "^2 a face)");
+      appendNote(note, "two layers each where needed (the second depth-peeled, " + std::to_string(layer1_size) +
+                           "^2 a face)");
     else if (mode == RasterMode::Impostor && scene.render.impostor_layers > 1)
       appendNote(note, "one layer each: too few texture units for the second layers' cubes");
     if (follow > 0) appendNote(note, "normal and index cube maps of the elements in them");
@@ -1816,64 +1840,104 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   PassCamera eye_cam;
   eye_cam.origin = ob.eye;
   eye_cam.view_proj = vp;
-  for (size_t e = 0; e < n_el; ++e) {
+  // Element e drawn by the plain, envmap or impostor program from its mesh in element_meshes[element_slot[e]].
+  // Impostor with two layers (layer_draw): 0 the first draw, which leaves the pixels whose search ends off a
+  // surface in the first layer (it discards them, writing no depth); 2 a probe, which counts those pixels (no
+  // colour, no depth: only what passes the depth test is shaded, and it returns at once); 1 the second draw
+  // (LAYER_MARCH), which passes the depth test only there: where the first draw kept a fragment, the same
+  // fragment has the same depth (element.vert's invariant position). A renderer that runs every path of a
+  // shader with the lanes that do not take it masked off (llvmpipe) pays the second layer's search only there:
+  // it tests depth before a shader that may discard, and skips blocks of pixels that all fail.
+  std::vector<size_t> element_slot(n_el, 0);
+  auto drawElement = [&](size_t e, int layer_draw) {
     const Element& el = scene.elements[e];
     const Vec3 anchor = Vec3(el.local_to_world[3]);
     const bool lens = el.type == ElementType::Lens;
+    const Program& p = mode == RasterMode::Raster ? plain_program
+                       : mode == RasterMode::Impostor
+                           ? impostorProgram(lens, impostorChannels(e), follow, lensInCubes(mode), layers, layer_draw)
+                           : (lens ? lens_envmap_program : envmap_program);
+    p.use();
+    p.set("u_view_proj", toFloat(vp));
+    p.set("u_offset", glm::vec3(anchor - ob.eye));
+    p.set("u_view_origin", glm::vec3(0.0f));
+    setLights(p, ob.eye);
+    setElementMaterial(p, el, int(e));
+    if (mode == RasterMode::Raster) p.set("u_dark", 0);
+    if (mode == RasterMode::Envmap || mode == RasterMode::Impostor) {
+      glActiveTexture(GL_TEXTURE0);
+      glBindTexture(GL_TEXTURE_CUBE_MAP, cubes[e]->colors[0]);
+      glActiveTexture(GL_TEXTURE1);
+      if (cubes[e]->colors.size() > 1) glBindTexture(GL_TEXTURE_CUBE_MAP, cubes[e]->colors[1]);
+      glActiveTexture(GL_TEXTURE0);
+      p.set("u_cube", 0);
+      p.set("u_seen_cube", 1);
+      p.set("u_seen_offset", glm::vec3(anchor - ob.eye));
+    }
+    if (layers > 1 && follow == 0) {  // one element: its second layer after its own maps
+      for (int a = 0; a < 2; ++a) {
+        glActiveTexture(GLenum(GL_TEXTURE0 + kFirstCubeUnit + a));
+        glBindTexture(GL_TEXTURE_CUBE_MAP, cubes1[e]->colors[size_t(a)]);
+      }
+      glActiveTexture(GL_TEXTURE0);
+      p.set("u_cube1", kFirstCubeUnit);
+      p.set("u_seen_cube1", kFirstCubeUnit + 1);
+    }
+    if (mode == RasterMode::Impostor && !lens) setMirrorMaps(p, e);
+    if (follow > 0) setCubeElements(p, e, ob.eye, layers);
+    if (mode == RasterMode::Impostor && lens) setLensMaps(p, e);
+    if (mode == RasterMode::Impostor)
+      p.set("u_seen_channel", options.seen_channel < 0 ? 1 : std::min(options.seen_channel, 2));
+    draw(element_meshes[element_slot[e]]);
+  };
+  for (size_t e = 0; e < n_el; ++e) {
     frame_target->bind();
     if (mode == RasterMode::Pvrr) {
       if (beyondDepth(frames[e])) drawDarkElement(frames[e], eye_cam);
       else drawPvrrElement(frames[e], top_slot[e], eye_cam, options.seen_channel);
     } else {
       ElementFrame f = prepareElement(scene, int(e), &grid_cache.get(scene, int(e)));
-      if (lens && mode == RasterMode::Envmap) traceVertexRays(rays, f, ob.eye, VertexStageOptions{});
-      // Impostor with two layers: the first draw leaves the pixels whose search ends off a surface in the first
-      // layer (LAYER_MARCH undefined: it discards them, writing no depth); the second draw (LAYER_MARCH) passes
-      // the depth test (GL_LESS) only there: where the first draw kept a fragment, the same fragment has the
-      // same depth (element.vert's invariant position). A renderer that runs every path of a shader with the
-      // lanes that do not take it masked off (llvmpipe) pays the second layer's search only there: it tests
-      // depth before a shader that may discard, and skips blocks of pixels that all fail.
-      const int draws = mode == RasterMode::Impostor && layers > 1 ? 2 : 1;
-      MeshBuffers& mb = meshSlot();
-      uploadElementGrid(mb, f, anchor);
-      for (int d = 0; d < draws; ++d) {
-        const Program& p = mode == RasterMode::Raster ? plain_program
-                           : mode == RasterMode::Impostor
-                               ? impostorProgram(lens, impostorChannels(e), follow, lensInCubes(mode), layers, d == 1)
-                               : (lens ? lens_envmap_program : envmap_program);
-        p.use();
-        p.set("u_view_proj", toFloat(vp));
-        p.set("u_offset", glm::vec3(anchor - ob.eye));
-        p.set("u_view_origin", glm::vec3(0.0f));
-        setLights(p, ob.eye);
-        setElementMaterial(p, el, int(e));
-        if (mode == RasterMode::Raster) p.set("u_dark", 0);
-        if (mode == RasterMode::Envmap || mode == RasterMode::Impostor) {
-          glActiveTexture(GL_TEXTURE0);
-          glBindTexture(GL_TEXTURE_CUBE_MAP, cubes[e]->colors[0]);
-          glActiveTexture(GL_TEXTURE1);
-          if (cubes[e]->colors.size() > 1) glBindTexture(GL_TEXTURE_CUBE_MAP, cubes[e]->colors[1]);
-          glActiveTexture(GL_TEXTURE0);
-          p.set("u_cube", 0);
-          p.set("u_seen_cube", 1);
-          p.set("u_seen_offset", glm::vec3(anchor - ob.eye));
-        }
-        if (layers > 1 && follow == 0) {  // one element: its second layer after its own maps
-          for (int a = 0; a < 2; ++a) {
-            glActiveTexture(GLenum(GL_TEXTURE0 + kFirstCubeUnit + a));
-            glBindTexture(GL_TEXTURE_CUBE_MAP, cubes1[e]->colors[size_t(a)]);
-          }
-          glActiveTexture(GL_TEXTURE0);
-          p.set("u_cube1", kFirstCubeUnit);
-          p.set("u_seen_cube1", kFirstCubeUnit + 1);
-        }
-        if (mode == RasterMode::Impostor && !lens) setMirrorMaps(p, e);
-        if (follow > 0) setCubeElements(p, e, ob.eye, layers);
-        if (mode == RasterMode::Impostor && lens) setLensMaps(p, e);
-        if (mode == RasterMode::Impostor)
-          p.set("u_seen_channel", options.seen_channel < 0 ? 1 : std::min(options.seen_channel, 2));
-        draw(mb);
-      }
+      if (scene.elements[e].type == ElementType::Lens && mode == RasterMode::Envmap)
+        traceVertexRays(rays, f, ob.eye, VertexStageOptions{});
+      element_slot[e] = next_mesh;
+      uploadElementGrid(meshSlot(), f, Vec3(scene.elements[e].local_to_world[3]));
+      drawElement(e, 0);
+    }
+  }
+  // The second layers, where some pixel needs them: the probe counts each element's pixels left by its first
+  // draw; the second layers' cubes are drawn if there are any, and the second draw of each such element.
+  std::string layer_note;
+  if (second_layers) {
+    const auto t_layers = Clock::now();
+    std::vector<GLuint> queries(n_el);
+    glGenQueries(GLsizei(n_el), queries.data());
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    glDepthMask(GL_FALSE);
+    for (size_t e = 0; e < n_el; ++e) {
+      glBeginQuery(GL_SAMPLES_PASSED, queries[e]);
+      drawElement(e, 2);
+      glEndQuery(GL_SAMPLES_PASSED);
+    }
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDepthMask(GL_TRUE);
+    std::vector<GLuint> left(n_el, 0);
+    GLuint total = 0;
+    for (size_t e = 0; e < n_el; ++e) {
+      glGetQueryObjectuiv(queries[e], GL_QUERY_RESULT, &left[e]);
+      total += left[e];
+    }
+    glDeleteQueries(GLsizei(n_el), queries.data());
+    if (total > 0) {
+      second_layers();
+      frame_target->bind();
+      glEnable(GL_DEPTH_TEST);
+      glDepthFunc(GL_LESS);
+      for (size_t e = 0; e < n_el; ++e)
+        if (left[e] > 0) drawElement(e, 1);
+      layer_note = "second layers drawn (" + fmt("%.1f", msSince(t_layers)) + " ms): " + std::to_string(total) +
+                   " pixel(s) whose first-layer search ended off a surface";
+    } else {
+      layer_note = "second layers not drawn: every pixel's search ended on a surface in the first layer";
     }
   }
   // The environment after the elements: behind a lens or mirror it fails the early depth test, unshaded.
@@ -1881,7 +1945,9 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   const CullCount culled = drawEnvironment(view, proj, ob.eye);
   glFinish();
   checkGlError("rendering a frame");
-  out.stages.ran("second-pass", msSince(t0), -1, cullNote(culled));
+  std::string second_note = cullNote(culled);
+  appendNote(second_note, layer_note);
+  out.stages.ran("second-pass", msSince(t0), -1, second_note);
   if (options.seen_points)
     out.stages.ran("seen-points", 0, -1, "world-position attachments in every pass (for accuracy reports)");
   else

@@ -224,15 +224,42 @@ TEST_P(ImpostorTest, SecondLayerShowsWhatAnOccluderHidesFromTheOrigin) {
                 << " layer(s): median " << quantile(e, 0.5) << "', p95 " << quantile(e, 0.95) << "', p99 "
                 << quantile(e, 0.99) << "'\n";
       const StageTiming* fp = runs.back().f.stages.find("first-pass");
+      const StageTiming* sp = runs.back().f.stages.find("second-pass");
       ASSERT_NE(fp, nullptr);
+      ASSERT_NE(sp, nullptr);
       EXPECT_EQ(fp->note.find("two layers") != std::string::npos, layers == 2) << fp->note;
       EXPECT_EQ(fp->note.find("normal and index") != std::string::npos, several) << fp->note;
+      EXPECT_EQ(sp->note.find("second layers drawn") != std::string::npos, layers == 2) << sp->note;
     }
     EXPECT_GT(quantile(runs[0].errors, 0.95), 20.0);
     EXPECT_LT(quantile(runs[1].errors, 0.95), 0.5);
     EXPECT_LT(quantile(runs[1].errors, 0.99), 10.0);
     EXPECT_LT(quantile(runs[1].errors, 0.5), 0.05);
   }
+}
+
+// The second layers are drawn only where a pixel needs them: in the concave mirror's scene every pixel's search
+// ends on a surface in the first layer, so the frame skips them (the second-pass note says so) and is the
+// one-layer frame exactly.
+TEST_P(ImpostorTest, SecondLayerSkippedWhereNoPixelNeedsIt) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  std::vector<gl::RasterFrame> frames;
+  for (const int layers : {1, 2}) {
+    const Scene s = test::shippedScene("concave-mirror", {"observer.image_size=[160,120]",
+                                                          "render.impostor_layers=" + std::to_string(layers)});
+    RayScene rays(s);
+    gl::RendererOptions o;
+    o.map_size = 512;
+    frames.push_back(gl::Renderer(s, rays, o).render(gl::RasterMode::Impostor));
+  }
+  const StageTiming* sp = frames[1].stages.find("second-pass");
+  ASSERT_NE(sp, nullptr);
+  EXPECT_NE(sp->note.find("second layers not drawn"), std::string::npos) << sp->note;
+  ASSERT_EQ(frames[0].color.size(), frames[1].color.size());
+  size_t differ = 0;
+  for (size_t i = 0; i < frames[0].color.size(); ++i) differ += frames[0].color[i] != frames[1].color[i];
+  EXPECT_EQ(differ, 0u);
 }
 
 // Each fragment reflects at the exact surface point on its view ray, with the exact normal, from the mirror's
