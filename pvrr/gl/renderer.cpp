@@ -1928,13 +1928,22 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     }
     glDeleteQueries(GLsizei(n_el), queries.data());
     if (total > 0) {
-      second_layers();
+      // No cube stays bound to a unit while cubes are drawn into (the element programs bound the second
+      // layers from kFirstCubeUnit on).
+      for (int unit = kFirstCubeUnit; unit < std::min(max_texture_units, kFirstCubeUnit + 6 * int(n_el)); ++unit) {
+        glActiveTexture(GLenum(GL_TEXTURE0 + unit));
+        glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
+      }
+      glActiveTexture(GL_TEXTURE0);
+      const CullCount layer_culled = second_layers();
       frame_target->bind();
       glEnable(GL_DEPTH_TEST);
       glDepthFunc(GL_LESS);
       for (size_t e = 0; e < n_el; ++e)
         if (left[e] > 0) drawElement(e, 1);
-      layer_note = "second layers drawn (" + fmt("%.1f", msSince(t_layers)) + " ms): " + std::to_string(total) +
+      glFinish();
+      layer_note = "second layers drawn (" + fmt("%.1f", msSince(t_layers)) + " ms: their cubes, " +
+                   cullNote(layer_culled) + ", and the second draws): " + std::to_string(total) +
                    " pixel(s) whose first-layer search ended off a surface";
     } else {
       layer_note = "second layers not drawn: every pixel's search ended on a surface in the first layer";
