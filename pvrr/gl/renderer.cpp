@@ -1677,7 +1677,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     const int follow = cubeElements(mode);
     const bool lens_in_cubes = lensInCubes(mode);
     // The elements drawn in other elements' cubes: the mirrors, and the lens if it is the only one.
-    auto inCubes = [&](size_t m) {
+    auto inCubes = [this, follow, lens_in_cubes](size_t m) {
       return follow > 0 && (scene.elements[m].type == ElementType::Mirror || lens_in_cubes);
     };
     std::vector<GLenum> formats{GL_RGBA16F};
@@ -1707,10 +1707,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     // the nearest beyond them, what an occluder near the element hides from its origin; where nothing lies
     // beyond, the first layer's own texel (shaders/sky.frag, FIRST_LAYER). Layer 1 is drawn in the second pass,
     // and only if some pixel's search needs it (second_layers).
-    auto drawCubes = [this, n_el, follow, lens_in_cubes, with_seen, cube_mesh](size_t e, int layer) {
-      auto inCubes = [&](size_t m) {
-        return follow > 0 && (scene.elements[m].type == ElementType::Mirror || lens_in_cubes);
-      };
+    auto drawCubes = [this, n_el, inCubes, with_seen, cube_mesh](size_t e, int layer) {
       const Vec3 centre = Vec3(scene.elements[e].local_to_world[3]);
       const double near_m = 1e-3, far_m = 2.0 * (scene.boundsRadius() + glm::length(centre - scene.bounds_min)) + 1.0;
       const Mat4 proj = glm::perspective(kPi / 2, 1.0, near_m, far_m);
