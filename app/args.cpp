@@ -4,8 +4,8 @@
 #include <cmath>
 #include <sstream>
 
-#include "cad/error.h"
-#include "pvrr/scene_json.h"
+#include "pvrr/base/error.h"
+#include "pvrr/scene/scene_json.h"
 
 namespace pvrr::app {
 

@@ -6,7 +6,7 @@
 #include "app/args.h"
 #include "app/report.h"
 #include "cad/cad_import.h"
-#include "cad/error.h"
+#include "pvrr/base/error.h"
 
 namespace fs = std::filesystem;
 

@@ -15,13 +15,13 @@
 
 #include "app/args.h"
 #include "app/report.h"
-#include "cad/error.h"
+#include "pvrr/base/error.h"
 #include "pvrr/gl/context.h"
 #include "pvrr/gl/gl.h"
-#include "pvrr/format.h"
-#include "pvrr/image.h"
-#include "pvrr/scene_json.h"
-#include "pvrr/spectrum.h"
+#include "pvrr/base/format.h"
+#include "pvrr/base/image.h"
+#include "pvrr/scene/scene_json.h"
+#include "pvrr/optics/spectrum.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -37,30 +37,6 @@ LoadedScene loadScene(const std::string& path, const std::vector<std::string>& o
   }
   ls.scene = buildScene(ls.desc, readMeshFile);
   return ls;
-}
-
-void writeFileAtomic(const std::string& path, const std::string& content) {
-  const fs::path target(path);
-  std::error_code ec;
-  if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
-  if (ec) throw Error(path + ": cannot create the folder " + target.parent_path().string() + ": " + ec.message());
-  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw Error(path + ": cannot write (could not open " + tmp + ")");
-    out << content;
-    out.flush();
-    if (!out) {
-      out.close();
-      fs::remove(tmp, ec);
-      throw Error(path + ": write failed");
-    }
-  }
-  fs::rename(tmp, target, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    throw Error(path + ": cannot rename the temporary file into place");
-  }
 }
 
 size_t writeLinearPng(const std::string& path, int width, int height, const std::vector<Vec3>& linear) {

@@ -4,10 +4,11 @@
 #include <string>
 #include <vector>
 
+#include "pvrr/base/atomic_file.h"
 #include "pvrr/gl/renderer.h"
-#include "pvrr/scene_build.h"
-#include "pvrr/scene_desc.h"
-#include "pvrr/tracer.h"
+#include "pvrr/scene/scene_build.h"
+#include "pvrr/scene/scene_desc.h"
+#include "pvrr/trace/tracer.h"
 
 namespace pvrr::app {
 
@@ -32,10 +33,6 @@ LoadedScene loadScene(const std::string& path, const std::vector<std::string>& o
                       int height = 0);
 // Reads OBJ and PLY meshes with VTK (the scene builder's mesh loader).
 MeshData readMeshFile(const std::string& path);
-
-// Writes `content` to `path` through a temporary file in the same folder and a rename; creates the
-// folder. On failure removes the temporary and throws pvrr::Error naming the path.
-void writeFileAtomic(const std::string& path, const std::string& content);
 // Linear RGB -> sRGB8 PNG, atomically. Non-finite values are written as black and counted (returned).
 size_t writeLinearPng(const std::string& path, int width, int height, const std::vector<Vec3>& linear);
 

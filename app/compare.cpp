@@ -12,9 +12,9 @@
 
 #include "app/args.h"
 #include "app/report.h"
-#include "cad/error.h"
-#include "pvrr/image.h"
-#include "pvrr/spectrum.h"
+#include "pvrr/base/error.h"
+#include "pvrr/base/image.h"
+#include "pvrr/optics/spectrum.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -196,7 +196,7 @@ std::vector<int8_t> zoomingRegion(const RenderedFrame& ref, const std::vector<El
       for (uint32_t vi : f.grid_patches[size_t(f.views[v].patch)].vertices)
         if (vi < vertex_view.size() && vertex_view[vi] < 0) vertex_view[vi] = int(v);
     // The forward direction of each patch's forward volume: the normalised mean of its outgoing ray directions
-    // (pvrr/view_volume.h; a patch rendered with the reversed volume keeps only forward' in its volume).
+    // (pvrr/method/view_volume.h; a patch rendered with the reversed volume keeps only forward' in its volume).
     const size_t fit_channel = f.rays.size() / 2;
     std::vector<Vec3> forward(f.views.size());
     for (size_t v = 0; v < f.views.size(); ++v) {

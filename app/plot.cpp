@@ -34,10 +34,9 @@
 #include <limits>
 #include <map>
 #include <sstream>
-#include <unistd.h>
 
 #include "app/commands.h"
-#include "cad/error.h"
+#include "pvrr/base/error.h"
 #include "pvrr/gl/context.h"
 
 namespace fs = std::filesystem;
@@ -254,18 +253,13 @@ void renderChart(const std::string& path, const Axes& axes, const std::vector<Pl
   grab->SetInputBufferTypeToRGB();
   grab->ReadFrontBufferOff();
   grab->Update();
-  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
-  vtkNew<vtkPNGWriter> w;
-  w->SetFileName(tmp.c_str());
-  w->SetInputConnection(grab->GetOutputPort());
-  w->Write();
-  std::error_code ec;
-  if (!fs::exists(tmp)) throw Error(path + ": VTK could not write the plot");
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    throw Error(path + ": cannot rename the temporary file into place");
-  }
+  writeAtomic(path, [&](const std::string& temp) {
+    vtkNew<vtkPNGWriter> w;
+    w->SetFileName(temp.c_str());
+    w->SetInputConnection(grab->GetOutputPort());
+    w->Write();
+    if (!fs::exists(temp)) throw Error(path + ": VTK could not write the plot");
+  });
 }
 
 // An SVG marker of the chart's marker set at (x, y).

@@ -82,7 +82,7 @@ ErrorStats summarizeErrors(const std::vector<double>& errors_arcmin, const std::
 
 // The zooming region (issue 5; docs/accuracy.md): a pixel is in it when the reference's seen point lies
 // behind the fitted viewpoint of the patch under the pixel, along that patch's forward direction:
-// (seen - fit.eye) . forward <= 0, where forward is the forward volume's (pvrr/view_volume.h: the normalised
+// (seen - fit.eye) . forward <= 0, where forward is the forward volume's (pvrr/method/view_volume.h: the normalised
 // mean of the patch's outgoing ray directions; recomputed from the rays when the patch's volume is the
 // reversed one). The patch under a pixel is the patch of the element vertex nearest the reference's element
 // point. Per pixel: 1 zooming, 0 not, -1 no element pixel or an element missing from `frames`, 2 not

@@ -8,7 +8,7 @@
 #include "app/args.h"
 #include "app/plot.h"
 #include "app/report.h"
-#include "cad/error.h"
+#include "pvrr/base/error.h"
 
 namespace pvrr::app {
 

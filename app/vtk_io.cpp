@@ -17,10 +17,9 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <unistd.h>
 
 #include "app/report.h"
-#include "cad/error.h"
+#include "pvrr/base/error.h"
 
 namespace fs = std::filesystem;
 
@@ -57,25 +56,13 @@ vtkSmartPointer<vtkDoubleArray> vec3Array(const char* name, const std::vector<Ve
   return a;
 }
 
-// VTK writers take a file name: write to a temporary beside the target, then rename.
+// VTK writers take a file name: they write the temporary that writeAtomic renames into place.
 template <class Writer>
 void writeAtomicWith(Writer* w, const std::string& path) {
-  const fs::path target(path);
-  std::error_code ec;
-  if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
-  // Keep the extension: some VTK writers decide details by it.
-  const std::string tmp = (target.parent_path() / ("." + target.stem().string() + ".tmp-" + std::to_string(::getpid()) +
-                                                    target.extension().string())).string();
-  w->SetFileName(tmp.c_str());
-  if (w->Write() != 1 || !fs::exists(tmp)) {
-    fs::remove(tmp, ec);
-    throw Error(path + ": VTK could not write the file");
-  }
-  fs::rename(tmp, target, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    throw Error(path + ": cannot rename the temporary file into place");
-  }
+  writeAtomic(path, [&](const std::string& temp) {
+    w->SetFileName(temp.c_str());
+    if (w->Write() != 1 || !fs::exists(temp)) throw Error(path + ": VTK could not write the file");
+  });
 }
 
 }  // namespace

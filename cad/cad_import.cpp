@@ -84,7 +84,8 @@
 #include <mutex>
 #include <sstream>
 
-#include "cad/error.h"
+#include "pvrr/base/atomic_file.h"
+#include "pvrr/base/error.h"
 
 namespace pvrr::cad {
 namespace {
@@ -727,17 +728,6 @@ TopoDS_Face makeFace(const NurbsSurface& s, const std::optional<Outline>& trim, 
   return face;
 }
 
-std::string tempPathFor(const std::string& path) { return path + ".partial"; }
-
-void commit(const std::string& tmp, const std::string& path) {
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    throw Error(path + ": cannot rename the temporary file into place: " + ec.message());
-  }
-}
-
 // Fixed header values make the files reproducible byte for byte.
 constexpr const char* kStepTimeStamp = "2000-01-01T00:00:00";
 constexpr const char* kIgesDate = "20000101.000000";
@@ -771,43 +761,41 @@ void writeStep(const std::string& path, const NurbsSurface& s, const std::option
   const LengthUnit u = writeUnit(unit, path);
   std::lock_guard<std::mutex> lock(occtMutex());
   silenceOcct();
-  const std::string tmp = tempPathFor(path);
-  try {
-    const TopoDS_Face face = makeFace(s, trim, path);
-    Interface_Static::SetCVal("write.step.unit", unit == "mm" ? "MM" : "M");
-    Interface_Static::SetIVal("write.surfacecurve.mode", 1);  // write the pcurves
-    STEPControl_Writer writer;
-    // Our numbers are already in the file's unit: no conversion on the way out.
-    writer.Model()->SetLocalLengthUnit(u.mm);
-    if (writer.Transfer(face, STEPControl_AsIs) != IFSelect_RetDone)
-      throw Error(path + ": OpenCASCADE could not translate the face to STEP");
-    // OCCT names the product "Open CASCADE STEP translator 7.6 <n>" with a per-process counter; the
-    // file's stem keeps the output reproducible.
-    const Handle(StepData_StepModel) model = writer.Model();
-    const Handle(TCollection_HAsciiString) product = new TCollection_HAsciiString(fs::path(path).stem().string().c_str());
-    for (int i = 1; i <= model->NbEntities(); ++i)
-      if (const Handle(StepBasic_Product) p = Handle(StepBasic_Product)::DownCast(model->Value(i))) {
-        p->SetId(product);
-        p->SetName(product);
-      }
-    APIHeaderSection_MakeHeader header(model);
-    header.SetName(new TCollection_HAsciiString(fs::path(path).filename().string().c_str()));
-    header.SetTimeStamp(new TCollection_HAsciiString(kStepTimeStamp));
-    header.SetAuthorValue(1, new TCollection_HAsciiString(kAuthor));
-    header.SetOrganizationValue(1, new TCollection_HAsciiString(kAuthor));
-    header.SetOriginatingSystem(new TCollection_HAsciiString("pvrr (OpenCASCADE 7.6)"));
-    header.SetAuthorisation(new TCollection_HAsciiString(""));
-    if (writer.Write(tmp.c_str()) != IFSelect_RetDone) {
-      std::error_code ec;
-      fs::remove(tmp, ec);
-      throw Error(path + ": cannot write the STEP file");
-    }
-  } catch (const Standard_Failure& f) {
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    throw Error(path + ": OpenCASCADE failed to write STEP (" + occtMessage(f) + ")");
-  }
-  commit(tmp, path);
+  writeAtomic(
+      path,
+      [&](const std::string& tmp) {
+        try {
+          const TopoDS_Face face = makeFace(s, trim, path);
+          Interface_Static::SetCVal("write.step.unit", unit == "mm" ? "MM" : "M");
+          Interface_Static::SetIVal("write.surfacecurve.mode", 1);  // write the pcurves
+          STEPControl_Writer writer;
+          // Our numbers are already in the file's unit: no conversion on the way out.
+          writer.Model()->SetLocalLengthUnit(u.mm);
+          if (writer.Transfer(face, STEPControl_AsIs) != IFSelect_RetDone)
+            throw Error(path + ": OpenCASCADE could not translate the face to STEP");
+          // OCCT names the product "Open CASCADE STEP translator 7.6 <n>" with a per-process counter; the
+          // file's stem keeps the output reproducible.
+          const Handle(StepData_StepModel) model = writer.Model();
+          const Handle(TCollection_HAsciiString) product =
+              new TCollection_HAsciiString(fs::path(path).stem().string().c_str());
+          for (int i = 1; i <= model->NbEntities(); ++i)
+            if (const Handle(StepBasic_Product) p = Handle(StepBasic_Product)::DownCast(model->Value(i))) {
+              p->SetId(product);
+              p->SetName(product);
+            }
+          APIHeaderSection_MakeHeader header(model);
+          header.SetName(new TCollection_HAsciiString(fs::path(path).filename().string().c_str()));
+          header.SetTimeStamp(new TCollection_HAsciiString(kStepTimeStamp));
+          header.SetAuthorValue(1, new TCollection_HAsciiString(kAuthor));
+          header.SetOrganizationValue(1, new TCollection_HAsciiString(kAuthor));
+          header.SetOriginatingSystem(new TCollection_HAsciiString("pvrr (OpenCASCADE 7.6)"));
+          header.SetAuthorisation(new TCollection_HAsciiString(""));
+          if (writer.Write(tmp.c_str()) != IFSelect_RetDone) throw Error(path + ": cannot write the STEP file");
+        } catch (const Standard_Failure& f) {
+          throw Error(path + ": OpenCASCADE failed to write STEP (" + occtMessage(f) + ")");
+        }
+      },
+      MissingFolder::Fail);
 }
 
 void writeIges(const std::string& path, const NurbsSurface& s, const std::optional<Outline>& trim,
@@ -815,36 +803,33 @@ void writeIges(const std::string& path, const NurbsSurface& s, const std::option
   const LengthUnit u = writeUnit(unit, path);
   std::lock_guard<std::mutex> lock(occtMutex());
   silenceOcct();
-  const std::string tmp = tempPathFor(path);
-  try {
-    const TopoDS_Face face = makeFace(s, trim, path);
-    Interface_Static::SetCVal("write.iges.header.author", kAuthor);
-    Interface_Static::SetCVal("write.iges.header.company", kAuthor);
-    Interface_Static::SetCVal("write.iges.header.product", "pvrr");
-    Interface_Static::SetCVal("write.iges.header.receiver", "");
-    // Mode 0: faces as trimmed surfaces (entity 144), which every IGES reader understands.
-    IGESControl_Writer writer(unit == "mm" ? "MM" : "M", 0);
-    IGESData_GlobalSection gs = writer.Model()->GlobalSection();
-    gs.SetCascadeUnit(u.mm);  // our numbers are already in the file's unit
-    gs.SetDate(new TCollection_HAsciiString(kIgesDate));
-    gs.SetLastChangeDate(new TCollection_HAsciiString(kIgesDate));
-    gs.SetFileName(new TCollection_HAsciiString(fs::path(path).filename().string().c_str()));
-    gs.SetAuthorName(new TCollection_HAsciiString(kAuthor));
-    gs.SetCompanyName(new TCollection_HAsciiString(kAuthor));
-    writer.Model()->SetGlobalSection(gs);
-    if (!writer.AddShape(face)) throw Error(path + ": OpenCASCADE could not translate the face to IGES");
-    writer.ComputeModel();
-    if (!writer.Write(tmp.c_str())) {
-      std::error_code ec;
-      fs::remove(tmp, ec);
-      throw Error(path + ": cannot write the IGES file");
-    }
-  } catch (const Standard_Failure& f) {
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    throw Error(path + ": OpenCASCADE failed to write IGES (" + occtMessage(f) + ")");
-  }
-  commit(tmp, path);
+  writeAtomic(
+      path,
+      [&](const std::string& tmp) {
+        try {
+          const TopoDS_Face face = makeFace(s, trim, path);
+          Interface_Static::SetCVal("write.iges.header.author", kAuthor);
+          Interface_Static::SetCVal("write.iges.header.company", kAuthor);
+          Interface_Static::SetCVal("write.iges.header.product", "pvrr");
+          Interface_Static::SetCVal("write.iges.header.receiver", "");
+          // Mode 0: faces as trimmed surfaces (entity 144), which every IGES reader understands.
+          IGESControl_Writer writer(unit == "mm" ? "MM" : "M", 0);
+          IGESData_GlobalSection gs = writer.Model()->GlobalSection();
+          gs.SetCascadeUnit(u.mm);  // our numbers are already in the file's unit
+          gs.SetDate(new TCollection_HAsciiString(kIgesDate));
+          gs.SetLastChangeDate(new TCollection_HAsciiString(kIgesDate));
+          gs.SetFileName(new TCollection_HAsciiString(fs::path(path).filename().string().c_str()));
+          gs.SetAuthorName(new TCollection_HAsciiString(kAuthor));
+          gs.SetCompanyName(new TCollection_HAsciiString(kAuthor));
+          writer.Model()->SetGlobalSection(gs);
+          if (!writer.AddShape(face)) throw Error(path + ": OpenCASCADE could not translate the face to IGES");
+          writer.ComputeModel();
+          if (!writer.Write(tmp.c_str())) throw Error(path + ": cannot write the IGES file");
+        } catch (const Standard_Failure& f) {
+          throw Error(path + ": OpenCASCADE failed to write IGES (" + occtMessage(f) + ")");
+        }
+      },
+      MissingFolder::Fail);
 }
 
 }  // namespace pvrr::cad

@@ -9,7 +9,7 @@
 #include <sstream>
 #include <vector>
 
-#include "cad/error.h"
+#include "pvrr/base/error.h"
 
 namespace pvrr::cad {
 namespace {

@@ -25,7 +25,7 @@ namespace pvrr::cad {
 // given, with the tolerance trim_tolerance_uv in (u, v)) and is at most kNurbsSagMaxSlope_deg steep there.
 // Elsewhere sag() does not throw: it continues the surface by its second-order Taylor expansion at the
 // boundary point where the inversion stops (continuous with a continuous gradient). That continuation is
-// the "analytic extension" a lens's rim rays use (pvrr/vertex_stage.cpp); within the parameter domain
+// the "analytic extension" a lens's rim rays use (pvrr/method/vertex_stage.cpp); within the parameter domain
 // (a CAD blank is usually larger than the edged lens) it is the NURBS surface itself.
 // Throws pvrr::Error, prefixed by `what`, when the surface does not lie over the local origin.
 constexpr double kNurbsSagMaxSlope_deg = 75;

@@ -13,7 +13,8 @@
 #include <sstream>
 
 #include "cad/cad_import.h"
-#include "cad/error.h"
+#include "pvrr/base/atomic_file.h"
+#include "pvrr/base/error.h"
 
 namespace pvrr::cad {
 namespace {
@@ -264,16 +265,7 @@ void writeFreeformCageObj(const std::string& path) {
       const int a = 1 + i + D::nx * j;  // OBJ indices are 1-based
       os << "f " << a << ' ' << a + 1 << ' ' << a + 1 + D::nx << ' ' << a + D::nx << '\n';
     }
-  const std::string tmp = path + ".partial";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw Error(path + ": cannot open for writing");
-    out << os.str();
-    if (!out.flush()) throw Error(path + ": write failed");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) throw Error(path + ": cannot rename the temporary file into place: " + ec.message());
+  writeFileAtomic(path, os.str(), MissingFolder::Fail);
 }
 
 }  // namespace pvrr::cad

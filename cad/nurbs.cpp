@@ -12,7 +12,7 @@
 #include <iomanip>
 #include <sstream>
 
-#include "cad/error.h"
+#include "pvrr/base/error.h"
 
 namespace pvrr::cad {
 namespace {

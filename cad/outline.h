@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "cad/math.h"
+#include "pvrr/base/math.h"
 
 namespace pvrr::cad {
 

@@ -6,7 +6,7 @@
 #include <iomanip>
 #include <sstream>
 
-#include "cad/error.h"
+#include "pvrr/base/error.h"
 
 namespace pvrr::cad {
 namespace {

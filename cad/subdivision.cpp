@@ -28,7 +28,7 @@
 #include <sstream>
 
 #include "cad/cad_import.h"
-#include "cad/error.h"
+#include "pvrr/base/error.h"
 
 namespace pvrr::cad {
 namespace {

@@ -11,7 +11,7 @@
 #include <memory>
 #include <string>
 
-#include "cad/math.h"
+#include "pvrr/base/math.h"
 
 namespace pvrr::cad {
 

@@ -16,7 +16,7 @@
 #include <cmath>
 #include <unordered_map>
 
-#include "cad/error.h"
+#include "pvrr/base/error.h"
 #include "cad/sag.h"
 
 namespace pvrr::cad {

@@ -12,7 +12,7 @@
 //   MODE_IMPOSTOR  distance impostors (Szirmay-Kalos et al., seeds 003): the envmap cube maps, whose seen
 //                points give each direction's distance from the cube's origin, searched per fragment for the
 //                point the exact reflected (or doubly refracted) ray meets. LENS: the ray through the glass is
-//                traced per fragment in the lens's refractor height maps (pvrr/lens_height_map.h).
+//                traced per fragment in the lens's refractor height maps (pvrr/impostor/lens_height_map.h).
 //                IMPOSTOR_ITERATIONS: the search's false-position steps; IMPOSTOR_CHANNELS 3: a lens's R, G
 //                and B each refracted with its own index (u_index), else the middle one only (for a mirror:
 //                through the scene's lens, LENS_IN_CUBES).
@@ -92,7 +92,7 @@ uniform int u_self;               // this element's index
 uniform int u_max_depth;          // render.max_depth: the tracer absorbs at an element met after that many events
 #endif
 #if !defined(LENS)
-uniform sampler2D u_surf_p;       // surface maps over the parameter domain (pvrr/surface_map.h), local frame:
+uniform sampler2D u_surf_p;       // surface maps over the parameter domain (pvrr/impostor/surface_map.h), local frame:
 uniform sampler2D u_surf_du;      // position, first derivatives and unit normal
 uniform sampler2D u_surf_dv;
 uniform sampler2D u_surf_n;
@@ -101,7 +101,7 @@ uniform vec2 u_sm;                // texture coordinate = (s, t) * u_sm.x + u_sm
 #if defined(LENS) || defined(LENS_IN_CUBES)
 // A lens's maps: this element's (LENS), or those of the scene's one lens, which other elements' cubes show
 // (LENS_IN_CUBES: followCubes refracts through it).
-uniform sampler2D u_lens_front;   // refractor height maps (pvrr/lens_height_map.h): z, outward unit normal
+uniform sampler2D u_lens_front;   // refractor height maps (pvrr/impostor/lens_height_map.h): z, outward unit normal
 uniform sampler2D u_lens_back;
 uniform sampler2D u_lens_mask;    // 1 inside the outline, 0 outside
 uniform vec4 u_hm;                // the maps' x0, y0, 1 / width, 1 / height (lens local, metres)
@@ -300,7 +300,7 @@ vec2 surfaceHit(vec2 uv, vec3 e, vec3 v) {
 }
 #endif
 #if defined(LENS) || defined(LENS_IN_CUBES)
-// Exact unpolarised dielectric Fresnel reflectance from index n1 into n2 (pvrr/optics.cpp fresnelDielectric).
+// Exact unpolarised dielectric Fresnel reflectance from index n1 into n2 (pvrr/optics/optics.cpp fresnelDielectric).
 float fresnelDielectric(float cos_i, float n1, float n2) {
   float eta = n1 / n2, s2t = eta * eta * (1.0 - cos_i * cos_i);
   if (s2t >= 1.0) return 1.0;
@@ -445,7 +445,7 @@ vec3 throughLens(vec3 x, vec3 v, vec3 n, float eta, int max_events, out vec3 dir
 #endif
 #endif
 
-// Exact unpolarised conductor Fresnel reflectance, outside index 1 (pvrr/optics.cpp fresnelConductor).
+// Exact unpolarised conductor Fresnel reflectance, outside index 1 (pvrr/optics/optics.cpp fresnelConductor).
 float fresnelConductor(float cos_i, float n, float k) {
   float c2 = cos_i * cos_i, s2 = 1.0 - c2;
   float a = n * n - k * k - s2;

@@ -1,4 +1,4 @@
-// The environment shading model; keep in step with pvrr/shading.cpp (the reference tracer's copy).
+// The environment shading model; keep in step with pvrr/trace/shading.cpp (the reference tracer's copy).
 //   colour = albedo(uv) * (sum ambient + sum_dir max(0, n.(-dir)) L + sum_point max(0, n.l) L / d^2)
 // Positions are relative to the camera origin of the current pass (camera-relative rendering).
 // Specialised to the scene's lights when the program is built (pvrr/gl/renderer.cpp prepends

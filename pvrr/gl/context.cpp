@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "cad/error.h"
+#include "pvrr/base/error.h"
 #include "pvrr/gl/gl.h"
 
 namespace pvrr::gl {

@@ -11,7 +11,7 @@
 #include <sstream>
 #include <vector>
 
-#include "cad/error.h"
+#include "pvrr/base/error.h"
 
 namespace pvrr::gl::detail {
 

@@ -6,7 +6,7 @@
 
 #include <vector>
 
-#include "cad/error.h"
+#include "pvrr/base/error.h"
 
 namespace pvrr::gl::detail {
 namespace {

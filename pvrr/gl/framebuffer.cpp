@@ -5,7 +5,7 @@
 #include <sstream>
 #include <string>
 
-#include "cad/error.h"
+#include "pvrr/base/error.h"
 #include "pvrr/gl/gl.h"
 
 namespace pvrr::gl {

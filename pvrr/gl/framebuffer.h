@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "pvrr/image.h"
+#include "pvrr/base/image.h"
 
 namespace pvrr::gl {
 

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cstddef>
 
-#include "cad/error.h"
+#include "pvrr/base/error.h"
 #include "pvrr/gl/gl.h"
 
 namespace pvrr::gl {

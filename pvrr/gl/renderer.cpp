@@ -11,15 +11,15 @@
 #include <functional>
 #include <map>
 
-#include "cad/error.h"
+#include "pvrr/base/error.h"
 #include "pvrr/gl/gl.h"
 #include "pvrr/gl/framebuffer.h"
 #include "pvrr/gl/program.h"
-#include "pvrr/format.h"
-#include "pvrr/lens_height_map.h"
-#include "pvrr/map_footprint.h"
-#include "pvrr/surface_map.h"
-#include "pvrr/spectrum.h"
+#include "pvrr/base/format.h"
+#include "pvrr/impostor/lens_height_map.h"
+#include "pvrr/method/map_footprint.h"
+#include "pvrr/impostor/surface_map.h"
+#include "pvrr/optics/spectrum.h"
 
 namespace pvrr::gl {
 
@@ -416,7 +416,7 @@ struct Renderer::Impl {
   std::vector<int> map_side;  // per map slot: the longer side its last first pass rendered (MapPass::side)
   std::vector<std::unique_ptr<CubeTarget>> cubes;  // envmap and impostor cubes, one per element
   std::vector<std::unique_ptr<CubeTarget>> cubes1;  // impostor mode's second layers (impostorLayers), one per element
-  // Impostor mode: each lens's refractor height maps (pvrr/lens_height_map.h), built on first use (a lens's
+  // Impostor mode: each lens's refractor height maps (pvrr/impostor/lens_height_map.h), built on first use (a lens's
   // shape in its own frame never changes; its pose reaches the shader as u_to_local).
   struct LensMaps {
     GLuint front = 0, back = 0, mask = 0;
@@ -425,7 +425,7 @@ struct Renderer::Impl {
     LensHeightMap map;
   };
   std::vector<LensMaps> lens_maps;
-  // Impostor mode: each mirror's surface maps (pvrr/surface_map.h: position, derivatives, normal over its
+  // Impostor mode: each mirror's surface maps (pvrr/impostor/surface_map.h: position, derivatives, normal over its
   // parameter domain), built on first use and again if its surface changes.
   struct MirrorMaps {
     std::array<GLuint, 4> textures{};  // position (RGBA32F, w: outline mask), du, dv (RGBA16F), normal (RGBA32F)
@@ -448,7 +448,7 @@ struct Renderer::Impl {
       image.height = t.height;
       image.rgb = t.rgb;
       // sRGB, flipped so v = 0 is the image's bottom row, no mipmaps: bilinear sampling with repeat wrapping,
-      // exactly what the tracer does (pvrr/shading.cpp).
+      // exactly what the tracer does (pvrr/trace/shading.cpp).
       textures.push_back(createTexture2D(image, TextureEncoding::Srgb, false));
       glBindTexture(GL_TEXTURE_2D, textures.back().name());
       glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
@@ -835,7 +835,7 @@ struct Renderer::Impl {
       glm::vec3 p(f.world_pos[i] - anchor), n(f.world_normal[i]);
       const glm::vec3 d = has_rays ? glm::vec3(f.rays[0][i].dir) : glm::vec3(0, 0, 1);
       const glm::vec3 tr = has_rays ? glm::vec3(f.rays[0][i].transmittance) : glm::vec3(1);
-      // The surface parameters normalised to the domain in double (pvrr/surface_map.h).
+      // The surface parameters normalised to the domain in double (pvrr/impostor/surface_map.h).
       const glm::vec2 uv = i < f.grid.params.size()
                                ? glm::vec2((f.grid.params[i].x - domain.u0) / (domain.u1 - domain.u0),
                                            (f.grid.params[i].y - domain.v0) / (domain.v1 - domain.v0))

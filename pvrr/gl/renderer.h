@@ -1,5 +1,5 @@
 // The raster paths on the GPU: "raster" (elements drawn as plain surfaces), "pvrr" (the paper's two passes,
-// with the CPU stages of pvrr/vertex_stage.h), "envmap" (a dynamic cube map from each element's centre,
+// with the CPU stages of pvrr/method/vertex_stage.h), "envmap" (a dynamic cube map from each element's centre,
 // the classic baseline) and "impostor" (the glass mode of distance impostors: the same cube maps with each
 // direction's distance, searched per fragment along the exact reflected ray, or along the ray refracted
 // through a lens's refractor height maps; docs/method.md "Distance impostors"). A current GL context
@@ -11,15 +11,15 @@
 // deepest first) down to the scene's render.max_depth, beyond which it is drawn black with its own surface
 // as the seen point, as the tracer absorbs there. Stage "nested-passes" reports the recursion.
 // Spectral dispersion: N channels share one first pass per patch; the second pass adds ceil(N / 3) draws
-// of three channels each, weighted per channel (pvrr/spectrum.h), into the colour attachment only.
+// of three channels each, weighted per channel (pvrr/optics/spectrum.h), into the colour attachment only.
 #pragma once
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "pvrr/ray_scene.h"
-#include "pvrr/stats.h"
-#include "pvrr/vertex_stage.h"
+#include "pvrr/trace/ray_scene.h"
+#include "pvrr/base/stats.h"
+#include "pvrr/method/vertex_stage.h"
 
 namespace pvrr::gl {
 
@@ -42,8 +42,8 @@ struct RasterFrame {
 
 struct RendererOptions {
   int map_size = 1024;              // first-pass map's longer side at most (pvrr), cube face size (envmap, impostor)
-  // impostor: the longer side (texels) of a lens's refractor height maps (pvrr/lens_height_map.h), and the
-  // side of a mirror's surface maps (pvrr/surface_map.h); each built once per renderer.
+  // impostor: the longer side (texels) of a lens's refractor height maps (pvrr/impostor/lens_height_map.h), and the
+  // side of a mirror's surface maps (pvrr/impostor/surface_map.h); each built once per renderer.
   int lens_height_map_size = 512;
   int surface_map_size = 512;
   // pvrr: each top-level map's texels per image pixel of its patch (Scene render.map_texels_per_pixel); the
@@ -80,7 +80,7 @@ struct RendererOptions {
   // separate): the front face now wins there, as in the tracer. false draws every face, for the tests that
   // compare.
   bool cull_back_faces = true;
-  // Leave unshaded the texels of each first-pass map that its reader cannot fetch (pvrr/map_footprint.h: the
+  // Leave unshaded the texels of each first-pass map that its reader cannot fetch (pvrr/method/map_footprint.h: the
   // element's triangles at their texture coordinates, widened by the bilinear neighbourhood): the car mirror's
   // warped image covers about three quarters of its map. Not for maps widened for reuse, whose later frames
   // read elsewhere. The picture is the same texel for texel; false draws whole maps, for the tests that
@@ -125,7 +125,7 @@ struct FrameCache {
 
 // The map size (longer side, texels) of each of an element's top-level patches when `patches_in_view` of them
 // are in the observer's view: map_size up to four patches, beyond that shrunk so that all of them together
-// hold about as many texels as four full maps. Each map renders mapTexels(volume, this) (pvrr/view_volume.h).
+// hold about as many texels as four full maps. Each map renders mapTexels(volume, this) (pvrr/method/view_volume.h).
 int patchMapSize(int map_size, size_t patches_in_view);
 
 // The longer side (texels) of the map of the top-level patch `pv` of `f`: patchMapSize, lowered to what the

@@ -173,7 +173,7 @@ TEST(LensCli, VerticesExportsLensRaysThatObeySnell) {
     if (key.second != 0) continue;
     const double n_r = n, n_g = index.at({key.first, 1}), n_b = index.at({key.first, 2});
     EXPECT_GT(n_b, n_r) << "patch " << key.first << ": blue must bend more";
-    // Polycarbonate (pvrr/material.h): n_d = 1.586, V_d = (n_d - 1) / (n_F - n_C) = 30, exactly for the
+    // Polycarbonate (pvrr/optics/material.h): n_d = 1.586, V_d = (n_d - 1) / (n_F - n_C) = 30, exactly for the
     // Cauchy law through them.
     EXPECT_NEAR(n_g, 1.586, 1e-9);
     EXPECT_NEAR((n_g - 1.0) / (n_b - n_r), 30.0, 1e-6);

@@ -9,7 +9,7 @@
 
 #include "app/plot.h"
 #include "app/report.h"
-#include "cad/error.h"
+#include "pvrr/base/error.h"
 
 namespace pvrr::app {
 namespace {

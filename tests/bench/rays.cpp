@@ -22,10 +22,10 @@
 #include <vector>
 #include <time.h>
 
-#include "pvrr/optics.h"
-#include "pvrr/scene_build.h"
-#include "pvrr/scene_json.h"
-#include "pvrr/tracer.h"
+#include "pvrr/optics/optics.h"
+#include "pvrr/scene/scene_build.h"
+#include "pvrr/scene/scene_json.h"
+#include "pvrr/trace/tracer.h"
 
 namespace {
 

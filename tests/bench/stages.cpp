@@ -5,8 +5,8 @@
 
 #include "pvrr/gl/context.h"
 #include "pvrr/gl/renderer.h"
-#include "pvrr/scene_build.h"
-#include "pvrr/scene_json.h"
+#include "pvrr/scene/scene_build.h"
+#include "pvrr/scene/scene_json.h"
 
 namespace {
 

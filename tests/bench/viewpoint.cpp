@@ -6,8 +6,8 @@
 
 #include <cmath>
 
-#include "pvrr/view_volume.h"
-#include "pvrr/viewpoint.h"
+#include "pvrr/method/view_volume.h"
+#include "pvrr/method/viewpoint.h"
 
 namespace {
 

@@ -11,7 +11,7 @@
 #include <iterator>
 
 #include "cad/cad_import.h"
-#include "cad/error.h"
+#include "pvrr/base/error.h"
 #include "cad/lens.h"
 #include "cad/model_generator.h"
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <functional>
 
-#include "cad/error.h"
+#include "pvrr/base/error.h"
 #include "cad/nurbs.h"
 
 namespace pvrr::cad {

@@ -10,7 +10,7 @@
 #include <sstream>
 
 #include "cad/cad_import.h"
-#include "cad/error.h"
+#include "pvrr/base/error.h"
 #include "cad/model_generator.h"
 #include "cad/nurbs.h"
 

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "cad/error.h"
+#include "pvrr/base/error.h"
 #include "cad/outline.h"
 #include "cad/surface.h"
 

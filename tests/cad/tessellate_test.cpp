@@ -7,7 +7,7 @@
 #include <map>
 #include <set>
 
-#include "cad/error.h"
+#include "pvrr/base/error.h"
 #include "cad/nurbs.h"
 #include "cad/sag.h"
 #include "cad/tessellate.h"

@@ -11,9 +11,9 @@
 #include "cad/sag.h"
 #include "pvrr/gl/context.h"
 #include "pvrr/gl/renderer.h"
-#include "pvrr/scene_build.h"
-#include "pvrr/scene_json.h"
-#include "pvrr/tracer.h"
+#include "pvrr/scene/scene_build.h"
+#include "pvrr/scene/scene_json.h"
+#include "pvrr/trace/tracer.h"
 #include "support/gl_backends.h"
 #include "support/test_scenes.h"
 

@@ -12,10 +12,10 @@
 
 #include "pvrr/gl/context.h"
 #include "pvrr/gl/renderer.h"
-#include "pvrr/image.h"
-#include "pvrr/scene_build.h"
-#include "pvrr/scene_json.h"
-#include "pvrr/spectrum.h"
+#include "pvrr/base/image.h"
+#include "pvrr/scene/scene_build.h"
+#include "pvrr/scene/scene_json.h"
+#include "pvrr/optics/spectrum.h"
 #include "support/gl_backends.h"
 #include "support/test_scenes.h"
 

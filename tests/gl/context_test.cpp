@@ -12,12 +12,12 @@
 #include <string>
 #include <vector>
 
-#include "cad/error.h"
+#include "pvrr/base/error.h"
 #include "pvrr/gl/context.h"
 #include "pvrr/gl/framebuffer.h"
 #include "pvrr/gl/gl.h"  // test-only: glad for drawing and glGetTexImage
 #include "pvrr/gl/program.h"
-#include "pvrr/image.h"
+#include "pvrr/base/image.h"
 
 namespace pvrr::gl {
 namespace {

@@ -8,9 +8,9 @@
 
 #include "pvrr/gl/context.h"
 #include "pvrr/gl/renderer.h"
-#include "pvrr/scene_build.h"
-#include "pvrr/scene_json.h"
-#include "pvrr/tracer.h"
+#include "pvrr/scene/scene_build.h"
+#include "pvrr/scene/scene_json.h"
+#include "pvrr/trace/tracer.h"
 #include "support/gl_backends.h"
 
 namespace pvrr {

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "pvrr/gl/renderer.h"
-#include "pvrr/tracer.h"
+#include "pvrr/trace/tracer.h"
 #include "support/gl_backends.h"
 #include "support/scenes.h"
 #include "support/test_scenes.h"

@@ -1,4 +1,4 @@
-// Spectacle prescriptions and aspheric lenses: the prescription -> radii closed form (pvrr/scene_build.h), the
+// Spectacle prescriptions and aspheric lenses: the prescription -> radii closed form (pvrr/scene/scene_build.h), the
 // powers the reference tracer measures through a toric lens built from a prescription (the cylinder appears
 // between the principal meridians, along the axis the scene names), and pvrr mode against the reference
 // tracer for a toric and an aspheric spectacle lens, on OSMesa and on EGL.
@@ -21,9 +21,9 @@
 
 #include "pvrr/gl/context.h"
 #include "pvrr/gl/renderer.h"
-#include "pvrr/scene_build.h"
-#include "pvrr/scene_json.h"
-#include "pvrr/tracer.h"
+#include "pvrr/scene/scene_build.h"
+#include "pvrr/scene/scene_json.h"
+#include "pvrr/trace/tracer.h"
 #include "support/accuracy.h"
 #include "support/gl_backends.h"
 
@@ -77,7 +77,7 @@ const char* kAsphericSurfaces =
 const char* kSphericalSurfaces =
     R"("front": {"type": "sphere", "radius": -0.070925}, "back": {"type": "sphere", "radius": -0.1245})";
 
-// Back vertex power from surface radii (pvrr/scene_build.cpp's convention): F1 the object-side ("back")
+// Back vertex power from surface radii (pvrr/scene/scene_build.cpp's convention): F1 the object-side ("back")
 // surface, F2 the eye-side ("front") one.
 double backVertexPower(double r_back, double r_front, double n, double t) {
   const double f1 = std::isfinite(r_back) ? -(n - 1.0) / r_back : 0.0;
@@ -153,7 +153,7 @@ TEST(LensPrescription, RadiiGiveTheBackVertexPowersInBothMeridians) {
       EXPECT_EQ(r.front_radius_a_m, r.front_radius_b_m);
     }
   }
-  // Vogel's rule for the default base curve (pvrr/scene_build.cpp).
+  // Vogel's rule for the default base curve (pvrr/scene/scene_build.cpp).
   EXPECT_DOUBLE_EQ(defaultBaseCurve(2.0), 8.0);
   EXPECT_DOUBLE_EQ(defaultBaseCurve(-4.0), 4.0);
 }

@@ -16,7 +16,7 @@
 #include "cad/lens.h"
 #include "pvrr/gl/context.h"
 #include "pvrr/gl/renderer.h"
-#include "pvrr/tracer.h"
+#include "pvrr/trace/tracer.h"
 #include "support/test_scenes.h"
 #include "support/gl_backends.h"
 

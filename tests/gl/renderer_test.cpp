@@ -9,13 +9,13 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "cad/error.h"
+#include "pvrr/base/error.h"
 #include "pvrr/gl/context.h"
 #include "pvrr/gl/renderer.h"
-#include "pvrr/scene_build.h"
-#include "pvrr/scene_json.h"
-#include "pvrr/spectrum.h"
-#include "pvrr/tracer.h"
+#include "pvrr/scene/scene_build.h"
+#include "pvrr/scene/scene_json.h"
+#include "pvrr/optics/spectrum.h"
+#include "pvrr/trace/tracer.h"
 #include "support/test_scenes.h"
 #include "support/accuracy.h"
 #include "support/gl_backends.h"

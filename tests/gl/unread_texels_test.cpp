@@ -1,5 +1,5 @@
 // RendererOptions::skip_unread_texels: the first passes leave unshaded the map texels that no element can fetch
-// (pvrr/map_footprint.h), and every frame is the same, bit for bit, as with whole maps: colour, seen points,
+// (pvrr/method/map_footprint.h), and every frame is the same, bit for bit, as with whole maps: colour, seen points,
 // element ids and surface points. Covered: a convex mirror, a concave mirror's reversed (zooming) map, nested
 // maps of a mirror seen in a mirror, a lens's R, G and B planes, a saddle, and map reuse across frames (maps
 // widened for reuse are drawn whole: later frames read elsewhere in them). OSMesa and EGL.
@@ -12,8 +12,8 @@
 
 #include "pvrr/gl/context.h"
 #include "pvrr/gl/renderer.h"
-#include "pvrr/scene_build.h"
-#include "pvrr/scene_json.h"
+#include "pvrr/scene/scene_build.h"
+#include "pvrr/scene/scene_json.h"
 #include "support/frames.h"
 #include "support/scenes.h"
 #include "support/gl_backends.h"

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "pvrr/gl/renderer.h"
-#include "pvrr/tracer.h"
+#include "pvrr/trace/tracer.h"
 
 namespace pvrr::test {
 

@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
-#include "pvrr/scene_build.h"
-#include "pvrr/scene_json.h"
+#include "pvrr/scene/scene_build.h"
+#include "pvrr/scene/scene_json.h"
 
 namespace pvrr::test {
 

@@ -2,7 +2,7 @@
 #pragma once
 #include "cad/lens.h"
 #include "cad/sag.h"
-#include "pvrr/scene.h"
+#include "pvrr/scene/scene.h"
 
 namespace pvrr::test {
 

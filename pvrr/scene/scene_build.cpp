@@ -1,0 +1,375 @@
+#include "pvrr/scene/scene_build.h"
+
+#include <filesystem>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "cad/cad_import.h"
+#include "pvrr/base/error.h"
+#include "cad/sag.h"
+#include "pvrr/base/image.h"
+#include "pvrr/optics/material.h"
+#include "pvrr/scene/texture_gen.h"
+
+namespace pvrr {
+
+namespace {
+
+// A surface scaled by a constant (file units -> metres), derivatives included.
+class ScaledSurface : public cad::Surface {
+ public:
+  ScaledSurface(cad::SurfacePtr base, double factor) : base_(std::move(base)), f_(factor) {}
+  cad::ParamDomain domain() const override { return base_->domain(); }
+  cad::SurfaceDerivs evaluate(double u, double v) const override {
+    cad::SurfaceDerivs d = base_->evaluate(u, v);
+    d.p *= f_;
+    d.du *= f_;
+    d.dv *= f_;
+    d.duu *= f_;
+    d.duv *= f_;
+    d.dvv *= f_;
+    return d;
+  }
+  Vec3 normal(double u, double v) const override { return base_->normal(u, v); }
+  std::string describe() const override { return base_->describe() + " x " + std::to_string(f_); }
+
+ private:
+  cad::SurfacePtr base_;
+  double f_;
+};
+
+cad::Outline toOutline(const OutlineDesc& o) {
+  switch (o.shape) {
+    case OutlineDesc::Shape::Rectangle: return cad::Outline::rectangle(o.width_m, o.height_m, o.corner_radius_m);
+    case OutlineDesc::Shape::Ellipse: return cad::Outline::ellipse(o.width_m, o.height_m);
+    case OutlineDesc::Shape::Circle: return cad::Outline::circle(o.width_m);
+  }
+  return cad::Outline::circle(o.width_m);
+}
+
+cad::SagSurfacePtr makeSag(const SurfaceDesc& s, const cad::Outline& outline, double z_vertex) {
+  switch (s.type) {
+    case SurfaceDesc::Type::Plane: return cad::makePlane(outline, z_vertex);
+    case SurfaceDesc::Type::Sphere: return cad::makeSphere(s.radius_m, outline, z_vertex);
+    case SurfaceDesc::Type::Asphere: return cad::makeAsphere(s.radius_m, s.conic, s.coefficients, outline, z_vertex);
+    case SurfaceDesc::Type::Toric:
+      return cad::makeToric(s.radius_a_m, s.radius_b_m, radians(s.axis_deg), outline, z_vertex);
+    case SurfaceDesc::Type::Cylinder: return cad::makeCylinder(s.radius_m, radians(s.axis_deg), outline, z_vertex);
+    default: break;
+  }
+  throw InternalError("makeSag: not a sag surface");
+}
+
+// A lens surface in the lens frame: analytic, or a face of a STEP/IGES file as a NURBS graph over the lens
+// plane (cad::makeNurbsSag), in the file's unit converted to metres and translated along z only, so that
+// its point over the lens axis is the vertex. The face's trim loop, when it has one, must contain the lens
+// outline (within the loop's own chord error). `where` ("<scene>: elements[i].back") starts every message.
+cad::SagSurfacePtr makeLensSurface(const SurfaceDesc& s, const cad::Outline& outline, const std::string& where) {
+  if (s.isSag()) return makeSag(s, outline, 0.0);
+  if (s.type != SurfaceDesc::Type::Cad) throw InternalError("makeLensSurface: not a lens surface type");
+  cad::ImportedModel model;
+  try {
+    model = cad::importCadFile(s.file);
+  } catch (const Error& err) {
+    throw Error(where + ".file: " + err.what());
+  }
+  if (s.face < 0 || size_t(s.face) >= model.faces.size())
+    throw Error(where + ".face: " + s.file + ": face " + std::to_string(s.face) + " requested, the file has " +
+                std::to_string(model.faces.size()) + " face(s) (indices from 0)");
+  const cad::ImportedFace& face = model.faces[size_t(s.face)];
+  auto surface = std::make_shared<cad::NurbsSurface>(cad::scaled(*face.surface, model.unit_to_metres));
+  double trim_tol = 0;
+  if (face.trim)
+    trim_tol = 1.01 * face.trim_chord_error_uv + 1e-9 * std::max(face.trim->width(), face.trim->height());
+  try {
+    return cad::makeNurbsSag(std::move(surface), outline, face.trim, trim_tol,
+                             s.file + " face " + std::to_string(s.face));
+  } catch (const Error& err) {
+    throw Error(where + ": " + err.what());
+  }
+}
+
+// Local frame -> world: z = normal, y = up orthogonalised, x = y x z.
+Mat4 poseMatrix(const PoseDesc& p) {
+  const Vec3 z = glm::normalize(p.normal);
+  const Vec3 y = glm::normalize(p.up - glm::dot(p.up, z) * z);
+  const Vec3 x = glm::cross(y, z);
+  Mat4 m(1.0);
+  m[0] = Vec4(x, 0);
+  m[1] = Vec4(y, 0);
+  m[2] = Vec4(z, 0);
+  m[3] = Vec4(p.position, 1);
+  return m;
+}
+
+Mat4 observerToWorld(const Observer& ob) { return glm::inverse(ob.view()); }
+
+Texture makeTexture(const TextureDesc& t, const std::string& name) {
+  Texture out;
+  out.name = name;
+  if (t.kind == TextureDesc::Kind::Image) {
+    ImageRGB8 img = readPng(t.image_path);
+    out.width = img.width;
+    out.height = img.height;
+    out.rgb = std::move(img.rgb);
+  } else {
+    TextureImage img = generateTexture(t);
+    out.width = img.width;
+    out.height = img.height;
+    out.rgb = std::move(img.rgb);
+  }
+  return out;
+}
+
+// Grid size for an adaptive tessellation request: cells whose sagitta h^2 k / 8 stays below the chordal
+// tolerance at the surface's centre curvature.
+int gridForTolerance(const cad::Surface& s, const cad::Outline* outline, double tol_m) {
+  const cad::ParamDomain d = s.domain();
+  const double cu = 0.5 * (d.u0 + d.u1), cv = 0.5 * (d.v0 + d.v1);
+  const cad::Curvature k = s.curvature(cu, cv);
+  const double kmax = std::max({std::abs(k.k1), std::abs(k.k2), 1e-9});
+  const cad::SurfaceDerivs sd = s.evaluate(cu, cv);
+  const double extent = outline ? std::max(outline->width(), outline->height())
+                                : std::max(glm::length(sd.du) * (d.u1 - d.u0), glm::length(sd.dv) * (d.v1 - d.v0));
+  const double h = std::sqrt(8.0 * tol_m / kmax);
+  return std::clamp(int(std::ceil(extent / h)) + 1, 3, 257);
+}
+
+}  // namespace
+
+double defaultBaseCurve(double sphere_d) {
+  // Vogel's rule, the usual choice of front (object-side) curve for a given sphere power.
+  return sphere_d >= 0 ? sphere_d + 6.0 : sphere_d / 2.0 + 6.0;
+}
+
+PrescriptionRadii prescriptionRadii(double sphere_d, double cylinder_d, double base_curve_d, double n, double t_m) {
+  // Light enters the object-side surface (power F1, the lens's back in our naming) and leaves through the
+  // eye-side surface (F2). Back vertex power: F_v = F1 / (1 - (t/n) F1) + F2. Surface powers in our sign
+  // convention (cad/sag.h): F1 = -(n - 1) / R_back, F2 = (n - 1) / R_front.
+  const double f1 = base_curve_d;
+  const double f1_eff = f1 / (1.0 - (t_m / n) * f1);
+  auto frontRadius = [&](double power) {
+    const double f2 = power - f1_eff;
+    return std::abs(f2) < 1e-12 ? kInf : (n - 1.0) / f2;
+  };
+  PrescriptionRadii r;
+  r.back_radius_m = std::abs(f1) < 1e-12 ? kInf : -(n - 1.0) / f1;
+  r.front_radius_a_m = frontRadius(sphere_d);
+  r.front_radius_b_m = frontRadius(sphere_d + cylinder_d);
+  return r;
+}
+
+Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
+  Scene scene;
+  scene.source_path = desc.source;
+  scene.name = std::filesystem::path(desc.source).stem().string();
+  const std::string& file = desc.source;
+
+  Observer& ob = scene.observer;
+  ob.eye = desc.observer.eye;
+  ob.target = desc.observer.target;
+  ob.up = desc.observer.up;
+  ob.fov_y_rad = radians(desc.observer.fov_y_deg);
+  ob.width = desc.observer.image_width;
+  ob.height = desc.observer.image_height;
+
+  for (size_t i = 0; i < desc.environment.size(); ++i) {
+    const EnvObjectDesc& o = desc.environment[i];
+    const std::string what = file + ": environment[" + std::to_string(i) + "]" + (o.name.empty() ? "" : " (" + o.name + ")");
+    DiffuseMaterial mat;
+    mat.color = o.material.color;
+    if (o.material.texture) {
+      mat.texture = int(scene.textures.size());
+      scene.textures.push_back(makeTexture(*o.material.texture, what));
+    }
+    const double uv_scale = o.material.texture_fit ? 0.0 : o.material.texture_scale_m.x;
+    EnvMesh mesh;
+    switch (o.type) {
+      case EnvObjectDesc::Type::Box: mesh = makeBoxMesh(o.position, o.size, o.rotation, uv_scale); break;
+      case EnvObjectDesc::Type::Sphere: mesh = makeSphereMesh(o.position, o.radius_m); break;
+      case EnvObjectDesc::Type::Ground:
+      case EnvObjectDesc::Type::Quad:
+        mesh = makeQuadMesh(o.position, o.normal, o.v_axis, o.size.x, o.size.y, uv_scale);
+        break;
+      case EnvObjectDesc::Type::Mesh: {
+        if (!load_mesh) throw Error(what + ": no mesh reader is available in this program");
+        MeshData md = load_mesh(o.file);
+        if (md.positions.empty() || md.triangles.empty()) throw Error(what + ": " + o.file + " holds no triangles");
+        mesh.anchor = o.position;
+        for (size_t v = 0; v < md.positions.size(); ++v) {
+          const Vec3 p = o.rotation * (o.scale * md.positions[v]);
+          mesh.positions.push_back(glm::vec3(p));
+          mesh.uvs.push_back(v < md.uvs.size() ? glm::vec2(md.uvs[v]) : glm::vec2(0));
+        }
+        mesh.triangles = md.triangles;
+        // Normals: transformed by the inverse transpose, or from the faces when the file has none.
+        std::vector<Vec3> normals(md.positions.size(), Vec3(0));
+        if (md.normals.size() == md.positions.size()) {
+          const Mat3 nt = glm::transpose(glm::inverse(o.rotation * Mat3(glm::scale(Mat4(1.0), o.scale))));
+          for (size_t v = 0; v < normals.size(); ++v) normals[v] = nt * md.normals[v];
+        } else {
+          for (const auto& t : mesh.triangles) {
+            const Vec3 a(mesh.positions[t.x]), b(mesh.positions[t.y]), c(mesh.positions[t.z]);
+            const Vec3 fn = glm::cross(b - a, c - a);
+            normals[t.x] += fn;
+            normals[t.y] += fn;
+            normals[t.z] += fn;
+          }
+        }
+        for (const Vec3& n : normals) {
+          const double len = glm::length(n);
+          mesh.normals.push_back(glm::vec3(len > 0 ? n / len : Vec3(0, 1, 0)));
+        }
+        break;
+      }
+    }
+    mesh.name = o.name.empty() ? std::string(toString(o.type)) + std::to_string(i) : o.name;
+    mesh.material = int(scene.materials.size());
+    scene.materials.push_back(mat);
+    scene.meshes.push_back(std::move(mesh));
+  }
+
+  for (const LightDesc& l : desc.lights) {
+    Light light;
+    light.radiance = l.color * l.intensity;
+    switch (l.type) {
+      case LightDesc::Type::Ambient: light.type = Light::Type::Ambient; break;
+      case LightDesc::Type::Directional:
+        light.type = Light::Type::Directional;
+        light.direction = glm::normalize(l.direction);
+        break;
+      case LightDesc::Type::Point:
+        light.type = Light::Type::Point;
+        light.position = l.position;
+        break;
+    }
+    scene.lights.push_back(light);
+  }
+
+  for (size_t i = 0; i < desc.elements.size(); ++i) {
+    const ElementDesc& e = desc.elements[i];
+    const std::string what = file + ": elements[" + std::to_string(i) + "] (" + e.name + ")";
+    Element el;
+    el.name = e.name;
+    el.type = e.type == ElementDesc::Type::Lens ? ElementType::Lens : ElementType::Mirror;
+    el.attached_to_observer = e.attached_to_observer;
+    el.patches_u = e.patches_u;
+    el.patches_v = e.patches_v;
+    el.max_patch_fov_rad = radians(e.max_patch_fov_deg);
+    el.has_outline = e.outline.has_value();
+    if (e.outline) el.outline = toOutline(*e.outline);
+    try {
+      if (el.type == ElementType::Mirror) {
+        const SurfaceDesc& s = e.surface;
+        if (s.isSag()) {
+          if (!e.outline) throw Error("a " + std::string(toString(s.type)) + " mirror needs an outline");
+          el.surface = makeSag(s, el.outline, 0.0);
+        } else if (s.type == SurfaceDesc::Type::Cad) {
+          cad::ImportedModel model = cad::importCadFile(s.file);
+          if (s.face < 0 || size_t(s.face) >= model.faces.size())
+            throw Error(s.file + ": face " + std::to_string(s.face) + " requested, the file has " +
+                        std::to_string(model.faces.size()));
+          const cad::ImportedFace& face = model.faces[size_t(s.face)];
+          el.surface = std::make_shared<cad::NurbsSurface>(cad::scaled(*face.surface, model.unit_to_metres));
+          // The trim loop (in parameter space) is the outline; an explicit outline cannot apply to (u, v).
+          el.has_outline = face.trim.has_value();
+          if (face.trim) el.outline = *face.trim;
+        } else {
+          el.surface = std::make_shared<ScaledSurface>(cad::loadSubdivisionCage(s.file), s.file_unit_m);
+          el.has_outline = false;
+        }
+        switch (e.mirror_material.kind) {
+          case MirrorMaterialDesc::Kind::Reflectance:
+            el.mirror.reflectance = Vec3(e.mirror_material.reflectance);
+            break;
+          case MirrorMaterialDesc::Kind::Metal: {
+            Metal m = lookupMetal(e.mirror_material.metal);
+            el.mirror.metal = true;
+            el.mirror.n = m.n_rgb();
+            el.mirror.k = m.k_rgb();
+            el.mirror.metal_table = std::make_shared<const Metal>(m);
+            break;
+          }
+          case MirrorMaterialDesc::Kind::Conductor:
+            el.mirror.metal = true;
+            el.mirror.n = e.mirror_material.n;
+            el.mirror.k = e.mirror_material.k;
+            break;
+        }
+      } else {
+        const LensMaterialDesc& lm = e.lens_material;
+        Dispersion disp;
+        switch (lm.kind) {
+          case LensMaterialDesc::Kind::Named: disp = lookupLensMaterial(lm.name).dispersion; break;
+          case LensMaterialDesc::Kind::Abbe: disp = Dispersion::fromAbbe(lm.n_d, lm.V_d); break;
+          case LensMaterialDesc::Kind::Sellmeier: disp = Dispersion::sellmeier(lm.sellmeier_b, lm.sellmeier_c_um2); break;
+        }
+        if (!lm.dispersion) disp = Dispersion::constant(disp.n_d());
+        el.dispersion = disp;
+        el.dispersion_on = lm.dispersion;
+        if (!e.outline) throw Error("a lens needs an outline");
+        cad::SagSurfacePtr front, back;
+        double t = e.centre_thickness_m;
+        if (e.prescription) {
+          const PrescriptionDesc& p = *e.prescription;
+          if (t <= 0) t = p.sphere_d < 0 ? 2e-3 : 1.5e-3;
+          const double base = p.base_curve_d ? *p.base_curve_d : defaultBaseCurve(p.sphere_d);
+          const PrescriptionRadii r = prescriptionRadii(p.sphere_d, p.cylinder_d, base, disp.n_d(), t);
+          back = std::isfinite(r.back_radius_m) ? cad::makeSphere(r.back_radius_m, el.outline)
+                                                : cad::makePlane(el.outline);
+          if (p.cylinder_d == 0)
+            front = std::isfinite(r.front_radius_a_m) ? cad::makeSphere(r.front_radius_a_m, el.outline)
+                                                      : cad::makePlane(el.outline);
+          else
+            front = cad::makeToric(r.front_radius_a_m, r.front_radius_b_m, radians(p.axis_deg), el.outline);
+        } else {
+          const std::string where = file + ": elements[" + std::to_string(i) + "]";
+          front = makeLensSurface(e.front, el.outline, where + ".front");
+          back = makeLensSurface(e.back, el.outline, where + ".back");
+        }
+        el.lens = cad::makeLens(front, back, el.outline, t, e.min_edge_thickness_m, what);
+      }
+    } catch (const Error& err) {
+      const std::string msg = err.what();
+      throw Error(msg.rfind(file, 0) == 0 ? msg : what + ": " + msg);
+    }
+    if (e.tessellation.mode == TessellationDesc::Mode::Grid) {
+      el.tess_u = e.tessellation.n_u;
+      el.tess_v = e.tessellation.n_v;
+    } else {
+      const int n = gridForTolerance(el.frontSurface(), el.has_outline ? &el.outline : nullptr,
+                                     e.tessellation.chordal_tolerance_m);
+      el.tess_u = el.tess_v = n;
+    }
+    scene.elements.push_back(std::move(el));
+  }
+  updateAttachedElements(scene, desc);
+
+  RenderSettings& rs = scene.render;
+  rs.mode = toString(desc.render.mode);
+  rs.map_size = desc.render.map_size;
+  rs.map_texels_per_pixel = desc.render.map_texels_per_pixel;
+  rs.map_reuse_margin_deg = desc.render.map_reuse_margin_deg;
+  rs.impostor_iterations = desc.render.impostor_iterations;
+  rs.impostor_layers = desc.render.impostor_layers;
+  rs.output = desc.render.output.empty() ? "out/" + scene.name + ".png" : desc.render.output;
+  rs.max_depth = desc.render.max_depth;
+  rs.dispersion = toString(desc.render.dispersion);
+  rs.spectral_samples = desc.render.spectral_samples;
+  rs.background = desc.render.background;
+  scene.updateBounds();
+  rs.far_distance_m = std::max(1e3, 100.0 * scene.boundsRadius());
+  return scene;
+}
+
+void updateAttachedElements(Scene& scene, const SceneDesc& desc) {
+  const Mat4 obs = observerToWorld(scene.observer);
+  for (size_t i = 0; i < scene.elements.size() && i < desc.elements.size(); ++i) {
+    Element& el = scene.elements[i];
+    const Mat4 pose = poseMatrix(desc.elements[i].pose);
+    el.local_to_world = el.attached_to_observer ? obs * pose : pose;
+    el.world_to_local = glm::inverse(el.local_to_world);
+  }
+}
+
+}  // namespace pvrr

@@ -1,0 +1,41 @@
+// Build: the validated plain description (pvrr/scene/scene_desc.h) -> the runtime Scene (pvrr/scene/scene.h).
+// Environment meshes from files are read by a loader the caller provides (the app reads OBJ and PLY with
+// VTK, which pvrr/ does not depend on).
+#pragma once
+#include <functional>
+#include <string>
+
+#include "pvrr/scene/scene.h"
+#include "pvrr/scene/scene_desc.h"
+
+namespace pvrr {
+
+// Reads a mesh file: positions in file coordinates, normals (may be empty: then computed from faces) and
+// texture coordinates (may be empty).
+struct MeshData {
+  std::vector<Vec3> positions, normals;
+  std::vector<Vec2> uvs;
+  std::vector<glm::u32vec3> triangles;
+};
+using MeshLoader = std::function<MeshData(const std::string& path)>;
+
+// Throws pvrr::Error naming the scene file and the element or object when something cannot be built
+// (e.g. lens surfaces that cross, a CAD file without the requested face).
+Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh = {});
+
+// The pose of an element attached to the observer follows the observer: recomputes local_to_world for
+// every attached element after the observer moved (pvrr render --orbit).
+void updateAttachedElements(Scene& scene, const SceneDesc& desc);
+
+// Spectacle prescription -> surface radii (our sign convention, cad/sag.h). `base_curve_d` is the
+// object-side surface power; t the centre thickness (m). Back vertex power = sphere (+ cylinder).
+struct PrescriptionRadii {
+  double back_radius_m;            // object side (the lens's "back" surface)
+  double front_radius_a_m;         // eye side, along the cylinder axis (the sphere meridian)
+  double front_radius_b_m;         // eye side, perpendicular (sphere + cylinder meridian)
+};
+PrescriptionRadii prescriptionRadii(double sphere_d, double cylinder_d, double base_curve_d, double n,
+                                    double centre_thickness_m);
+double defaultBaseCurve(double sphere_d);
+
+}  // namespace pvrr

@@ -1,0 +1,1255 @@
+#include "pvrr/scene/scene_json.h"
+
+#include <algorithm>
+#include <cctype>
+#include <climits>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <nlohmann/json.hpp>
+
+#include "pvrr/base/error.h"
+#include "pvrr/optics/material.h"
+#include "pvrr/scene/texture_gen.h"
+
+namespace pvrr {
+namespace {
+
+using json = nlohmann::json;
+namespace fs = std::filesystem;
+
+// Shorter than this (in the file's unit) a direction is "zero": no scene quantity is that small, so a
+// vector this short is a typo, not a geometry.
+constexpr double kZeroVectorLength = 1e-12;
+// Two points closer than this (metres) are "the same point" (eye == target).
+constexpr double kSamePoint_m = 1e-9;
+// Directions whose angle is within this of 0 or pi (radians) are "parallel": a frame built from them would
+// be dominated by rounding (up vs. view, up vs. element normal).
+constexpr double kParallelAngle_rad = 1e-6;
+// Largest pixel dimension accepted for images and maps (GL 4.5 guarantees at least 16384).
+constexpr int kMaxImageSize = 16384;
+// Largest procedural texture side (textures stay small; docs/scene-format.md).
+constexpr int kMaxTextureSize = 1024;
+
+// ---------------------------------------------------------------------------------------------------------
+// Messages
+
+std::string fmt(double v) {
+  std::ostringstream os;
+  os.precision(10);
+  os << v;
+  return os.str();
+}
+
+std::string show(const json* j) {
+  if (!j) return "nothing";
+  if (j->is_number_float() && !std::isfinite(j->get<double>())) return fmt(j->get<double>());
+  std::string s = j->dump();
+  constexpr size_t kMaxShown = 60;
+  if (s.size() > kMaxShown) s = s.substr(0, kMaxShown - 3) + "...";
+  return s;
+}
+
+std::string inQuotes(const std::string& s) { return "\"" + s + "\""; }
+
+std::string joinQuoted(const std::vector<std::string>& v, const char* last_sep = " or ") {
+  std::string out;
+  for (size_t i = 0; i < v.size(); ++i) {
+    if (i > 0) out += (i + 1 == v.size()) ? last_sep : ", ";
+    out += inQuotes(v[i]);
+  }
+  return out;
+}
+
+std::string lower(std::string s) {
+  for (char& ch : s) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  return s;
+}
+
+bool startsWith(const std::string& s, const std::string& prefix) { return s.compare(0, prefix.size(), prefix) == 0; }
+
+bool endsWithAny(const std::string& s, const std::vector<std::string>& exts) {
+  const std::string l = lower(s);
+  for (const std::string& e : exts)
+    if (l.size() >= e.size() && l.compare(l.size() - e.size(), e.size(), e) == 0) return true;
+  return false;
+}
+
+// The nearest option within a typo's distance, or "" (case is ignored).
+std::string nearest(const std::string& word, const std::vector<std::string>& options) {
+  std::string best;
+  int best_d = INT_MAX;
+  for (const std::string& o : options) {
+    const int d = editDistance(lower(word), lower(o));
+    if (d < best_d) {
+      best_d = d;
+      best = o;
+    }
+  }
+  // A third of the word's letters may be wrong; words of one or two letters get no suggestion ("cm" is not
+  // a typo of "m").
+  const int allowed = word.size() <= 2 ? 0 : std::max(1, static_cast<int>(word.size()) / 3);
+  return best_d <= allowed ? best : std::string();
+}
+
+std::string childPath(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
+std::string indexPath(const std::string& path, size_t i) { return path + "[" + std::to_string(i) + "]"; }
+
+// ---------------------------------------------------------------------------------------------------------
+// Context: file name, folder, unit, overrides (for " (from --set ...)" notes).
+
+struct Override {
+  std::string path;  // normalised, e.g. elements[0].tessellation
+  std::string text;  // as given
+};
+
+bool relatedPaths(const std::string& a, const std::string& b) {
+  const auto under = [](const std::string& p, const std::string& q) {
+    return p == q || startsWith(p, q + ".") || startsWith(p, q + "[");
+  };
+  return under(a, b) || under(b, a);
+}
+
+struct Ctx {
+  std::string file;
+  std::string base_dir;
+  std::string units = "m";
+  double unit_m = 1;
+  std::vector<Override> overrides;
+
+  [[noreturn]] void fail(const std::string& path, const std::string& msg) const {
+    std::string m = file + ": " + (path.empty() ? std::string("(top level)") : path) + ": " + msg;
+    for (auto it = overrides.rbegin(); it != overrides.rend(); ++it) {
+      if (relatedPaths(path, it->path)) {
+        m += " (from --set " + it->text + ")";
+        break;
+      }
+    }
+    throw Error(m);
+  }
+  [[noreturn]] void expected(const std::string& path, const std::string& what, const json* got) const {
+    fail(path, "expected " + what + ", got " + show(got));
+  }
+};
+
+// ---------------------------------------------------------------------------------------------------------
+// Typed reads of one JSON value at a path.
+
+struct Range {
+  double lo = -kInf, hi = kInf;
+  bool lo_open = false, hi_open = false;
+  bool contains(double v) const {
+    return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
+  }
+  std::string text(const std::string& noun) const {
+    const bool has_lo = std::isfinite(lo), has_hi = std::isfinite(hi);
+    if (!has_lo && !has_hi) return "a finite " + noun.substr(noun.find(' ') + 1);
+    if (has_lo && !has_hi) return noun + (lo_open ? " > " : " >= ") + fmt(lo);
+    if (!has_lo) return noun + (hi_open ? " < " : " <= ") + fmt(hi);
+    return noun + " in " + (lo_open ? "(" : "[") + fmt(lo) + ", " + fmt(hi) + (hi_open ? ")" : "]");
+  }
+};
+const Range kAny{};
+const Range kPositive{0, kInf, true, false};
+const Range kNonNegative{0, kInf, false, false};
+Range closed(double lo, double hi) { return {lo, hi, false, false}; }
+Range open(double lo, double hi) { return {lo, hi, true, true}; }
+Range leftOpen(double lo, double hi) { return {lo, hi, true, false}; }
+
+double readNumber(const Ctx& c, const json* j, const std::string& path, const Range& r,
+                  const std::string& noun = "a number") {
+  if (!j || !j->is_number()) c.expected(path, r.text(noun), j);
+  const double v = j->get<double>();
+  if (!std::isfinite(v) || !r.contains(v)) c.expected(path, r.text(noun), j);
+  return v;
+}
+
+int readInt(const Ctx& c, const json* j, const std::string& path, int lo, int hi) {
+  const std::string what = hi == INT_MAX ? "an integer >= " + std::to_string(lo)
+                                         : "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  if (!j || !j->is_number()) c.expected(path, what, j);
+  const double v = j->get<double>();
+  if (!std::isfinite(v) || v != std::floor(v) || v < lo || v > hi) c.expected(path, what, j);
+  return static_cast<int>(v);
+}
+
+enum class VecKind { Point, Direction, Colour01, ColourNonNegative, Size, Positive };
+
+std::string vecText(VecKind k, int n) {
+  const std::string xyz = n == 3 ? "[x, y, z]" : "[x, y]";
+  switch (k) {
+    case VecKind::Point: return "a point " + xyz + " of " + std::to_string(n) + " finite numbers";
+    case VecKind::Direction: return "a non-zero direction " + xyz;
+    case VecKind::Colour01: return "a colour [r, g, b] with each in [0, 1]";
+    case VecKind::ColourNonNegative: return "a colour [r, g, b] with each >= 0";
+    case VecKind::Size: return "a size " + std::string(n == 3 ? "[x, y, z]" : "[w, h]") + " with each > 0";
+    case VecKind::Positive: return "an array of " + std::to_string(n) + " numbers, each > 0";
+  }
+  return "";
+}
+
+template <int N>
+glm::vec<N, double> readVec(const Ctx& c, const json* j, const std::string& path, VecKind k) {
+  const std::string what = vecText(k, N);
+  if (!j || !j->is_array() || j->size() != N) c.expected(path, what, j);
+  glm::vec<N, double> v(0.0);
+  for (int i = 0; i < N; ++i) {
+    const json& e = (*j)[i];
+    if (!e.is_number() || !std::isfinite(e.get<double>())) c.expected(path, what, j);
+    v[i] = e.get<double>();
+    const bool ok = (k == VecKind::Colour01)            ? (v[i] >= 0 && v[i] <= 1)
+                    : (k == VecKind::ColourNonNegative) ? v[i] >= 0
+                    : (k == VecKind::Size || k == VecKind::Positive) ? v[i] > 0
+                                                                      : true;
+    if (!ok) c.expected(path, what, j);
+  }
+  if (k == VecKind::Direction) {
+    if (glm::length(v) <= kZeroVectorLength) c.expected(path, what, j);
+    v = glm::normalize(v);
+  }
+  return v;
+}
+
+void unknownKey(const Ctx& c, const std::string& path, const std::string& key, const std::vector<std::string>& keys) {
+  const std::string near = nearest(key, keys);
+  if (!near.empty()) c.fail(childPath(path, key), "unknown key; did you mean " + inQuotes(near) + "?");
+  c.fail(childPath(path, key), "unknown key; expected one of " + joinQuoted(keys));
+}
+
+// An object at a path whose keys must all be in `keys`.
+class Obj {
+ public:
+  Obj(const Ctx& c, const json* j, std::string path, const std::string& what, std::vector<std::string> keys)
+      : c_(c), j_(j), path_(std::move(path)) {
+    if (!j || !j->is_object()) c.expected(path_, what, j);
+    for (auto it = j->begin(); it != j->end(); ++it)
+      if (std::find(keys.begin(), keys.end(), it.key()) == keys.end()) unknownKey(c, path_, it.key(), keys);
+  }
+  const Ctx& ctx() const { return c_; }
+  const std::string& path() const { return path_; }
+  const json& value() const { return *j_; }
+  const json* get(const std::string& k) const {
+    auto it = j_->find(k);
+    return it == j_->end() ? nullptr : &*it;
+  }
+  bool has(const std::string& k) const { return get(k) != nullptr; }
+  std::string at(const std::string& k) const { return childPath(path_, k); }
+  [[noreturn]] void expected(const std::string& k, const std::string& what) const { c_.expected(at(k), what, get(k)); }
+
+  double number(const std::string& k, const Range& r, const std::string& noun = "a number") const {
+    return readNumber(c_, get(k), at(k), r, noun);
+  }
+  double number(const std::string& k, const Range& r, double def, const std::string& noun = "a number") const {
+    return has(k) ? number(k, r, noun) : def;
+  }
+  // A length in the file's unit, returned in metres.
+  double length(const std::string& k, const Range& r) const { return number(k, r, "a length") * c_.unit_m; }
+  double length(const std::string& k, const Range& r, double def_m) const {
+    return has(k) ? length(k, r) : def_m;
+  }
+  int integer(const std::string& k, int lo, int hi) const { return readInt(c_, get(k), at(k), lo, hi); }
+  int integer(const std::string& k, int lo, int hi, int def) const { return has(k) ? integer(k, lo, hi) : def; }
+  bool boolean(const std::string& k, bool def) const {
+    if (!has(k)) return def;
+    if (!get(k)->is_boolean()) expected(k, "true or false");
+    return get(k)->get<bool>();
+  }
+  std::string string(const std::string& k) const {
+    const json* j = get(k);
+    if (!j || !j->is_string() || j->get<std::string>().empty()) expected(k, "a non-empty string");
+    return j->get<std::string>();
+  }
+  std::string string(const std::string& k, const std::string& def) const { return has(k) ? string(k) : def; }
+  std::string choice(const std::string& k, const std::vector<std::string>& options) const {
+    const json* j = get(k);
+    const std::string what = "one of " + joinQuoted(options);
+    if (!j || !j->is_string()) expected(k, what);
+    const std::string s = j->get<std::string>();
+    if (std::find(options.begin(), options.end(), s) != options.end()) return s;
+    const std::string near = nearest(s, options);
+    c_.fail(at(k), "expected " + what + ", got " + show(j) + (near.empty() ? "" : "; did you mean " + inQuotes(near) + "?"));
+  }
+  std::string choice(const std::string& k, const std::vector<std::string>& options, const std::string& def) const {
+    return has(k) ? choice(k, options) : def;
+  }
+  Vec3 vec3(const std::string& k, VecKind kind) const { return readVec<3>(c_, get(k), at(k), kind); }
+  Vec3 vec3(const std::string& k, VecKind kind, Vec3 def) const { return has(k) ? vec3(k, kind) : def; }
+  Vec2 vec2(const std::string& k, VecKind kind) const { return readVec<2>(c_, get(k), at(k), kind); }
+  // A point in the file's unit, returned in metres.
+  Vec3 point(const std::string& k) const { return vec3(k, VecKind::Point) * c_.unit_m; }
+  Vec3 point(const std::string& k, Vec3 def_m) const { return has(k) ? point(k) : def_m; }
+
+  // A file named relative to the scene's folder, with one of the extensions, that must exist.
+  std::string file(const std::string& k, const std::vector<std::string>& exts, const std::string& what) const {
+    const std::string rel = string(k);
+    if (!endsWithAny(rel, exts)) expected(k, what + " (" + joinQuoted(exts) + ")");
+    fs::path p(rel);
+    if (p.is_relative() && !c_.base_dir.empty()) p = fs::path(c_.base_dir) / p;
+    p = p.lexically_normal();
+    std::error_code ec;
+    if (!fs::is_regular_file(p, ec)) expected(k, "an existing " + what + " (looked for " + inQuotes(p.string()) + ")");
+    return p.string();
+  }
+
+ private:
+  const Ctx& c_;
+  const json* j_;
+  std::string path_;
+};
+
+// Reads "type"-like discriminators before the key set is known: the value must be an object holding `key`.
+std::string peekChoice(const Ctx& c, const json* j, const std::string& path, const std::string& what,
+                       const std::string& key, const std::vector<std::string>& options) {
+  if (!j || !j->is_object()) c.expected(path, what, j);
+  std::vector<std::string> keys;
+  for (auto it = j->begin(); it != j->end(); ++it) keys.push_back(it.key());
+  // Only `key` is checked here; the caller's Obj checks the rest against the set for the chosen option.
+  return Obj(c, j, path, what, keys).choice(key, options);
+}
+
+const json* arrayAt(const Ctx& c, const json* j, const std::string& path, const std::string& what) {
+  if (j && !j->is_array()) c.expected(path, what, j);
+  return j;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Rotations: rotation_deg [x, y, z] is R = Rz * Ry * Rx (about the fixed parent axes, x first);
+// axis_angle {axis, angle_deg} is a right-handed rotation about the axis.
+
+Mat3 rotationAbout(const Vec3& axis, double angle_rad) { return Mat3(glm::rotate(Mat4(1.0), angle_rad, axis)); }
+
+Mat3 readRotation(const Obj& o) {
+  if (o.has("rotation_deg") && o.has("axis_angle"))
+    o.ctx().fail(o.at("axis_angle"), "expected either \"rotation_deg\" or \"axis_angle\", got both");
+  if (o.has("rotation_deg")) {
+    const Vec3 deg = o.vec3("rotation_deg", VecKind::Point);
+    return rotationAbout(Vec3(0, 0, 1), radians(deg.z)) * rotationAbout(Vec3(0, 1, 0), radians(deg.y)) *
+           rotationAbout(Vec3(1, 0, 0), radians(deg.x));
+  }
+  if (o.has("axis_angle")) {
+    Obj aa(o.ctx(), o.get("axis_angle"), o.at("axis_angle"), "an object {\"axis\": [x, y, z], \"angle_deg\": a}",
+           {"axis", "angle_deg"});
+    return rotationAbout(aa.vec3("axis", VecKind::Direction), radians(aa.number("angle_deg", kAny, "an angle")));
+  }
+  return Mat3(1.0);
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Textures and materials
+
+struct ProceduralSpec {
+  const char* name;
+  TextureDesc::Kind kind;
+  int resolution;
+  Vec3 a, b;
+  std::vector<std::string> keys;  // besides procedural, resolution, seed, a, b
+};
+
+const std::vector<ProceduralSpec>& proceduralSpecs() {
+  static const std::vector<ProceduralSpec> specs = {
+      {"checker", TextureDesc::Kind::Checker, 256, Vec3(0.9), Vec3(0.1), {"squares"}},
+      {"eye-chart", TextureDesc::Kind::EyeChart, 512, Vec3(1.0), Vec3(0.0), {"rows"}},
+      {"page", TextureDesc::Kind::Page, 512, Vec3(0.85, 0.82, 0.75), Vec3(0.02, 0.02, 0.025), {"lines"}},
+      {"bricks", TextureDesc::Kind::Bricks, 256, Vec3(0.45, 0.12, 0.07), Vec3(0.55, 0.53, 0.5), {"courses"}},
+      {"road", TextureDesc::Kind::Road, 512, Vec3(0.045, 0.045, 0.05), Vec3(0.8, 0.8, 0.75), {"lanes"}},
+      {"windows", TextureDesc::Kind::Windows, 512, Vec3(0.6, 0.45, 0.32), Vec3(0.05, 0.08, 0.12), {"grid"}},
+      {"sky", TextureDesc::Kind::Sky, 256, Vec3(0.75, 0.85, 1.0), Vec3(0.15, 0.3, 0.75), {}},
+      {"sign", TextureDesc::Kind::Sign, 256, Vec3(0.01, 0.1, 0.5), Vec3(0.9), {"symbol"}},
+  };
+  return specs;
+}
+
+TextureDesc readTexture(const Ctx& c, const json* j, const std::string& path) {
+  const std::string what = "an object {\"image\": \"file.png\"} or {\"procedural\": \"checker\", ...}";
+  if (!j || !j->is_object()) c.expected(path, what, j);
+  TextureDesc t;
+  if (j->contains("image")) {
+    Obj o(c, j, path, what, {"image"});
+    t.kind = TextureDesc::Kind::Image;
+    t.image_path = o.file("image", {".png"}, "PNG image");
+    return t;
+  }
+  if (!j->contains("procedural")) c.expected(path, what, j);
+  std::vector<std::string> names;
+  for (const ProceduralSpec& s : proceduralSpecs()) names.push_back(s.name);
+  const std::string name = peekChoice(c, j, path, what, "procedural", names);
+  const ProceduralSpec& spec = *std::find_if(proceduralSpecs().begin(), proceduralSpecs().end(),
+                                             [&](const ProceduralSpec& s) { return name == s.name; });
+  std::vector<std::string> keys = {"procedural", "resolution", "seed", "a", "b"};
+  keys.insert(keys.end(), spec.keys.begin(), spec.keys.end());
+  Obj o(c, j, path, what, keys);
+  t.kind = spec.kind;
+  t.width = t.height = spec.resolution;
+  if (const json* r = o.get("resolution")) {
+    const std::string rwhat = "a size N or [w, h] in pixels, each in [8, " + std::to_string(kMaxTextureSize) + "]";
+    if (r->is_array()) {
+      if (r->size() != 2) c.expected(o.at("resolution"), rwhat, r);
+      t.width = readInt(c, &(*r)[0], o.at("resolution"), 8, kMaxTextureSize);
+      t.height = readInt(c, &(*r)[1], o.at("resolution"), 8, kMaxTextureSize);
+    } else {
+      if (!r->is_number()) c.expected(o.at("resolution"), rwhat, r);
+      t.width = t.height = o.integer("resolution", 8, kMaxTextureSize);
+    }
+  }
+  t.seed = static_cast<uint32_t>(o.number("seed", closed(0, 4294967295.0), 1, "an integer"));
+  if (o.has("seed") && o.get("seed")->get<double>() != std::floor(o.get("seed")->get<double>()))
+    o.expected("seed", "an integer in [0, 4294967295]");
+  t.color_a = o.vec3("a", VecKind::Colour01, spec.a);
+  t.color_b = o.vec3("b", VecKind::Colour01, spec.b);
+  switch (spec.kind) {
+    case TextureDesc::Kind::Checker: {
+      t.squares_u = t.squares_v = 8;
+      if (const json* s = o.get("squares")) {
+        if (s->is_array()) {
+          if (s->size() != 2) o.expected("squares", "a count N or [nu, nv]");
+          t.squares_u = readInt(c, &(*s)[0], o.at("squares"), 1, t.width / 2);
+          t.squares_v = readInt(c, &(*s)[1], o.at("squares"), 1, t.height / 2);
+        } else {
+          t.squares_u = o.integer("squares", 1, std::min(t.width, t.height) / 2);
+          t.squares_v = t.squares_u;
+        }
+      }
+      break;
+    }
+    case TextureDesc::Kind::EyeChart: {
+      const int max_rows = eyeChartMaxRows(t.width, t.height);
+      if (max_rows < 1) o.expected("resolution", "a resolution large enough for one row of optotypes");
+      t.rows = o.integer("rows", 1, max_rows, std::min(8, max_rows));
+      break;
+    }
+    case TextureDesc::Kind::Page: t.rows = o.integer("lines", 1, pageMaxLines(t.height), std::min(32, pageMaxLines(t.height))); break;
+    case TextureDesc::Kind::Bricks: t.rows = o.integer("courses", 1, t.height / 4, std::min(8, t.height / 4)); break;
+    case TextureDesc::Kind::Road: t.lanes = o.integer("lanes", 1, 8, 2); break;
+    case TextureDesc::Kind::Windows: {
+      if (const json* g = o.get("grid")) {
+        if (!g->is_array() || g->size() != 2) o.expected("grid", "[columns, floors]");
+        t.columns = readInt(c, &(*g)[0], o.at("grid"), 1, t.width / 8);
+        t.floors = readInt(c, &(*g)[1], o.at("grid"), 1, t.height / 8);
+      }
+      break;
+    }
+    case TextureDesc::Kind::Sign: t.symbol = o.choice("symbol", {"arrow", "bar", "ring", "cross"}, "arrow"); break;
+    case TextureDesc::Kind::Sky:
+    case TextureDesc::Kind::Image: break;
+  }
+  return t;
+}
+
+MaterialDesc readMaterial(const Ctx& c, const json* j, const std::string& path) {
+  MaterialDesc m;
+  if (!j) return m;
+  Obj o(c, j, path, "a material {\"color\": [r, g, b], \"texture\": {...}, \"texture_scale\": ...}",
+        {"color", "texture", "texture_scale"});
+  if (o.has("texture")) m.texture = readTexture(c, o.get("texture"), o.at("texture"));
+  m.color = o.vec3("color", VecKind::Colour01, m.texture ? Vec3(1.0) : Vec3(0.8));
+  if (const json* s = o.get("texture_scale")) {
+    if (s->is_string() && s->get<std::string>() == "fit") {
+      m.texture_fit = true;
+    } else {
+      if (!s->is_array()) o.expected("texture_scale", "\"fit\" or [su, sv] (lengths per texture repeat, each > 0)");
+      m.texture_fit = false;
+      m.texture_scale_m = readVec<2>(c, s, o.at("texture_scale"), VecKind::Size) * c.unit_m;
+    }
+  }
+  return m;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Sections
+
+ObserverDesc readObserver(const Ctx& c, const json* j) {
+  Obj o(c, j, "observer", "an object {\"eye\", \"target\", \"up\", \"fov_y_deg\", \"image_size\"}",
+        {"eye", "target", "up", "fov_y_deg", "image_size"});
+  ObserverDesc d;
+  d.eye = o.point("eye");
+  d.target = o.point("target");
+  d.up = o.vec3("up", VecKind::Direction, Vec3(0, 1, 0));
+  const Vec3 view = d.target - d.eye;
+  if (glm::length(view) <= kSamePoint_m) o.expected("target", "a point different from observer.eye");
+  const double a = angleBetween(d.up, view);
+  if (a < kParallelAngle_rad || a > kPi - kParallelAngle_rad)
+    o.expected("up", "a direction not parallel to the view direction (target - eye)");
+  d.fov_y_deg = o.number("fov_y_deg", open(0, 180), 50, "an angle (degrees)");
+  if (const json* s = o.get("image_size")) {
+    const std::string what = "[width, height] in pixels, each in [1, " + std::to_string(kMaxImageSize) + "]";
+    if (!s->is_array() || s->size() != 2) o.expected("image_size", what);
+    d.image_width = readInt(c, &(*s)[0], o.at("image_size"), 1, kMaxImageSize);
+    d.image_height = readInt(c, &(*s)[1], o.at("image_size"), 1, kMaxImageSize);
+  }
+  return d;
+}
+
+LightDesc readLight(const Ctx& c, const json* j, const std::string& path) {
+  const std::string what = "a light {\"type\": \"directional\" | \"point\" | \"ambient\", ...}";
+  const std::string type = peekChoice(c, j, path, what, "type", {"directional", "point", "ambient"});
+  LightDesc l;
+  if (type == "directional") {
+    Obj o(c, j, path, what, {"type", "direction", "color", "intensity"});
+    l.type = LightDesc::Type::Directional;
+    l.direction = o.vec3("direction", VecKind::Direction);
+    l.color = o.vec3("color", VecKind::ColourNonNegative, Vec3(1.0));
+    l.intensity = o.number("intensity", kNonNegative, 1.0);
+  } else if (type == "point") {
+    Obj o(c, j, path, what, {"type", "position", "color", "intensity"});
+    l.type = LightDesc::Type::Point;
+    l.position = o.point("position");
+    l.color = o.vec3("color", VecKind::ColourNonNegative, Vec3(1.0));
+    l.intensity = o.number("intensity", kNonNegative, 1.0);
+  } else {
+    Obj o(c, j, path, what, {"type", "color", "intensity"});
+    l.type = LightDesc::Type::Ambient;
+    l.color = o.vec3("color", VecKind::ColourNonNegative, Vec3(1.0));
+    l.intensity = o.number("intensity", kNonNegative, 1.0);
+  }
+  return l;
+}
+
+// In-plane axes of a ground or quad: u from `u_hint` projected onto the plane, v = normal x u.
+void planeAxes(const Obj& o, const std::string& hint_key, const Vec3& u_hint, bool hint_is_up, EnvObjectDesc& d) {
+  const double a = angleBetween(u_hint, d.normal);
+  if (a < kParallelAngle_rad || a > kPi - kParallelAngle_rad)
+    o.ctx().expected(o.at(hint_key), "a direction not parallel to \"normal\"" +
+                     std::string(o.has(hint_key) ? "" : " (the default is parallel here: give one)"),
+                     o.get(hint_key));
+  if (hint_is_up) {
+    d.u_axis = glm::normalize(glm::cross(u_hint, d.normal));
+  } else {
+    d.u_axis = glm::normalize(u_hint - glm::dot(u_hint, d.normal) * d.normal);
+  }
+  d.v_axis = glm::cross(d.normal, d.u_axis);
+}
+
+EnvObjectDesc readEnvObject(const Ctx& c, const json* j, const std::string& path, size_t index) {
+  const std::string what = "an environment object {\"type\": \"mesh\" | \"ground\" | \"box\" | \"sphere\" | \"quad\", ...}";
+  const std::string type = peekChoice(c, j, path, what, "type", {"mesh", "ground", "box", "sphere", "quad"});
+  std::vector<std::string> keys = {"type", "name", "material"};
+  if (type == "mesh") keys.insert(keys.end(), {"file", "transform"});
+  if (type == "ground") keys.insert(keys.end(), {"point", "normal", "size", "u_axis"});
+  if (type == "box") keys.insert(keys.end(), {"centre", "size", "rotation_deg", "axis_angle"});
+  if (type == "sphere") keys.insert(keys.end(), {"centre", "radius"});
+  if (type == "quad") keys.insert(keys.end(), {"centre", "normal", "up", "size"});
+  Obj o(c, j, path, what, keys);
+  EnvObjectDesc d;
+  d.name = o.string("name", type + std::to_string(index));
+  d.material = readMaterial(c, o.get("material"), o.at("material"));
+  if (type == "mesh") {
+    d.type = EnvObjectDesc::Type::Mesh;
+    d.file = o.file("file", {".obj", ".ply"}, "OBJ or PLY mesh");
+    d.scale = Vec3(c.unit_m);
+    if (o.has("transform")) {
+      Obj t(c, o.get("transform"), o.at("transform"),
+            "a transform {\"position\", \"rotation_deg\" | \"axis_angle\", \"scale\"}",
+            {"position", "rotation_deg", "axis_angle", "scale"});
+      d.position = t.point("position", Vec3(0));
+      d.rotation = readRotation(t);
+      if (const json* s = t.get("scale")) {
+        if (s->is_array()) d.scale = readVec<3>(c, s, t.at("scale"), VecKind::Positive) * c.unit_m;
+        else d.scale = Vec3(t.number("scale", kPositive)) * c.unit_m;
+      }
+    }
+  } else if (type == "ground" || type == "quad") {
+    d.type = type == "ground" ? EnvObjectDesc::Type::Ground : EnvObjectDesc::Type::Quad;
+    d.position = o.point(type == "ground" ? "point" : "centre");
+    d.normal = o.vec3("normal", VecKind::Direction);
+    d.size = Vec3(o.vec2("size", VecKind::Size) * c.unit_m, 0.0);
+    if (type == "ground") {
+      const Vec3 hint = o.has("u_axis") ? o.vec3("u_axis", VecKind::Direction)
+                        : (std::abs(d.normal.x) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 0, -1));
+      planeAxes(o, "u_axis", hint, false, d);
+    } else {
+      planeAxes(o, "up", o.vec3("up", VecKind::Direction, Vec3(0, 1, 0)), true, d);
+    }
+  } else if (type == "box") {
+    d.type = EnvObjectDesc::Type::Box;
+    d.position = o.point("centre");
+    d.size = o.vec3("size", VecKind::Size) * c.unit_m;
+    d.rotation = readRotation(o);
+  } else {
+    d.type = EnvObjectDesc::Type::Sphere;
+    d.position = o.point("centre");
+    d.radius_m = o.length("radius", kPositive);
+  }
+  return d;
+}
+
+// --- elements ---
+
+const std::vector<std::string> kAllSurfaceTypes = {"plane", "sphere", "asphere", "toric", "cylinder", "cad", "subdivision"};
+// A lens surface: analytic, or a CAD face that is a graph over the lens plane (cad::makeNurbsSag).
+const std::vector<std::string> kLensSurfaceTypes = {"plane", "sphere", "asphere", "toric", "cylinder", "cad"};
+
+double nonZeroRadius(const Obj& o, const std::string& k) {
+  const double r = o.number(k, kAny, "a length");
+  if (r == 0)
+    o.expected(k, "a non-zero radius (R > 0 convex, R < 0 concave as seen from +z; a flat surface is "
+                  "{\"type\": \"plane\"})");
+  return r * o.ctx().unit_m;
+}
+
+SurfaceDesc readSurface(const Ctx& c, const json* j, const std::string& path, const std::vector<std::string>& types) {
+  const std::string what = "a surface {\"type\": ...}";
+  const std::string type = peekChoice(c, j, path, what, "type", types);
+  SurfaceDesc s;
+  if (type == "plane") {
+    Obj o(c, j, path, what, {"type"});
+    s.type = SurfaceDesc::Type::Plane;
+  } else if (type == "sphere") {
+    Obj o(c, j, path, what, {"type", "radius"});
+    s.type = SurfaceDesc::Type::Sphere;
+    s.radius_m = nonZeroRadius(o, "radius");
+  } else if (type == "asphere") {
+    Obj o(c, j, path, what, {"type", "radius", "conic", "coefficients"});
+    s.type = SurfaceDesc::Type::Asphere;
+    s.radius_m = nonZeroRadius(o, "radius");
+    s.conic = o.number("conic", kAny, 0.0);
+    if (const json* a = o.get("coefficients")) {
+      if (!a->is_array()) o.expected("coefficients", "an array [A4, A6, ...] of finite numbers");
+      for (size_t i = 0; i < a->size(); ++i) {
+        const double v = readNumber(c, &(*a)[i], indexPath(o.at("coefficients"), i), kAny);
+        // A term A r^n with r and sag in the file unit s (metres per unit): A_m = A s^(1 - n).
+        const int n = static_cast<int>(2 * i + 4);
+        s.coefficients.push_back(v * std::pow(c.unit_m, 1 - n));
+      }
+    }
+  } else if (type == "toric") {
+    Obj o(c, j, path, what, {"type", "radius_a", "radius_b", "axis_deg"});
+    s.type = SurfaceDesc::Type::Toric;
+    s.radius_a_m = nonZeroRadius(o, "radius_a");
+    s.radius_b_m = nonZeroRadius(o, "radius_b");
+    s.axis_deg = o.number("axis_deg", closed(-360, 360), 0.0, "an angle (degrees)");
+  } else if (type == "cylinder") {
+    Obj o(c, j, path, what, {"type", "radius", "axis_deg"});
+    s.type = SurfaceDesc::Type::Cylinder;
+    s.radius_m = nonZeroRadius(o, "radius");
+    s.axis_deg = o.number("axis_deg", closed(-360, 360), 0.0, "an angle (degrees)");
+  } else if (type == "cad") {
+    Obj o(c, j, path, what, {"type", "file", "face"});
+    s.type = SurfaceDesc::Type::Cad;
+    s.file = o.file("file", {".step", ".stp", ".igs", ".iges"}, "STEP or IGES file");
+    s.face = o.integer("face", 0, INT_MAX, 0);
+  } else {
+    Obj o(c, j, path, what, {"type", "file"});
+    s.type = SurfaceDesc::Type::Subdivision;
+    s.file = o.file("file", {".obj"}, "OBJ quad cage");
+    s.file_unit_m = c.unit_m;
+  }
+  return s;
+}
+
+// Largest distance from the vertex to the outline (metres).
+double outlineReach_m(const OutlineDesc& o) {
+  switch (o.shape) {
+    case OutlineDesc::Shape::Rectangle: {
+      const double r = o.corner_radius_m;
+      return glm::length(Vec2(0.5 * o.width_m - r, 0.5 * o.height_m - r)) + r;
+    }
+    case OutlineDesc::Shape::Ellipse:
+    case OutlineDesc::Shape::Circle: return 0.5 * std::max(o.width_m, o.height_m);
+  }
+  return 0;
+}
+
+// A sag surface must be defined over its outline (cad/sag.h): |R| beyond the outline's reach for spheres
+// and the sections of toric and cylindrical surfaces (conservatively, in every direction), and
+// (1 + k) r^2 < R^2 for a conic.
+void checkSagReach(const Ctx& c, const json& surface_json, const std::string& path, const SurfaceDesc& s,
+                   const OutlineDesc& outline) {
+  const double reach = outlineReach_m(outline);
+  const auto need = [&](const char* key, double radius_m, double factor) {
+    if (std::abs(radius_m) * factor > reach) return;
+    const double limit = reach / factor / c.unit_m;
+    c.expected(childPath(path, key),
+               "|" + std::string(key) + "| > " + fmt(limit) + " " + c.units + " (the outline reaches " +
+                   fmt(reach / c.unit_m) + " " + c.units + " from the vertex" +
+                   (factor != 1 ? ", with the conic constant" : "") + ")",
+               &surface_json.at(key));
+  };
+  switch (s.type) {
+    case SurfaceDesc::Type::Sphere:
+    case SurfaceDesc::Type::Cylinder: need("radius", s.radius_m, 1); break;
+    case SurfaceDesc::Type::Asphere:
+      if (1 + s.conic > 0) need("radius", s.radius_m, 1 / std::sqrt(1 + s.conic));
+      break;
+    case SurfaceDesc::Type::Toric:
+      need("radius_a", s.radius_a_m, 1);
+      need("radius_b", s.radius_b_m, 1);
+      break;
+    default: break;
+  }
+}
+
+OutlineDesc readOutline(const Ctx& c, const json* j, const std::string& path) {
+  const std::string what = "an outline {\"shape\": \"rectangle\" | \"ellipse\" | \"circle\", ...}";
+  const std::string shape = peekChoice(c, j, path, what, "shape", {"rectangle", "ellipse", "circle"});
+  OutlineDesc d;
+  if (shape == "circle") {
+    Obj o(c, j, path, what, {"shape", "diameter"});
+    d.shape = OutlineDesc::Shape::Circle;
+    d.width_m = d.height_m = o.length("diameter", kPositive);
+  } else if (shape == "ellipse") {
+    Obj o(c, j, path, what, {"shape", "width", "height"});
+    d.shape = OutlineDesc::Shape::Ellipse;
+    d.width_m = o.length("width", kPositive);
+    d.height_m = o.length("height", kPositive);
+  } else {
+    Obj o(c, j, path, what, {"shape", "width", "height", "corner_radius"});
+    d.shape = OutlineDesc::Shape::Rectangle;
+    d.width_m = o.length("width", kPositive);
+    d.height_m = o.length("height", kPositive);
+    const double half_min = 0.5 * std::min(d.width_m, d.height_m) / c.unit_m;
+    d.corner_radius_m = o.length("corner_radius", closed(0, half_min), 0.0);
+  }
+  return d;
+}
+
+TessellationDesc readTessellation(const Ctx& c, const json* j, const std::string& path, int default_n) {
+  TessellationDesc t;
+  t.n_u = t.n_v = default_n;
+  if (!j) return t;
+  const std::string what = "a vertex count N in [2, 1024], {\"u\": N, \"v\": M} or {\"tolerance\": length, "
+                           "\"angle_deg\": a}";
+  if (j->is_number()) {
+    t.n_u = t.n_v = readInt(c, j, path, 2, 1024);
+    return t;
+  }
+  Obj o(c, j, path, what, {"u", "v", "tolerance", "angle_deg"});
+  const bool grid = o.has("u") || o.has("v"), adaptive = o.has("tolerance") || o.has("angle_deg");
+  if (grid == adaptive) c.expected(path, what, j);
+  if (grid) {
+    t.n_u = o.integer("u", 2, 1024);
+    t.n_v = o.integer("v", 2, 1024);
+  } else {
+    t.mode = TessellationDesc::Mode::Adaptive;
+    t.chordal_tolerance_m = o.length("tolerance", kPositive);
+    t.angle_tolerance_deg = o.number("angle_deg", leftOpen(0, 90), 5.0, "an angle (degrees)");
+  }
+  return t;
+}
+
+MirrorMaterialDesc readMirrorMaterial(const Ctx& c, const json* j, const std::string& path) {
+  MirrorMaterialDesc m;
+  if (!j) return m;
+  const std::string what = "a mirror material {\"reflectance\": x} | {\"metal\": name} | {\"n\": [r, g, b], "
+                           "\"k\": [r, g, b]}";
+  Obj o(c, j, path, what, {"reflectance", "metal", "n", "k"});
+  const int forms = int(o.has("reflectance")) + int(o.has("metal")) + int(o.has("n") || o.has("k"));
+  if (forms != 1) c.expected(path, "exactly one of {\"reflectance\"}, {\"metal\"} or {\"n\", \"k\"}", j);
+  if (o.has("reflectance")) {
+    m.kind = MirrorMaterialDesc::Kind::Reflectance;
+    m.reflectance = o.number("reflectance", leftOpen(0, 1));
+  } else if (o.has("metal")) {
+    m.kind = MirrorMaterialDesc::Kind::Metal;
+    m.metal = o.choice("metal", metalNames());  // pvrr/optics/material.h
+  } else {
+    m.kind = MirrorMaterialDesc::Kind::Conductor;
+    m.n = o.vec3("n", VecKind::Positive);
+    m.k = o.vec3("k", VecKind::ColourNonNegative);
+  }
+  return m;
+}
+
+LensMaterialDesc readLensMaterial(const Ctx& c, const json* j, const std::string& path) {
+  const std::string what = "a lens material {\"name\": ...} | {\"n_d\": ..., \"V_d\": ...} | "
+                           "{\"sellmeier\": {\"B\": [3], \"C\": [3]}}";
+  Obj o(c, j, path, what, {"name", "n_d", "V_d", "sellmeier", "dispersion"});
+  LensMaterialDesc m;
+  const int forms = int(o.has("name")) + int(o.has("n_d") || o.has("V_d")) + int(o.has("sellmeier"));
+  if (forms != 1)
+    c.expected(path, "exactly one of {\"name\"}, {\"n_d\", \"V_d\"} or {\"sellmeier\"} (plus \"dispersion\")", j);
+  if (o.has("name")) {
+    // The material library (pvrr/optics/material.h) is the catalogue: its names, its n_d and V_d.
+    m.kind = LensMaterialDesc::Kind::Named;
+    m.name = o.choice("name", lensMaterialNames());
+    const Dispersion d = lookupLensMaterial(m.name).dispersion;
+    m.n_d = d.n_d();
+    m.V_d = d.abbe();
+  } else if (o.has("sellmeier")) {
+    m.kind = LensMaterialDesc::Kind::Sellmeier;
+    Obj s(c, o.get("sellmeier"), o.at("sellmeier"), "an object {\"B\": [B1, B2, B3], \"C\": [C1, C2, C3] (um^2)}",
+          {"B", "C"});
+    const Vec3 b = s.vec3("B", VecKind::ColourNonNegative), cc = s.vec3("C", VecKind::ColourNonNegative);
+    for (int i = 0; i < 3; ++i) {
+      m.sellmeier_b[i] = b[i];
+      m.sellmeier_c_um2[i] = cc[i];
+    }
+    const std::string what = "coefficients giving a finite index > 1 with normal dispersion over " +
+                             fmt(kDispersionCheckMin_nm) + ".." + fmt(kDispersionCheckMax_nm) + " nm";
+    try {
+      const Dispersion d = Dispersion::sellmeier(m.sellmeier_b, m.sellmeier_c_um2);
+      m.n_d = d.n_d();
+      m.V_d = d.abbe();
+    } catch (const Error&) {
+      c.expected(s.path(), what, o.get("sellmeier"));
+    }
+    if (!(m.n_d > 1) || !(m.V_d > 0) || !std::isfinite(m.V_d)) c.expected(s.path(), what, o.get("sellmeier"));
+  } else {
+    m.kind = LensMaterialDesc::Kind::Abbe;
+    m.n_d = o.number("n_d", leftOpen(1, 3));
+    m.V_d = o.number("V_d", closed(10, 120));
+  }
+  m.dispersion = o.boolean("dispersion", true);
+  return m;
+}
+
+ElementDesc readElement(const Ctx& c, const json* j, const std::string& path, size_t index) {
+  const std::string what = "an element {\"type\": \"mirror\" | \"lens\", ...}";
+  const std::string type = peekChoice(c, j, path, what, "type", {"mirror", "lens"});
+  std::vector<std::string> keys = {"name", "type", "pose", "attached_to_observer", "outline", "tessellation",
+                                   "patches", "max_patch_fov_deg", "material"};
+  if (type == "mirror") keys.push_back("surface");
+  else keys.insert(keys.end(), {"front", "back", "centre_thickness", "min_edge_thickness", "prescription"});
+  Obj o(c, j, path, what, keys);
+  ElementDesc e;
+  e.type = type == "mirror" ? ElementDesc::Type::Mirror : ElementDesc::Type::Lens;
+  e.name = o.string("name", "element" + std::to_string(index));
+  e.attached_to_observer = o.boolean("attached_to_observer", false);
+
+  {
+    Obj p(c, o.get("pose"), o.at("pose"), "a pose {\"position\", \"normal\", \"up\"}", {"position", "normal", "up"});
+    e.pose.position = p.point("position");
+    e.pose.normal = p.vec3("normal", VecKind::Direction);
+    e.pose.up = p.vec3("up", VecKind::Direction, Vec3(0, 1, 0));
+    const double a = angleBetween(e.pose.up, e.pose.normal);
+    if (a < kParallelAngle_rad || a > kPi - kParallelAngle_rad)
+      p.expected("up", "a direction not parallel to \"normal\"" +
+                           std::string(p.has("up") ? "" : " (the default [0, 1, 0] is parallel here: give one)"));
+  }
+
+  // Surfaces first: whether an outline is required depends on them.
+  bool analytic = true;
+  if (e.type == ElementDesc::Type::Mirror) {
+    e.surface = readSurface(c, o.get("surface"), o.at("surface"), kAllSurfaceTypes);
+    analytic = e.surface.isSag();
+    e.mirror_material = readMirrorMaterial(c, o.get("material"), o.at("material"));
+  } else {
+    if (o.has("prescription") && (o.has("front") || o.has("back")))
+      o.expected("prescription", "either \"prescription\" or \"front\" and \"back\", not both");
+    if (o.has("prescription")) {
+      Obj p(c, o.get("prescription"), o.at("prescription"),
+            "a prescription {\"sphere_d\", \"cylinder_d\", \"axis_deg\", \"base_curve_d\"}",
+            {"sphere_d", "cylinder_d", "axis_deg", "base_curve_d"});
+      PrescriptionDesc rx;
+      rx.sphere_d = p.number("sphere_d", closed(-30, 30), "a power in dioptres");
+      rx.cylinder_d = p.number("cylinder_d", closed(-15, 15), 0.0, "a power in dioptres");
+      rx.axis_deg = p.number("axis_deg", closed(0, 180), 0.0, "an angle (degrees)");
+      if (p.has("base_curve_d")) rx.base_curve_d = p.number("base_curve_d", leftOpen(0, 25), "a power in dioptres");
+      e.prescription = rx;
+    } else {
+      e.front = readSurface(c, o.get("front"), o.at("front"), kLensSurfaceTypes);
+      e.back = readSurface(c, o.get("back"), o.at("back"), kLensSurfaceTypes);
+    }
+    if (!o.has("centre_thickness") && !o.has("min_edge_thickness"))
+      o.expected("centre_thickness", "a length > 0 (or \"min_edge_thickness\")");
+    e.centre_thickness_m = o.length("centre_thickness", kPositive, 0.0);
+    e.min_edge_thickness_m = o.length("min_edge_thickness", kPositive, 0.0);
+    e.lens_material = readLensMaterial(c, o.get("material"), o.at("material"));
+  }
+
+  if (analytic) {
+    e.outline = readOutline(c, o.get("outline"), o.at("outline"));
+    if (e.type == ElementDesc::Type::Mirror) {
+      checkSagReach(c, *o.get("surface"), o.at("surface"), e.surface, *e.outline);
+    } else if (!e.prescription) {
+      checkSagReach(c, *o.get("front"), o.at("front"), e.front, *e.outline);
+      checkSagReach(c, *o.get("back"), o.at("back"), e.back, *e.outline);
+    }
+  } else if (o.has("outline")) {
+    o.expected("outline", std::string("no outline with a \"") + toString(e.surface.type) +
+                              "\" surface (its own boundary is the outline)");
+  }
+
+  e.tessellation = readTessellation(c, o.get("tessellation"), o.at("tessellation"),
+                                    e.type == ElementDesc::Type::Mirror ? 7 : 24);
+  if (const json* p = o.get("patches")) {
+    const bool grid = e.tessellation.mode == TessellationDesc::Mode::Grid;
+    const int max_u = grid ? e.tessellation.n_u - 1 : 1, max_v = grid ? e.tessellation.n_v - 1 : 1;
+    const std::string pwhat = "[pu, pv] with 1 <= pu <= " + std::to_string(max_u) + " and 1 <= pv <= " +
+                              std::to_string(max_v) + (grid ? " (each patch at least one grid cell)"
+                                                             : " (an adaptive tessellation is not split)");
+    if (!p->is_array() || p->size() != 2) o.expected("patches", pwhat);
+    for (int i = 0; i < 2; ++i)
+      if (!(*p)[i].is_number() || (*p)[i].get<double>() != std::floor((*p)[i].get<double>()) ||
+          (*p)[i].get<double>() < 1 || (*p)[i].get<double>() > (i == 0 ? max_u : max_v))
+        o.expected("patches", pwhat);
+    e.patches_u = (*p)[0].get<int>();
+    e.patches_v = (*p)[1].get<int>();
+  }
+  e.max_patch_fov_deg = o.number("max_patch_fov_deg", open(0, 180), 0.0, "an angle (degrees)");
+  return e;
+}
+
+RenderDesc readRender(const Ctx& c, const json* j, const std::string& source) {
+  RenderDesc r;
+  r.output = (fs::path("out") / (fs::path(source).stem().string() + ".png")).string();
+  if (!j) return r;
+  Obj o(c, j, "render", "an object {\"mode\", \"map_size\", \"output\", ...}",
+        {"mode", "map_size", "map_texels_per_pixel", "map_reuse_margin_deg", "impostor_iterations", "impostor_layers", "output",
+         "max_depth", "dispersion", "spectral_samples",
+         "background"});
+  const std::string mode = o.choice("mode", {"pvrr", "raster", "raytrace", "envmap", "impostor"}, "pvrr");
+  r.mode = mode == "pvrr"       ? RenderDesc::Mode::Pvrr
+           : mode == "raster"   ? RenderDesc::Mode::Raster
+           : mode == "raytrace" ? RenderDesc::Mode::Raytrace
+           : mode == "envmap"   ? RenderDesc::Mode::Envmap
+                                : RenderDesc::Mode::Impostor;
+  r.map_size = o.integer("map_size", 16, kMaxImageSize, 1024);
+  r.map_texels_per_pixel = o.number("map_texels_per_pixel", closed(0, 1e4), 4);
+  r.map_reuse_margin_deg = o.number("map_reuse_margin_deg", closed(0, 10), 2);
+  r.impostor_iterations = o.integer("impostor_iterations", 0, 64, 8);
+  r.impostor_layers = o.integer("impostor_layers", 1, 2, 2);
+  if (o.has("output")) {
+    r.output = o.string("output");
+    if (!endsWithAny(r.output, {".png"})) o.expected("output", "a file name ending in \".png\"");
+  }
+  r.max_depth = o.integer("max_depth", 1, 64, 4);
+  const std::string disp = o.choice("dispersion", {"off", "rgb", "spectral"}, "off");
+  r.dispersion = disp == "off" ? RenderDesc::Dispersion::Off
+                 : disp == "rgb" ? RenderDesc::Dispersion::Rgb
+                                 : RenderDesc::Dispersion::Spectral;
+  r.spectral_samples = o.integer("spectral_samples", 3, 256, 16);
+  r.background = o.vec3("background", VecKind::ColourNonNegative, r.background);
+  return r;
+}
+
+SceneDesc readScene(Ctx& c, const json& doc) {
+  Obj top(c, &doc, "", "a JSON object (a scene)",
+          {"version", "units", "description", "observer", "environment", "lights", "elements", "render"});
+  SceneDesc s;
+  {
+    const json* v = top.get("version");
+    if (!v || !v->is_number() || v->get<double>() != 1)
+      top.expected("version", "1 (the only scene format version this pvrr reads)");
+  }
+  s.units = top.choice("units", {"m", "mm"}, "m");
+  s.unit_m = s.units == "mm" ? 1e-3 : 1.0;
+  c.units = s.units;
+  c.unit_m = s.unit_m;
+  s.source = c.file;
+  s.base_dir = c.base_dir;
+  if (top.has("description") && !top.get("description")->is_string()) top.expected("description", "a string");
+  s.description = top.has("description") ? top.get("description")->get<std::string>() : "";
+  s.observer = readObserver(c, top.get("observer"));
+
+  if (const json* env = arrayAt(c, top.get("environment"), "environment", "an array of environment objects"))
+    for (size_t i = 0; i < env->size(); ++i)
+      s.environment.push_back(readEnvObject(c, &(*env)[i], indexPath("environment", i), i));
+
+  if (const json* lights = arrayAt(c, top.get("lights"), "lights", "an array of lights")) {
+    for (size_t i = 0; i < lights->size(); ++i) s.lights.push_back(readLight(c, &(*lights)[i], indexPath("lights", i)));
+    // The raster shaders hold each kind in a uniform array (shaders/shading.glsl).
+    size_t dir = 0, point = 0;
+    for (const LightDesc& l : s.lights) {
+      dir += l.type == LightDesc::Type::Directional;
+      point += l.type == LightDesc::Type::Point;
+    }
+    if (dir > kMaxLightsPerKind || point > kMaxLightsPerKind)
+      c.fail("lights", "expected at most " + std::to_string(kMaxLightsPerKind) + " directional and " +
+                           std::to_string(kMaxLightsPerKind) + " point lights, got " + std::to_string(dir) +
+                           " directional and " + std::to_string(point) + " point");
+  } else {
+    s.lights.push_back(LightDesc{});  // no "lights": ambient white, intensity 1 (albedo shown as is)
+  }
+
+  if (const json* els = arrayAt(c, top.get("elements"), "elements", "an array of elements")) {
+    std::set<std::string> names;
+    for (size_t i = 0; i < els->size(); ++i) {
+      const std::string path = indexPath("elements", i);
+      s.elements.push_back(readElement(c, &(*els)[i], path, i));
+      if (!names.insert(s.elements.back().name).second)
+        c.expected(childPath(path, "name"), "a name no other element has (names default to \"element<index>\")",
+                   (*els)[i].contains("name") ? &(*els)[i]["name"] : nullptr);
+    }
+  }
+  s.render = readRender(c, top.get("render"), c.file);
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Syntax pass: a SAX walk that reports syntax errors and non-finite numbers with line:column and the JSON
+// path, and duplicate keys (which nlohmann would silently collapse to the last one).
+
+std::pair<size_t, size_t> lineColumn(const std::string& text, size_t position) {
+  // position: characters read so far, i.e. the 1-based index of the last character read.
+  const size_t last = std::min(position == 0 ? 0 : position - 1, text.size());
+  size_t line = 1, line_start = 0;
+  for (size_t i = 0; i < last; ++i)
+    if (text[i] == '\n') {
+      ++line;
+      line_start = i + 1;
+    }
+  return {line, last - line_start + 1};
+}
+
+class SyntaxCheck : public nlohmann::json_sax<json> {
+ public:
+  SyntaxCheck(const std::string& text, const std::string& file) : text_(text), file_(file) {}
+  std::string error;
+
+  bool null() override { return value(); }
+  bool boolean(bool) override { return value(); }
+  bool number_integer(number_integer_t) override { return value(); }
+  bool number_unsigned(number_unsigned_t) override { return value(); }
+  bool number_float(number_float_t, const string_t&) override { return value(); }
+  bool string(string_t&) override { return value(); }
+  bool binary(binary_t&) override { return value(); }
+  bool start_object(std::size_t) override {
+    frames_.push_back(Frame{false, {}, 0, {}});
+    return true;
+  }
+  bool key(string_t& k) override {
+    Frame& f = frames_.back();
+    f.key = k;
+    if (!f.keys.insert(k).second) {
+      error = file_ + ": " + path() + ": expected each key once in an object, got " + inQuotes(k) + " twice";
+      return false;
+    }
+    return true;
+  }
+  bool end_object() override {
+    frames_.pop_back();
+    return value();
+  }
+  bool start_array(std::size_t) override {
+    frames_.push_back(Frame{true, {}, 0, {}});
+    return true;
+  }
+  bool end_array() override {
+    frames_.pop_back();
+    return value();
+  }
+  bool parse_error(std::size_t position, const std::string& last_token, const nlohmann::detail::exception& ex) override {
+    const auto [line, col] = lineColumn(text_, position);
+    const std::string where = file_ + ":" + std::to_string(line) + ":" + std::to_string(col) + ": ";
+    if (ex.id == 406) {  // out_of_range.406: a number literal beyond double range (e.g. 1e999)
+      error = where + path() + ": expected a finite number, got " + last_token;
+      return false;
+    }
+    std::string reason = ex.what();
+    const size_t col_pos = reason.find("column ");
+    const size_t colon = col_pos == std::string::npos ? std::string::npos : reason.find(": ", col_pos);
+    if (colon != std::string::npos) reason = reason.substr(colon + 2);
+    error = where + reason;
+    return false;
+  }
+
+ private:
+  struct Frame {
+    bool array;
+    std::string key;
+    size_t index;
+    std::set<std::string> keys;
+  };
+  bool value() {
+    if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
+    return true;
+  }
+  std::string path() const {
+    std::string p;
+    for (const Frame& f : frames_) p = f.array ? indexPath(p, f.index) : childPath(p, f.key);
+    return p.empty() ? "(top level)" : p;
+  }
+  const std::string& text_;
+  const std::string& file_;
+  std::vector<Frame> frames_;
+};
+
+json parseJson(const std::string& text, const std::string& file) {
+  SyntaxCheck check(text, file);
+  if (!json::sax_parse(text, &check) || !check.error.empty())
+    throw Error(check.error.empty() ? file + ": not a JSON document" : check.error);
+  return json::parse(text);
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// --set overrides
+
+struct Segment {
+  bool is_index = false;
+  std::string key;
+  size_t index = 0;
+};
+
+Override applyOverride(json& doc, const std::string& text, const std::string& file) {
+  const std::string prefix = file + ": --set " + text + ": ";
+  const size_t eq = text.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw Error(prefix + "expected PATH=VALUE (e.g. render.map_size=512), got " + inQuotes(text));
+  const std::string path_text = text.substr(0, eq), value_text = text.substr(eq + 1);
+  std::vector<Segment> segs;
+  const auto bad_path = [&]() -> Error {
+    return Error(prefix + "expected a path like elements[0].pose.position, got " + inQuotes(path_text));
+  };
+  size_t i = 0;
+  while (i < path_text.size()) {
+    if (path_text[i] == '[') {
+      const size_t close = path_text.find(']', i);
+      if (close == std::string::npos || close == i + 1) throw bad_path();
+      const std::string digits = path_text.substr(i + 1, close - i - 1);
+      if (digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 9) throw bad_path();
+      segs.push_back(Segment{true, {}, static_cast<size_t>(std::stoul(digits))});
+      i = close + 1;
+      if (i < path_text.size() && path_text[i] == '.') {
+        ++i;
+        if (i == path_text.size()) throw bad_path();
+      }
+    } else {
+      const size_t end = path_text.find_first_of(".[", i);
+      const std::string key = path_text.substr(i, end == std::string::npos ? std::string::npos : end - i);
+      if (key.empty()) throw bad_path();
+      segs.push_back(Segment{false, key, 0});
+      i = end == std::string::npos ? path_text.size() : end;
+      if (i < path_text.size() && path_text[i] == '.') {
+        ++i;
+        if (i == path_text.size()) throw bad_path();
+      }
+    }
+  }
+  if (segs.empty() || segs.front().is_index) throw bad_path();
+
+  json value;
+  try {
+    value = json::parse(value_text);
+  } catch (const json::exception&) {
+    value = value_text;  // not JSON: a string (render.mode=raster)
+  }
+
+  json* cur = &doc;
+  std::string so_far;
+  for (const Segment& s : segs) {
+    if (s.is_index) {
+      if (!cur->is_array())
+        throw Error(prefix + so_far + ": expected an array to index, got " + show(cur->is_null() ? nullptr : cur));
+      if (s.index >= cur->size())
+        throw Error(prefix + indexPath(so_far, s.index) + ": expected an index < " + std::to_string(cur->size()) +
+                    " (" + so_far + " has " + std::to_string(cur->size()) + " entries), got " + std::to_string(s.index));
+      so_far = indexPath(so_far, s.index);
+      cur = &(*cur)[s.index];
+    } else {
+      if (cur->is_null()) *cur = json::object();  // a section the file leaves out (e.g. "render")
+      if (!cur->is_object())
+        throw Error(prefix + (so_far.empty() ? "(top level)" : so_far) + ": expected an object to hold " +
+                    inQuotes(s.key) + ", got " + show(cur));
+      so_far = childPath(so_far, s.key);
+      cur = &(*cur)[s.key];
+    }
+  }
+  *cur = value;
+  return Override{so_far, text};
+}
+
+}  // namespace
+
+// -----------------------------------------------------------------------------------------------------------
+
+int editDistance(const std::string& a, const std::string& b) {
+  const size_t n = a.size(), m = b.size();
+  std::vector<std::vector<int>> d(n + 1, std::vector<int>(m + 1));
+  for (size_t i = 0; i <= n; ++i) d[i][0] = static_cast<int>(i);
+  for (size_t j = 0; j <= m; ++j) d[0][j] = static_cast<int>(j);
+  for (size_t i = 1; i <= n; ++i) {
+    for (size_t j = 1; j <= m; ++j) {
+      const int cost = a[i - 1] == b[j - 1] ? 0 : 1;
+      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + cost});
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+    }
+  }
+  return d[n][m];
+}
+
+SceneDesc parseScene(const std::string& json_text, const std::string& name_for_messages, const std::string& base_dir,
+                     const std::vector<std::string>& set_overrides) {
+  Ctx c;
+  c.file = name_for_messages;
+  c.base_dir = base_dir;
+  json doc = parseJson(json_text, name_for_messages);
+  for (const std::string& o : set_overrides) c.overrides.push_back(applyOverride(doc, o, name_for_messages));
+  return readScene(c, doc);
+}
+
+SceneDesc loadScene(const std::string& path, const std::vector<std::string>& set_overrides) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path + ": cannot open the scene file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw Error(path + ": cannot read the scene file");
+  const std::string dir = fs::path(path).parent_path().string();
+  return parseScene(ss.str(), path, dir, set_overrides);
+}
+
+const char* toString(TextureDesc::Kind k) {
+  switch (k) {
+    case TextureDesc::Kind::Image: return "image";
+    case TextureDesc::Kind::Checker: return "checker";
+    case TextureDesc::Kind::EyeChart: return "eye-chart";
+    case TextureDesc::Kind::Page: return "page";
+    case TextureDesc::Kind::Bricks: return "bricks";
+    case TextureDesc::Kind::Road: return "road";
+    case TextureDesc::Kind::Windows: return "windows";
+    case TextureDesc::Kind::Sky: return "sky";
+    case TextureDesc::Kind::Sign: return "sign";
+  }
+  return "?";
+}
+const char* toString(EnvObjectDesc::Type t) {
+  switch (t) {
+    case EnvObjectDesc::Type::Mesh: return "mesh";
+    case EnvObjectDesc::Type::Ground: return "ground";
+    case EnvObjectDesc::Type::Box: return "box";
+    case EnvObjectDesc::Type::Sphere: return "sphere";
+    case EnvObjectDesc::Type::Quad: return "quad";
+  }
+  return "?";
+}
+const char* toString(LightDesc::Type t) {
+  switch (t) {
+    case LightDesc::Type::Directional: return "directional";
+    case LightDesc::Type::Point: return "point";
+    case LightDesc::Type::Ambient: return "ambient";
+  }
+  return "?";
+}
+const char* toString(SurfaceDesc::Type t) {
+  switch (t) {
+    case SurfaceDesc::Type::Plane: return "plane";
+    case SurfaceDesc::Type::Sphere: return "sphere";
+    case SurfaceDesc::Type::Asphere: return "asphere";
+    case SurfaceDesc::Type::Toric: return "toric";
+    case SurfaceDesc::Type::Cylinder: return "cylinder";
+    case SurfaceDesc::Type::Cad: return "cad";
+    case SurfaceDesc::Type::Subdivision: return "subdivision";
+  }
+  return "?";
+}
+const char* toString(OutlineDesc::Shape s) {
+  switch (s) {
+    case OutlineDesc::Shape::Rectangle: return "rectangle";
+    case OutlineDesc::Shape::Ellipse: return "ellipse";
+    case OutlineDesc::Shape::Circle: return "circle";
+  }
+  return "?";
+}
+const char* toString(ElementDesc::Type t) { return t == ElementDesc::Type::Mirror ? "mirror" : "lens"; }
+const char* toString(RenderDesc::Mode m) {
+  switch (m) {
+    case RenderDesc::Mode::Pvrr: return "pvrr";
+    case RenderDesc::Mode::Raster: return "raster";
+    case RenderDesc::Mode::Raytrace: return "raytrace";
+    case RenderDesc::Mode::Envmap: return "envmap";
+    case RenderDesc::Mode::Impostor: return "impostor";
+  }
+  return "?";
+}
+const char* toString(RenderDesc::Dispersion d) {
+  switch (d) {
+    case RenderDesc::Dispersion::Off: return "off";
+    case RenderDesc::Dispersion::Rgb: return "rgb";
+    case RenderDesc::Dispersion::Spectral: return "spectral";
+  }
+  return "?";
+}
+
+}  // namespace pvrr

@@ -1,0 +1,17 @@
+// The environment shading model, shared by the reference tracer (this code) and the raster path
+// (shaders/shading.glsl implements the same formulas; keep them in step).
+//
+//   colour = albedo(uv) * ( sum ambient  +  sum_directional max(0, n.(-dir)) L  +  sum_point max(0, n.l) L / d^2 )
+//
+// n is the geometric normal turned towards the viewer (two-sided). No shadows: the raster path has none,
+// and the reference must differ from it only in geometry. Colours are linear RGB; textures are decoded
+// from sRGB before bilinear filtering with repeat wrapping (what GL does for GL_SRGB8 + GL_LINEAR).
+#pragma once
+#include "pvrr/scene/scene.h"
+
+namespace pvrr {
+
+Vec3 sampleTexture(const Texture& t, Vec2 uv);
+Vec3 shadeDiffuse(const Scene& scene, const DiffuseMaterial& m, const Vec3& p, const Vec3& n_facing, Vec2 uv);
+
+}  // namespace pvrr

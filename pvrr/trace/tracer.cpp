@@ -1,0 +1,285 @@
+#include "pvrr/trace/tracer.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <xmmintrin.h>
+#include <pmmintrin.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <mutex>
+
+#include "pvrr/base/error.h"
+#include "pvrr/optics/optics.h"
+#include "pvrr/trace/shading.h"
+#include "pvrr/optics/spectrum.h"
+
+namespace pvrr {
+
+DispersionMode parseDispersionMode(const std::string& s) {
+  if (s == "off") return DispersionMode::Off;
+  if (s == "rgb") return DispersionMode::Rgb;
+  if (s == "spectral") return DispersionMode::Spectral;
+  throw Error("dispersion: expected one of off, rgb, spectral; got \"" + s + "\"");
+}
+
+Tracer::Tracer(const RayScene& rays, TraceOptions options)
+    : rays_(rays), scene_(rays.scene()), options_(options) {
+  if (options_.dispersion == DispersionMode::Spectral) spectral_ = spectralSamples(options_.spectral_samples);
+}
+
+namespace {
+
+// Colour of the dark back of a mirror (its housing), the same constant as the raster path's.
+constexpr double kMirrorBackAlbedo = 0.05;
+
+double lensIndex(const Element& el, double wavelength_nm) {
+  return el.dispersion.index(wavelength_nm > 0 ? wavelength_nm : kLineD_nm);
+}
+
+}  // namespace
+
+TraceResult Tracer::trace(const Vec3& o, const Vec3& d, double wavelength_nm,
+                          std::vector<PathSegment>* path) const {
+  return traceImpl(o, d, wavelength_nm, path, nullptr, false);
+}
+
+TraceResult Tracer::traceImpl(const Vec3& o_in, const Vec3& d_in, double wavelength_nm,
+                              std::vector<PathSegment>* path, const RayHit* first, bool metal_spectral) const {
+  TraceResult r;
+  Vec3 o = o_in, d = glm::normalize(d_in);
+  Vec3 throughput(1.0);
+  int inside = -1;  // the lens element the ray is inside, or -1
+  double t_min = 0;
+  const double eps = rays_.epsilon();
+  for (int depth = 0;; ++depth) {
+    RayHit hit;
+    if (depth == 0 && first)
+      hit = *first;
+    else if (inside < 0)
+      hit = rays_.intersect(o, d, t_min);
+    if (inside >= 0) {
+      // Inside a lens: the next event is on one of its own surfaces.
+      RayHit back = rays_.intersectElementSurface(inside, 1, o, d, t_min);
+      RayHit front = rays_.intersectElementSurface(inside, 0, o, d, t_min);
+      hit = back.t <= front.t ? back : front;
+      if (!hit.hit()) {
+        // Leaving through the lens's edge band, which is not modelled as a surface: absorbed.
+        if (path) path->push_back({o, d, "absorb", inside, false, {}, {}, 1, 1});
+        r.color = Vec3(0);
+        r.seen = o + scene_.render.far_distance_m * d;
+        r.escaped = true;
+        return r;
+      }
+    }
+    PathSegment seg;
+    seg.origin = o;
+    seg.direction = d;
+    if (!hit.hit()) {
+      r.escaped = true;
+      r.seen = o + scene_.render.far_distance_m * d;
+      r.color = throughput * scene_.render.background;
+      seg.event = "escape";
+      if (path) path->push_back(seg);
+      return r;
+    }
+    seg.has_point = true;
+    seg.point = hit.point;
+    seg.normal = hit.normal;
+    if (hit.kind == HitKind::Environment) {
+      const EnvMesh& mesh = scene_.meshes[size_t(hit.mesh)];
+      Vec3 n = glm::dot(hit.normal, d) > 0 ? -hit.normal : hit.normal;
+      r.color = throughput * shadeDiffuse(scene_, scene_.materials[size_t(mesh.material)], hit.point, n, hit.uv);
+      r.seen = hit.point;
+      seg.event = "diffuse";
+      if (path) path->push_back(seg);
+      return r;
+    }
+    // An optical element.
+    const Element& el = scene_.elements[size_t(hit.element)];
+    seg.element = hit.element;
+    if (r.first_element < 0) {
+      r.first_element = hit.element;
+      r.element_point = hit.point;
+    }
+    if (depth >= options_.max_depth) {
+      seg.event = "absorb";
+      if (path) path->push_back(seg);
+      r.color = Vec3(0);
+      r.seen = hit.point;
+      return r;
+    }
+    const double cos_i = -glm::dot(d, hit.normal);
+    if (el.type == ElementType::Mirror) {
+      if (cos_i <= 0) {
+        // The mirror's back: dark diffuse.
+        seg.event = "diffuse";
+        if (path) path->push_back(seg);
+        r.color = throughput * kMirrorBackAlbedo * shadeDiffuse(scene_, DiffuseMaterial{Vec3(1.0), -1}, hit.point,
+                                                                -hit.normal, Vec2(0));
+        r.seen = hit.point;
+        return r;
+      }
+      Vec3 refl = el.mirror.reflectance;
+      if (el.mirror.metal) {
+        if (el.mirror.metal_table) r.hit_metal = true;
+        if (metal_spectral && el.mirror.metal_table) {
+          const ComplexIndex nk = el.mirror.metal_table->index(wavelength_nm > 0 ? wavelength_nm : kLineD_nm);
+          refl = Vec3(fresnelConductor(cos_i, 1.0, nk.n, nk.k));
+        } else {
+          for (int c = 0; c < 3; ++c) refl[c] = fresnelConductor(cos_i, 1.0, el.mirror.n[c], el.mirror.k[c]);
+        }
+      }
+      throughput *= refl;
+      seg.event = "reflect";
+      if (path) path->push_back(seg);
+      o = hit.point;
+      d = reflect(d, hit.normal);
+      t_min = eps;
+      ++r.bounces;
+      continue;
+    }
+    // Lens interface.
+    r.hit_lens = true;
+    const double n_glass = lensIndex(el, wavelength_nm);
+    const bool entering = inside < 0;
+    const double n1 = entering ? 1.0 : n_glass;
+    const double n2 = entering ? n_glass : 1.0;
+    Refraction rf = refract(d, hit.normal, n1, n2);
+    seg.n1 = n1;
+    seg.n2 = n2;
+    ++r.bounces;
+    o = hit.point;
+    t_min = eps;
+    if (rf.tir) {
+      seg.event = "tir";
+      if (path) path->push_back(seg);
+      d = reflect(d, hit.normal);
+      continue;
+    }
+    seg.event = "refract";
+    if (path) path->push_back(seg);
+    throughput *= 1.0 - fresnelDielectric(std::abs(cos_i), n1, n2);
+    d = rf.direction;
+    inside = entering ? hit.element : -1;
+  }
+}
+
+TraceResult Tracer::tracePixel(double px, double py) const {
+  return tracePrimary(scene_.observer.pixelDirection(px, py), nullptr, nullptr);
+}
+
+TraceResult Tracer::tracePrimary(const Vec3& d, const RayHit* first, std::array<Vec3, 3>* channel_seen) const {
+  const Vec3& eye = scene_.observer.eye;
+  // The primary hit does not depend on the wavelength: every trace below reuses `first`.
+  switch (options_.dispersion) {
+    case DispersionMode::Off:
+      return traceImpl(eye, d, 0, nullptr, first, false);
+    case DispersionMode::Rgb: {
+      const double* wl = kRgbWavelengths_nm;
+      TraceResult g = traceImpl(eye, d, wl[1], nullptr, first, false);
+      // Without any lens on the path the three channels follow the same path: skip the other two.
+      if (!g.hit_lens) {
+        if (channel_seen) *channel_seen = {g.seen, g.seen, g.seen};
+        return g;
+      }
+      TraceResult rr = traceImpl(eye, d, wl[0], nullptr, first, false);
+      TraceResult bb = traceImpl(eye, d, wl[2], nullptr, first, false);
+      if (channel_seen) *channel_seen = {rr.seen, g.seen, bb.seen};
+      g.color = Vec3(rr.color.r, g.color.g, bb.color.b);
+      return g;
+    }
+    case DispersionMode::Spectral: {
+      TraceResult centre = traceImpl(eye, d, 0, nullptr, first, false);
+      // Only lenses (the path) and tabulated metals (the reflectance) depend on the wavelength.
+      if (!centre.hit_lens && !centre.hit_metal) return centre;
+      Vec3 sum(0.0);
+      for (const SpectralSample& s : spectral_)
+        sum += s.rgb_weight * traceImpl(eye, d, s.wavelength_nm, nullptr, first, true).color;
+      centre.color = sum;
+      return centre;
+    }
+  }
+  return {};
+}
+
+namespace {
+
+// Primary rays are traced in square tiles of kTile x kTile pixels, one Embree packet each.
+constexpr int kTile = 4;
+static_assert(kTile * kTile == RayScene::kPacketSize, "one packet per tile");
+
+}  // namespace
+
+TracedFrame Tracer::render(const std::function<void(double)>& progress) const {
+  const int w = scene_.observer.width, h = scene_.observer.height;
+  TracedFrame f;
+  f.width = w;
+  f.height = h;
+  const size_t n = size_t(w) * size_t(h);
+  f.color.resize(n);
+  f.seen.resize(n);
+  f.element.resize(n);
+  f.element_point.resize(n);
+  f.bounces.resize(n);
+  const bool rgb = options_.dispersion == DispersionMode::Rgb;
+  if (rgb)
+    for (auto& c : f.channel_seen) c.resize(n);
+  auto start = std::chrono::steady_clock::now();
+  std::atomic<int> rows_done{0};
+  std::mutex progress_mutex;
+  const Vec3 eye = scene_.observer.eye;
+  // Bands of kTile rows; each band is cut into kTile x kTile tiles.
+  const int bands = (h + kTile - 1) / kTile;
+  tbb::parallel_for(tbb::blocked_range<int>(0, bands, 1), [&](const tbb::blocked_range<int>& range) {
+    // Denormals only slow the traversal down; flush them in every tracing thread (Embree's advice).
+    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+    std::array<Vec3, RayScene::kPacketSize> origins, dirs, units;
+    std::array<RayHit, RayScene::kPacketSize> hits;
+    std::array<int, RayScene::kPacketSize> px, py;
+    origins.fill(eye);
+    int rows = 0;
+    for (int band = range.begin(); band < range.end(); ++band) {
+      const int y0 = band * kTile, y1 = std::min(h, y0 + kTile);
+      rows += y1 - y0;
+      for (int x0 = 0; x0 < w; x0 += kTile) {
+        const int x1 = std::min(w, x0 + kTile);
+        int count = 0;
+        for (int y = y0; y < y1; ++y)
+          for (int x = x0; x < x1; ++x) {
+            px[size_t(count)] = x;
+            py[size_t(count)] = y;
+            dirs[size_t(count)] = scene_.observer.pixelDirection(x + 0.5, y + 0.5);
+            // The direction traceImpl() will trace (it normalises), so that the hit is the same.
+            units[size_t(count)] = glm::normalize(dirs[size_t(count)]);
+            ++count;
+          }
+        if (options_.primary_packets) rays_.intersectPacket(origins.data(), units.data(), count, hits.data());
+        for (int k = 0; k < count; ++k) {
+          std::array<Vec3, 3> cs;
+          TraceResult r = tracePrimary(dirs[size_t(k)], options_.primary_packets ? &hits[size_t(k)] : nullptr,
+                                       rgb ? &cs : nullptr);
+          const size_t i = size_t(py[size_t(k)]) * size_t(w) + size_t(px[size_t(k)]);
+          f.color[i] = r.color;
+          f.seen[i] = r.seen;
+          f.element[i] = r.first_element;
+          f.element_point[i] = r.element_point;
+          f.bounces[i] = r.bounces;
+          if (rgb)
+            for (size_t c = 0; c < 3; ++c) f.channel_seen[c][i] = cs[c];
+        }
+      }
+    }
+    int done = rows_done.fetch_add(rows) + rows;
+    if (progress && progress_mutex.try_lock()) {
+      progress(double(done) / h);
+      progress_mutex.unlock();
+    }
+  });
+  f.frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return f;
+}
+
+}  // namespace pvrr
