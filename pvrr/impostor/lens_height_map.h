@@ -1,6 +1,6 @@
-// Refractor height maps of a lens for the distance-impostor glass mode (`--mode impostor`; Dancsik and
-// Minarik's refractor height maps, seeds 000, in place of the refractor cube map of Szirmay-Kalos et al., seeds
-// 003, whose samples a thin lens's centre sees at grazing angles).
+// Refractor height maps of a lens for the distance-impostor glass mode (`--mode impostor`; the refractor height
+// maps of [Dancsik and Minarik], in place of the refractor cube map of [Szirmay-Kalos et al.], whose samples a
+// thin lens's centre sees at grazing angles).
 //
 // A lens's two surfaces are sag graphs over its local xy plane (cad/sag.h): z = z_vertex - Z(x, y). Each map
 // samples one surface on a regular grid of texel centres over the outline's bounding box, widened by

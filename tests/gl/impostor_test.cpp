@@ -3,7 +3,7 @@
 // distances) and lenses (the ray refracted through the lens's refractor height maps, then searched).
 //
 // Closed form: a plane mirror and a planar environment. There the search's planar-surface step is exact
-// (seeds 003, 2.1), so the impostor sees what the tracer sees to the resolution of the cube maps, everywhere
+// ([Szirmay-Kalos et al.], 2.1), so the impostor sees what the tracer sees to the resolution of the cube maps, everywhere
 // but where the mirror shows something its cube-map centre cannot see.
 #include <gtest/gtest.h>
 
@@ -192,8 +192,8 @@ TEST_P(ImpostorTest, SearchStepsConvergeAtDepthEdges) {
   EXPECT_LT(10 * p95[1], p95[0]);
 }
 
-// Layered distance maps (seeds 001): the car's own door, 0.3 m from the car mirror, hides part of the street
-// from the mirror's centre, the cube's origin, that the mirror's edge sees (seeds 003, Fig. 6). With one layer
+// Layered distance maps ([Umenhoffer et al.]): the car's own door, 0.3 m from the car mirror, hides part of the street
+// from the mirror's centre, the cube's origin, that the mirror's edge sees ([Szirmay-Kalos et al.], Fig. 6). With one layer
 // the search ends on the door's edge there; the second, depth-peeled layer holds the street behind the door.
 // Measured at 320 x 240 with 512^2 faces: one layer p95 43.5', p99 5634'; two 0.32' and 5.5' (no peeling in
 // the second layer: 1.4' and 271'). The same with a second mirror under the road, out of sight, so that the
@@ -565,7 +565,7 @@ void expectNested(const gl::RasterFrame& f, int count, const std::string& phrase
 // Mirrors in each other's cubes (models/mirror-pair.json): the back-wall mirror seen in the convex mirror, the
 // convex mirror again in that, down to render.max_depth = 4. Each element's cubes show the other mirror with
 // its exact surface point and normal; a search that meets it reflects there (the mirror's Fresnel) and goes on
-// in that mirror's cubes (seeds 000 and 001). Before, the cubes held the room only: median 7473' over the
+// in that mirror's cubes ([Dancsik and Minarik] and 001). Before, the cubes held the room only: median 7473' over the
 // convex mirror. Measured at 320 x 240 with 512^2 faces: median 0.0011' and p90 0.18' over the 3560 pixels
 // that meet two mirrors or more (pvrr's nested maps: 1.2' at 160 x 120), colour within 1.2 % of the tracer's;
 // 16 pixels of 76,800 where the tracer sees a mirror and the impostor does not (rims).
