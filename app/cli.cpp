@@ -8,6 +8,7 @@
 
 #include "app/args.h"
 #include "app/commands.h"
+#include "pvrr/base/atomic_file.h"
 #include "pvrr/base/error.h"
 
 namespace pvrr::app {
@@ -103,7 +104,11 @@ int runMain(int argc, char** argv) {
       throw Error("pvrr: unknown command \"" + args[0] + "\"" + (hint.empty() ? "" : "; did you mean \"" + hint + "\"?") +
                   " (see: pvrr help)");
     }
-    return it->second.run(std::vector<std::string>(args.begin() + 1, args.end()));
+    // Every file the command writes appears when it succeeds, none when it fails at any point.
+    OutputTransaction outputs;
+    const int rc = it->second.run(std::vector<std::string>(args.begin() + 1, args.end()));
+    if (rc == 0) outputs.commit();
+    return rc;
   } catch (const Error& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return 1;

@@ -52,10 +52,7 @@ size_t writeLinearPng(const std::string& path, int width, int height, const std:
       uint8_t* p = img.at(x, y);
       for (int k = 0; k < 3; ++k) p[k] = linearToSrgb8(std::clamp(c[k], 0.0, 1.0));
     }
-  const fs::path target(path);
-  std::error_code ec;
-  if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
-  writePngAtomic(path, img);
+  writePngAtomic(path, img, MissingFolder::Create);
   return bad;
 }
 

@@ -147,7 +147,7 @@ ImageRGB8 readPng(const std::string& path) {
   return image;
 }
 
-void writePngAtomic(const std::string& path, const ImageRGB8& image) {
+void writePngAtomic(const std::string& path, const ImageRGB8& image, MissingFolder folder) {
   checkShape(image.width, image.height, image.rgb.size(), "writePngAtomic");
   if (image.width == 0 || image.height == 0) {
     throw Error(path + ": cannot write an empty (" + sizeLabel(image.width, image.height) + ") PNG");
@@ -174,7 +174,7 @@ void writePngAtomic(const std::string& path, const ImageRGB8& image) {
           throw Error(path + ": writing the PNG failed: " + reason);
         }
       },
-      MissingFolder::Fail);
+      folder);
 }
 
 ImageDiff compareImages(const ImageRGB8& a, const ImageRGB8& b, double per_pixel_tolerance) {

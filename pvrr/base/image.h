@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "pvrr/base/atomic_file.h"
+
 namespace pvrr {
 
 // 8 bits per channel, sRGB-encoded (what PNG files and RGBA8 framebuffers hold).
@@ -52,11 +54,10 @@ ImageRGB8 rgbFromRgba(int width, int height, const std::vector<std::uint8_t>& rg
 // pvrr::Error naming the path and libpng's reason on failure.
 ImageRGB8 readPng(const std::string& path);
 
-// Writes `image` to `path` atomically: the PNG is written to "<path>.tmp-XXXXXX" in the same folder and renamed
-// onto `path` only when complete, so `path` is never seen half-written. On any failure the temporary file is
-// removed and pvrr::Error (naming the path and the reason) is thrown; `path` is left as it was. The new file has
-// mode 0644. The data is not fsync'ed: atomic against readers and failures, not against power loss.
-void writePngAtomic(const std::string& path, const ImageRGB8& image);
+// Writes `image` to `path` atomically (pvrr/base/atomic_file.h: a temporary beside it, renamed onto it when
+// complete, or kept for the command's OutputTransaction). On any failure pvrr::Error names the path and the reason
+// and `path` is left as it was. A missing folder is an error unless `folder` says to create it.
+void writePngAtomic(const std::string& path, const ImageRGB8& image, MissingFolder folder = MissingFolder::Fail);
 
 // How two images of the same size differ. For RGB8 differences are in code values (0..255), for float images in
 // the images' own units. max_abs: the largest difference of any channel of any pixel. mean_abs: the mean over all

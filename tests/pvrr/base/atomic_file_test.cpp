@@ -90,5 +90,58 @@ TEST(AtomicFile, FailedRenameNamesTheTargetAndRemovesTheTemporary) {
   EXPECT_TRUE(fs::is_directory(target));
 }
 
+TEST(OutputTransaction, OutputsAppearTogetherOnCommit) {
+  TempDir dir;
+  const fs::path a = dir.path() / "a.txt", b = dir.path() / "sub" / "b.txt";
+  {
+    OutputTransaction outputs;
+    writeFileAtomic(a.string(), "first");
+    writeFileAtomic(a.string(), "A");  // written again: the later content wins, one temporary kept
+    {
+      OutputTransaction inner;  // joins the outer one
+      writeFileAtomic(b.string(), "B");
+      inner.commit();
+    }
+    EXPECT_FALSE(fs::exists(a)) << "an output appeared before the command committed";
+    EXPECT_FALSE(fs::exists(b));
+    outputs.commit();
+  }
+  EXPECT_EQ(slurp(a), "A");
+  EXPECT_EQ(slurp(b), "B");
+  EXPECT_EQ(dir.entries(), 2u);  // a.txt and sub/, no temporaries
+}
+
+TEST(OutputTransaction, FailureLeavesNoneAndTheOldFilesUnchanged) {
+  TempDir dir;
+  const fs::path old = dir.path() / "a.txt";
+  std::ofstream(old) << "old";
+  {
+    OutputTransaction outputs;
+    writeFileAtomic(old.string(), "new");
+    writeFileAtomic((dir.path() / "made" / "deep" / "b.txt").string(), "B");
+    // the command fails here: no commit
+  }
+  EXPECT_EQ(slurp(old), "old");
+  EXPECT_EQ(dir.entries(), 1u) << "a temporary or a folder made for the outputs was left";
+}
+
+TEST(OutputTransaction, TargetInTheWayRenamesNothing) {
+  TempDir dir;
+  const fs::path a = dir.path() / "a.txt", blocked = dir.path() / "b.txt";
+  fs::create_directory(blocked);
+  std::ofstream(blocked / "keep") << "x";
+  OutputTransaction outputs;
+  writeFileAtomic(a.string(), "A");
+  writeFileAtomic(blocked.string(), "B");
+  try {
+    outputs.commit();
+    FAIL() << "commit onto a folder succeeded";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(blocked.string()), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(a)) << "an earlier output appeared although a later one failed";
+  EXPECT_EQ(dir.entries(), 1u);
+}
+
 }  // namespace
 }  // namespace pvrr
