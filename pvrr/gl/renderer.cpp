@@ -18,6 +18,7 @@
 #include "pvrr/format.h"
 #include "pvrr/lens_height_map.h"
 #include "pvrr/map_footprint.h"
+#include "pvrr/pass_plan.h"
 #include "pvrr/surface_map.h"
 #include "pvrr/spectrum.h"
 
@@ -189,40 +190,7 @@ Program makeProgram(const std::string& vert, const std::string& frag, const std:
 const std::vector<int> kElementLayout = {3, 3, 3, 3, 3, 3, 3, 3, 3, 4, 3};
 constexpr size_t kElementFloats = 34;
 
-// At most this many first passes per frame (top-level and nested): each holds a size^2 colour, seen-point
-// and depth target. Elements that would need more are drawn dark in their map, and the stats say so.
-constexpr size_t kMaxFirstPasses = 16;
-
-// The map size of an element seen in a map of size `parent`: half of it, at least 128 texels (for both the
-// texture and the side rendered). A nested element covers part of its parent's map, which covers part of the
-// image, so half the parent's texels still exceed the pixels it covers in the shipped scenes; full-size nested maps (28 MB each at 1024^2 then: RGBA16F
-// colour, RGBA32F seen points, 32-bit depth) took the mirror pair's render at 1280 x 720 to 460 MB.
-int nestedMapSize(int parent) { return parent <= 128 ? parent : std::max(128, parent / 2); }
-
 }  // namespace
-
-// Each patch's view volume is narrower, so its texels cover a smaller angle. At least 128. An automatic split
-// into 16 x 16 patches at full size took 3.3 GB and 14 s a frame.
-int patchMapSize(int map_size, size_t patches) {
-  if (patches <= 4 || map_size <= 128) return map_size;
-  const double shrink = std::ceil(std::sqrt(double(patches) / 4.0));
-  return std::max(128, int(double(map_size) / shrink));
-}
-
-namespace {
-// Patch views a viewer can see (the others render no map).
-size_t inView(const ElementFrame& f) {
-  return size_t(std::count_if(f.views.begin(), f.views.end(), [](const PatchView& v) { return v.in_view; }));
-}
-}  // namespace
-
-int topLevelMapSide(const Scene& scene, const ElementFrame& f, const PatchView& pv, const RendererOptions& options) {
-  const int size = patchMapSize(options.map_size, std::max<size_t>(1, inView(f)));
-  if (!(options.map_texels_per_pixel > 0)) return size;
-  const Observer& ob = scene.observer;
-  const double pixels = patchScreenPixels(f, pv, ob.visibilityProjection() * ob.view(), ob.width, ob.height);
-  return mapSideForPixels(pv.volume, pixels, options.map_texels_per_pixel, size);
-}
 
 namespace {
 
@@ -240,17 +208,6 @@ struct PassCamera {
 uint64_t nextFirstPassSerial() {
   static std::atomic<uint64_t> serial{0};
   return ++serial;
-}
-
-// Whether any part of the convex hull of `points` can be inside the view volume: false only when every
-// point lies outside one and the same clip plane (homogeneous outcodes; exact for a convex hull).
-bool mayBeInVolume(const std::vector<Vec3>& points, const Mat4& m) {
-  unsigned all = 0x3f;
-  for (const Vec3& p : points) {
-    all &= clipOutcode(m * Vec4(p, 1.0));
-    if (!all) return true;
-  }
-  return all == 0;
 }
 
 // A 2D float texture of w x h texels, 1 or 4 floats each, made or replaced in `tex`. The impostor shader
@@ -379,14 +336,6 @@ struct Renderer::Impl {
   }
   const Program& plainProgram(bool planes) const {
     return planes ? planesVariant("element.vert", "element.frag", {"#define MODE_PLAIN"}) : plain_program;
-  }
-  // A lens with RGB dispersion (three channels of unit R, G and B weights): its maps are planes, its second
-  // pass reads one component per channel.
-  static bool rgbLens(const Element& el, const ElementFrame& f) {
-    if (el.type != ElementType::Lens || f.rays.size() != 3 || f.channels.size() != 3) return false;
-    for (size_t c = 0; c < 3; ++c)
-      if (channelWeight(f.channels, c) != Vec3(c == 0, c == 1, c == 2)) return false;
-    return true;
   }
   Program mask_program = makeProgram("map_mask.vert", "map_mask.frag");
   GLuint empty_vao = 0;
@@ -919,37 +868,16 @@ struct Renderer::Impl {
     return *maps[i];
   }
 
-  // --- multiple reflection (recursive PVRR with an explicit work list) ---
+  // Per map slot held: whether it is in R, G and B planes (reuseMaps).
+  std::vector<bool> planesSlots() const {
+    std::vector<bool> out(maps.size(), false);
+    for (size_t i = 0; i < maps.size(); ++i) out[i] = maps[i] && maps[i]->colorFormat(0) == ColorFormat::R32F;
+    return out;
+  }
 
-  // An element drawn inside a first pass besides the environment: with its own PVRR maps (its vertex rays
-  // start from that pass's viewpoint), or dark where the tracer reaches its depth limit.
-  struct NestedDraw {
-    int element = -1;
-    const ElementFrame* frame = nullptr;  // null: drawn dark
-    size_t first_slot = 0;                // map slot of frame->views[0]; views[v] uses first_slot + v
-  };
-  // One first pass: the map of one patch view.
-  struct MapPass {
-    const ElementFrame* owner = nullptr;
-    size_t view = 0;
-    int depth = 0;     // the tracer's depth (events before) of what this map shows: 1 behind a mirror seen
-                       // from the eye, 2 behind a lens (two interfaces)
-    size_t slot = 0;   // index into `maps`
-    int size = 0;      // the map texture's width and height (nestedMapSize for nested maps)
-    int side = 0;      // the longer side rendered (topLevelMapSide; nested: half the parent's): the pass renders the
-                       // lower-left mapTexels(volume, side) of the texture
-    bool visible = true;  // false: a top-level element the observer cannot see; its map is left as it is
-    std::vector<NestedDraw> nested;
-  };
-  std::vector<MapPass> passes;                            // this frame's first passes, parents before children
-  std::vector<std::unique_ptr<ElementFrame>> nested_frames;  // elements as seen from virtual viewpoints
+  PassPlan plan;  // this frame's first passes
   size_t next_mesh = 0;
 
-  static int interfaces(const Element& el) { return el.type == ElementType::Lens ? 2 : 1; }
-  // Planned first passes that render a map (the budget counts these).
-  size_t visiblePasses() const {
-    return size_t(std::count_if(passes.begin(), passes.end(), [](const MapPass& m) { return m.visible; }));
-  }
   // Whether cached rays were traced for these channels (wavelengths and weights, not just their count).
   static bool sameChannels(const std::vector<ChannelSpec>& a, const std::vector<ChannelSpec>& b) {
     if (a.size() != b.size()) return false;
@@ -957,277 +885,17 @@ struct Renderer::Impl {
       if (a[c].wavelength_nm != b[c].wavelength_nm || channelWeight(a, c) != channelWeight(b, c)) return false;
     return true;
   }
-  // A top-level element whose interfaces reach render.max_depth (a lens with max_depth 1): the tracer
-  // absorbs at its back surface, so it is drawn dark and needs no map.
-  bool beyondDepth(const ElementFrame& f) const {
-    return interfaces(scene.elements[size_t(f.element)]) > scene.render.max_depth;
-  }
-
   VertexStageOptions optionsFor(size_t e) const {
     VertexStageOptions o = options.vertex;
     if (o.channels.empty()) o.channels = dispersionChannels(scene, int(e));
     // As seen from the eye: the tracer's whole budget (none for a lens drawn dark at the depth limit).
-    o.tir_trace_depth = interfaces(scene.elements[e]) > scene.render.max_depth ? 0 : scene.render.max_depth;
+    o.tir_trace_depth = elementInterfaces(scene.elements[e]) > scene.render.max_depth ? 0 : scene.render.max_depth;
     return o;
-  }
-
-  // Whether the top-level patch view v of f needs its map: the observer sees the patch and the element is
-  // not dark at the depth limit.
-  bool topLevelVisible(const ElementFrame& f, size_t v) const {
-    const Observer& ob = scene.observer;
-    return f.views[v].in_view && mayBeInVolume(f.world_pos, ob.visibilityProjection() * ob.view()) && !beyondDepth(f);
-  }
-
-  // Map reuse (RendererOptions::map_reuse_margin_deg). Whether the top-level maps of the last first pass
-  // (cache.maps) serve this frame's views: the same slots; every view the observer sees was rendered, lies
-  // inside its map's frustum (frustumContains), needs at most 15 % more texel density than the map has
-  // (and at least half), its viewpoint moved by under a quarter of the map's smallest texel angle as seen
-  // from its nearest hit point (parallax), and no other element reaches into the map's volume (nothing to
-  // nest; an element is never drawn in its own maps). If so each seen view takes its map's volume and its
-  // texture coordinates are projected through it; `note` says by what margin. Otherwise `note` says why not.
-  bool reuseMaps(std::vector<ElementFrame>& frames, const FrameCache& cache, std::string* note) const {
-    size_t slots = 0;
-    for (const ElementFrame& f : frames) slots += f.views.size();
-    if (cache.maps.empty() || cache.maps_serial != first_pass_serial) {
-      *note = cache.maps_serial != first_pass_serial && !cache.maps.empty()
-                  ? "this renderer drew other maps since"
-                  : "no reusable maps (the last first pass was not widened: a first frame, or nested passes)";
-      return false;
-    }
-    if (cache.maps.size() != slots) {
-      *note = "the patches changed";
-      return false;
-    }
-    double worst_parallax = 0, worst_move = 0;
-    std::vector<char> visible(slots, 0);  // per slot: the observer sees it (the views to check and to move)
-    size_t slot = 0;
-    for (const ElementFrame& f : frames)
-      for (size_t v = 0; v < f.views.size(); ++v, ++slot) {
-        const FrameCache::Map& m = cache.maps[slot];
-        if (m.element != f.element || m.view != v) {
-          *note = "the patches changed";
-          return false;
-        }
-        visible[slot] = topLevelVisible(f, v);
-        if (!visible[slot]) continue;
-        const PatchView& pv = f.views[v];
-        const ViewVolume &W = m.volume, &V = pv.volume;
-        if (!m.rendered || V.backward || W.backward) {
-          *note = !m.rendered ? "a patch came into view" : "a reversed (zooming) map is not reused";
-          return false;
-        }
-        const bool planes = slot < maps.size() && maps[slot] && maps[slot]->colorFormat(0) == ColorFormat::R32F;
-        if (planes != rgbLens(scene.elements[size_t(f.element)], f)) {
-          *note = "the colour channels changed";
-          return false;
-        }
-        if (!frustumContains(W, V)) {
-          *note = "a view left its map's margin";
-          return false;
-        }
-        const double need = topLevelMapSide(scene, f, pv, options) / longerExtentTan(V),
-                     have = m.side / longerExtentTan(W);
-        if (have < need / 1.15 || have > 2 * need) {
-          *note = "the texel density needed changed";
-          return false;
-        }
-        double nearest = kInf;
-        const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
-        for (const auto& channel : f.rays)
-          for (uint32_t vi : gp.vertices)
-            if ((f.in_view.empty() || f.in_view[vi]) && channel[vi].status == VertexStatus::Hit)
-              nearest = std::min(nearest, glm::length(channel[vi].hit - V.eye));
-        if (!std::isfinite(nearest)) {  // every ray escaped or was flagged: nothing bounds the parallax
-          *note = "no hit point bounds the parallax";
-          return false;
-        }
-        const double move = glm::length(V.eye - W.eye), parallax = move / nearest / minTexelAngle(W, m.side);
-        if (!(parallax <= 0.25)) {
-          *note = "the viewpoint moved too far (parallax " + fmt("%.2g", parallax) + " texel)";
-          return false;
-        }
-        const Mat4 map_clip = W.projection * W.view;
-        for (const ElementFrame& b : frames)
-          if (b.element != f.element && mayBeInVolume(b.world_pos, map_clip)) {
-            *note = "an element reaches into a map's volume";
-            return false;
-          }
-        worst_parallax = std::max(worst_parallax, parallax);
-        worst_move = std::max(worst_move, move);
-      }
-    slot = 0;
-    for (ElementFrame& f : frames)
-      for (size_t v = 0; v < f.views.size(); ++v, ++slot)
-        if (visible[slot]) {
-          f.views[v].volume = cache.maps[slot].volume;
-          projectPatchMap(f, f.views[v]);
-        }
-    *note = "map reuse: every view lies inside the maps drawn " + std::to_string(cache.maps_age + 1) +
-            " frame(s) ago with margins of up to " + fmt("%.3g", options.map_reuse_margin_deg) + " deg; viewpoints moved <= " +
-            fmt("%.3g", 1e3 * worst_move) + " mm (parallax <= " + fmt("%.3g", worst_parallax) + " texel)";
-    return true;
-  }
-
-  // Widens every top-level forward view by the reuse margin (widenViewVolume) at the texel density it needs
-  // (its side scaled by the wider extent) in a texture 25 % larger than patchMapSize, and projects its
-  // texture coordinates through the wider volume. A narrow view gets a smaller margin, so that its longer
-  // extent grows by at most kMaxWidening and its density is kept within that texture. Returns each slot's
-  // texture size and side.
-  static constexpr double kMaxWidening = 1.2;
-  std::vector<std::array<int, 2>> widenMaps(std::vector<ElementFrame>& frames) const {
-    std::vector<std::array<int, 2>> out;
-    for (ElementFrame& f : frames)
-      for (PatchView& pv : f.views) {
-        const int base = patchMapSize(options.map_size, std::max<size_t>(1, inView(f)));
-        const int size = std::min(32 * int(std::ceil(1.25 * base / 32.0)), std::max(base, max_texture_size)),
-                  side = topLevelMapSide(scene, f, pv, options);
-        if (pv.volume.backward) {
-          out.push_back({size, side});
-          continue;
-        }
-        const ViewVolume narrow = pv.volume;
-        double margin = radians(options.map_reuse_margin_deg);
-        pv.volume = widenViewVolume(narrow, margin);
-        double wider = longerExtentTan(pv.volume) / longerExtentTan(narrow);
-        for (int i = 0; i < 8 && wider > kMaxWidening; ++i) {  // the extent grows about linearly with the margin
-          margin *= 0.98 * (kMaxWidening - 1) / (wider - 1);
-          pv.volume = widenViewVolume(narrow, margin);
-          wider = longerExtentTan(pv.volume) / longerExtentTan(narrow);
-        }
-        out.push_back({size, std::min(size, 32 * int(std::ceil(side * wider / 32.0)))});
-        projectPatchMap(f, pv);
-      }
-    return out;
   }
 
   MeshBuffers& meshSlot() {
     if (element_meshes.size() <= next_mesh) element_meshes.resize(next_mesh + 1);
     return element_meshes[next_mesh++];
-  }
-
-  // Where the light that reaches each of `points` through the owner's patch leaves the owner (beyond the
-  // paper, which starts the nested rays at the outer virtual viewpoint and so inherits its fit residual):
-  // the outgoing-ray origins of the owner's vertices (mirror points, lens back points), interpolated at the
-  // point's position in the patch's map with the barycentric coordinates, in texture space, of the owner
-  // triangle that holds it there. A point outside the patch's image extrapolates from the nearest
-  // triangle, up to half a triangle; beyond that (or behind the map camera) it uses the viewpoint itself.
-  static std::vector<Vec3> rayOrigins(const ElementFrame& owner, const PatchView& pv, const std::vector<Vec3>& points) {
-    const cad::GridPatch& gp = owner.grid_patches[size_t(pv.patch)];
-    const size_t fc = owner.rays.size() / 2;
-    const std::vector<Vec2>& st = pv.st[fc];
-    std::vector<Vec3> out(points.size(), pv.volume.eye);
-    // A vertex out of the viewer's view or with a flagged ray (TIR, edge band) has placeholder texture
-    // coordinates: its triangles say nothing about where the map shows a point.
-    const auto usable = [&](uint32_t k) {
-      const uint32_t vi = gp.vertices[k];
-      return (owner.in_view.empty() || owner.in_view[vi]) && owner.rays[fc][vi].status != VertexStatus::Tir;
-    };
-    for (size_t i = 0; i < points.size(); ++i) {
-      const Vec2 p = projectToTexture(pv.volume, points[i]);
-      if (!std::isfinite(p.x) || !std::isfinite(p.y)) continue;
-      double best = -kInf, l[3] = {0, 0, 0};
-      const cad::Triangle* best_tri = nullptr;
-      for (const cad::Triangle& t : gp.triangles) {
-        if (!usable(t.x) || !usable(t.y) || !usable(t.z)) continue;
-        const Vec2 a = st[t.x], e1 = st[t.y] - a, e2 = st[t.z] - a, r = p - a;
-        const double den = e1.x * e2.y - e2.x * e1.y;
-        if (!(std::abs(den) > 0)) continue;
-        const double l1 = (r.x * e2.y - e2.x * r.y) / den, l2 = (e1.x * r.y - r.x * e1.y) / den, l0 = 1 - l1 - l2;
-        const double m = std::min(l0, std::min(l1, l2));
-        if (m > best) {
-          best = m;
-          l[0] = l0;
-          l[1] = l1;
-          l[2] = l2;
-          best_tri = &t;
-          if (m >= 0) break;
-        }
-      }
-      if (!best_tri || best < -0.5) continue;
-      const auto origin = [&](uint32_t k) { return owner.rays[fc][gp.vertices[k]].origin; };
-      out[i] = l[0] * origin(best_tri->x) + l[1] * origin(best_tri->y) + l[2] * origin(best_tri->z);
-    }
-    return out;
-  }
-
-  // Plans this frame's first passes: the top-level patch views of `frames` (slots 0..), then, breadth
-  // first, for every pass the other elements inside its view volume, each traced and fitted from the pass's
-  // viewpoint with its own maps appended to the list, down to the scene's depth limit. Children always
-  // follow their parent, so rendering the list backwards renders every map before the pass that reads it.
-  // Returns the number of nested passes; `dark` counts elements drawn dark at the depth limit or budget.
-  // `top_size_side`: the texture size and rendered side of each top-level slot (widened maps); default
-  // patchMapSize and topLevelMapSide.
-  size_t planPasses(const std::vector<ElementFrame>& frames, const std::vector<VertexStageOptions>& opts,
-                    size_t* dark, bool* budget_hit, const std::vector<std::array<int, 2>>* top_size_side = nullptr) {
-    passes.clear();
-    nested_frames.clear();
-    *dark = 0;
-    *budget_hit = false;
-    size_t slot = 0;
-    for (const ElementFrame& f : frames)
-      for (size_t v = 0; v < f.views.size(); ++v) {
-        const bool given = top_size_side && slot < top_size_side->size();
-        passes.push_back({&f, v, interfaces(scene.elements[size_t(f.element)]), slot,
-                          given ? (*top_size_side)[slot][0] : patchMapSize(options.map_size, std::max<size_t>(1, inView(f))),
-                          given ? (*top_size_side)[slot][1] : topLevelMapSide(scene, f, f.views[v], options), true, {}});
-        ++slot;
-      }
-    const size_t top = passes.size();
-    // A top-level element outside the observer's view needs no map (its second-pass triangles are clipped).
-    for (MapPass& mp : passes) mp.visible = topLevelVisible(*mp.owner, mp.view);
-    const int max_depth = scene.render.max_depth;
-    for (size_t i = 0; i < passes.size(); ++i) {
-      if (!passes[i].visible) continue;
-      const ElementFrame& owner = *passes[i].owner;
-      const PatchView& pv = owner.views[passes[i].view];
-      const int depth = passes[i].depth;
-      for (size_t b = 0; b < frames.size(); ++b) {
-        if (int(b) == owner.element || !mayBeInVolume(frames[b].world_pos, pv.volume.projection * pv.volume.view)) continue;
-        const Element& el = scene.elements[b];
-        const size_t views_needed = size_t(std::max(1, el.patches_u * el.patches_v));
-        // The tracer absorbs at an element event with depth >= max_depth; a lens's back surface is the
-        // event after its front, so the element is dark unless all its interfaces come before the limit.
-        const bool too_deep = depth + interfaces(el) > max_depth;
-        if (too_deep || visiblePasses() + views_needed > kMaxFirstPasses) {
-          *budget_hit = *budget_hit || !too_deep;
-          ++*dark;
-          passes[i].nested.push_back({int(b), nullptr, 0});
-          continue;
-        }
-        // The element as the owner's patch sees it: the geometry is the top-level frame's; each vertex's
-        // incoming ray comes from where the owner's rays that reach it leave the owner (rayOrigins), and
-        // the fit gives its own viewpoints and maps.
-        auto nf = std::make_unique<ElementFrame>();
-        nf->element = int(b);
-        nf->grid = frames[b].grid;
-        nf->world_pos = frames[b].world_pos;
-        nf->world_normal = frames[b].world_normal;
-        nf->patches_u = el.patches_u;
-        nf->patches_v = el.patches_v;
-        VertexStageOptions nested_opt = opts[b];
-        nested_opt.viewer_clip = pv.volume.projection * pv.volume.view;  // seen by the owner's map camera
-        nested_opt.tir_trace_depth = max_depth - depth;  // the events before this element are spent
-        traceVertexRays(rays, *nf, pv.volume.eye, rayOrigins(owner, pv, nf->world_pos), nested_opt);
-        fitPatchViews(scene, *nf, nested_opt);
-        if (visiblePasses() + inView(*nf) > kMaxFirstPasses) {  // an automatic split needed more maps
-          *budget_hit = true;
-          ++*dark;
-          passes[i].nested.push_back({int(b), nullptr, 0});
-          continue;
-        }
-        const size_t first = slot;
-        // The texture at half the parent's texture (it never reallocates), the rendered side at half the
-        // parent's rendered side.
-        const int size = nestedMapSize(passes[i].size), side = std::min(size, nestedMapSize(passes[i].side));
-        for (size_t v = 0; v < nf->views.size(); ++v)  // a patch the owner's map camera cannot see: no map
-          passes.push_back({nf.get(), v, depth + interfaces(el), slot++, size, side, nf->views[v].in_view, {}});
-        passes[i].nested.push_back({int(b), nf.get(), first});
-        nested_frames.push_back(std::move(nf));
-      }
-    }
-    map_side.assign(passes.size(), 0);
-    for (const MapPass& mp : passes) map_side[mp.slot] = mp.side;
-    return passes.size() - top;
   }
 
   // Draws one element with its PVRR maps into the bound target, as seen by `cam`. More than three channels
@@ -1389,8 +1057,8 @@ struct Renderer::Impl {
   CullCount renderPasses(const std::vector<ElementFrame>& frames, size_t whole_slots, int64_t* skipped, int64_t* texels) {
     CullCount count;
     *skipped = *texels = 0;
-    for (size_t i = passes.size(); i-- > 0;) {
-      const MapPass& mp = passes[i];
+    for (size_t i = plan.passes.size(); i-- > 0;) {
+      const MapPass& mp = plan.passes[i];
       const PatchView& pv = mp.owner->views[mp.view];
       const bool planes = rgbLens(scene.elements[size_t(mp.owner->element)], *mp.owner);
       const Framebuffer& t = mapTarget(mp.slot, mp.size, planes);
@@ -1578,7 +1246,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   // an earlier one while its views stay inside them; otherwise its maps are drawn widened by the margin.
   const bool reuse_on = mode == RasterMode::Pvrr && !frames.empty() && options.map_reuse_margin_deg > 0 && continuing;
   std::string reuse_note;
-  if (reuse_on && !skip_first_pass && !cache->environment_changed && reuseMaps(frames, *cache, &reuse_note)) {
+  if (reuse_on && !skip_first_pass && !cache->environment_changed && reuseMaps(scene, frames, *cache, options, first_pass_serial, planesSlots(), &reuse_note)) {
     skip_first_pass = true;
     ++cache->maps_age;
   } else if (reuse_on && skip_first_pass && !cache->maps.empty()) {
@@ -1596,11 +1264,14 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     out.stages.skipped("first-pass", why);
     out.stages.skipped("nested-passes", why);
   } else if (mode == RasterMode::Pvrr && !frames.empty()) {
-    size_t dark = 0;
-    bool budget_hit = false;
     std::vector<std::array<int, 2>> widened;  // per top-level slot: texture size, rendered side
-    if (widen) widened = widenMaps(frames);
-    const size_t nested = planPasses(frames, opts, &dark, &budget_hit, widen ? &widened : nullptr);
+    if (widen) widened = widenMaps(scene, frames, options, max_texture_size);
+    plan = planPasses(scene, rays, frames, opts, options, widen ? &widened : nullptr);
+    map_side.assign(plan.passes.size(), 0);
+    for (const MapPass& mp : plan.passes) map_side[mp.slot] = mp.side;
+    const std::vector<MapPass>& passes = plan.passes;
+    const size_t nested = plan.nested(), dark = plan.dark;
+    const bool budget_hit = plan.budget_hit;
     const double plan_ms = msSince(t0);
     int deepest = 0, rendered = 0;
     for (const MapPass& mp : passes) {
@@ -1890,7 +1561,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   for (size_t e = 0; e < n_el; ++e) {
     frame_target->bind();
     if (mode == RasterMode::Pvrr) {
-      if (beyondDepth(frames[e])) drawDarkElement(frames[e], eye_cam);
+      if (beyondDepth(scene, frames[e])) drawDarkElement(frames[e], eye_cam);
       else drawPvrrElement(frames[e], top_slot[e], eye_cam, options.seen_channel);
     } else {
       ElementFrame f = prepareElement(scene, int(e), &grid_cache.get(scene, int(e)));
