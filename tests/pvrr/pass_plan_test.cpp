@@ -178,6 +178,40 @@ TEST(PassPlan, TopLevelVisibilityAndDepth) {
   for (size_t v = 0; v < t.frames[0].views.size(); ++v) EXPECT_FALSE(topLevelVisible(s, t.frames[0], v));
 }
 
+// rayOrigins on the plane mirror, whose viewpoint is exact: a point seen through one of its vertices (on the
+// line from the viewpoint through it, beyond the mirror) takes that vertex's outgoing-ray origin, the vertex
+// itself; a point far outside the map's view takes the viewpoint.
+TEST(PassPlan, RayOriginsOfPointsSeenThroughTheMirror) {
+  // A vertex's texture coordinates and the point's projection agree to rounding (1e-12 of the map): its
+  // barycentric weights are 1 and 0 to about that, over a mirror of ~1 m.
+  constexpr double kOriginTol_m = 1e-6;
+  Scene s = test::shippedScene("plane-mirror", {"observer.image_size=[160,120]"});
+  RayScene rays(s);
+  const TopLevel t = topLevelFrames(s, rays);
+  ASSERT_EQ(t.frames.size(), 1u);
+  const ElementFrame& f = t.frames[0];
+  const PatchView& pv = f.views[0];
+  const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
+  const size_t fc = f.rays.size() / 2;
+  std::vector<Vec3> points, expect;
+  for (size_t k = 0; k < gp.vertices.size(); k += 7) {
+    const uint32_t vi = gp.vertices[k];
+    if (!f.in_view.empty() && !f.in_view[vi]) continue;
+    if (f.rays[fc][vi].status == VertexStatus::Tir) continue;
+    const Vec3 o = f.rays[fc][vi].origin;
+    points.push_back(pv.volume.eye + 3.0 * (o - pv.volume.eye));
+    expect.push_back(o);
+  }
+  ASSERT_GT(points.size(), 3u);
+  // Far to the side of the map's view: no triangle within half a triangle of it.
+  const Vec3 side = glm::normalize(glm::cross(expect[0] - pv.volume.eye, Vec3(0, 1, 0)));
+  points.push_back(expect[0] + 1e3 * side);
+  const std::vector<Vec3> got = rayOrigins(f, pv, points);
+  ASSERT_EQ(got.size(), points.size());
+  for (size_t i = 0; i < expect.size(); ++i) EXPECT_LT(glm::length(got[i] - expect[i]), kOriginTol_m) << i;
+  EXPECT_EQ(got.back(), pv.volume.eye);
+}
+
 // Map reuse on the plane mirror (one element, nothing to nest): the maps are widened once, and a later frame
 // draws from them while it stays inside them.
 class PlaneMirrorReuse : public ::testing::Test {
