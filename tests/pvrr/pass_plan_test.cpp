@@ -272,16 +272,44 @@ TEST_F(PlaneMirrorReuse, PlanesMapsAreNotReusedForRgbaChannels) {
 
 TEST_F(PlaneMirrorReuse, AMoveBeyondTheMarginOrParallaxRendersAgain) {
   const FrameCache c = widenedCache();
-  // A small step sideways: the viewpoints move by more than a quarter texel of parallax (or out of the
-  // margin), either of which refuses the maps.
+  // A step of 5 cm sideways: its view stays inside the 2 deg margin, but the viewpoint moves by far more than a
+  // quarter texel of parallax (4.3 texels at 160 x 120).
   const Vec3 step = 0.05 * glm::normalize(glm::cross(s.observer.target - s.observer.eye, s.observer.up));
   s.observer.eye += step;
   s.observer.target += step;
   TopLevel t = topLevelFrames(s, rays);
   std::string note;
   EXPECT_FALSE(reuseMaps(s, t.frames, c, options, kSerial, {}, &note));
-  EXPECT_TRUE(note.rfind("the viewpoint moved too far (parallax", 0) == 0 || note == "a view left its map's margin")
-      << note;
+  EXPECT_EQ(note.rfind("the viewpoint moved too far (parallax", 0), 0u) << note;
+}
+
+// A step of 1 mm (about a tenth of a texel of parallax) stays inside maps widened by 2 deg, not inside maps
+// widened by 1e-4 deg.
+TEST_F(PlaneMirrorReuse, ASmallStepLeavesANarrowMargin) {
+  const Vec3 step = 1e-3 * glm::normalize(glm::cross(s.observer.target - s.observer.eye, s.observer.up));
+  const FrameCache wide = widenedCache();
+  options.map_reuse_margin_deg = 1e-4;
+  const FrameCache narrow = widenedCache();
+  s.observer.eye += step;
+  s.observer.target += step;
+  TopLevel t = topLevelFrames(s, rays);
+  std::string note;
+  EXPECT_FALSE(reuseMaps(s, t.frames, narrow, options, kSerial, {}, &note));
+  EXPECT_EQ(note, "a view left its map's margin");
+  options.map_reuse_margin_deg = 2;
+  t = topLevelFrames(s, rays);
+  EXPECT_TRUE(reuseMaps(s, t.frames, wide, options, kSerial, {}, &note)) << note;
+}
+
+TEST_F(PlaneMirrorReuse, AStepWellUnderAQuarterTexelOfParallaxIsReused) {
+  const FrameCache c = widenedCache();
+  const Vec3 step = 2e-5 * glm::normalize(glm::cross(s.observer.target - s.observer.eye, s.observer.up));  // 0.02 mm
+  s.observer.eye += step;
+  s.observer.target += step;
+  TopLevel t = topLevelFrames(s, rays);
+  std::string note;
+  ASSERT_TRUE(reuseMaps(s, t.frames, c, options, kSerial, {}, &note)) << note;
+  EXPECT_NE(note.find("viewpoints moved <= 0.0"), std::string::npos) << note;  // mm, the virtual eye's step
 }
 
 TEST_F(PlaneMirrorReuse, WideningGrowsTheExtentByAtMostTwentyPercent) {
