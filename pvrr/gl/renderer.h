@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "pvrr/method/pass_plan.h"
 #include "pvrr/trace/ray_scene.h"
 #include "pvrr/base/stats.h"
 #include "pvrr/method/vertex_stage.h"
@@ -40,15 +41,13 @@ struct RasterFrame {
   std::vector<ElementFrame> elements;  // PVRR per-element state of this frame (pvrr mode)
 };
 
-struct RendererOptions {
-  int map_size = 1024;              // first-pass map's longer side at most (pvrr), cube face size (envmap, impostor)
+// The planning's settings (map_size, map_texels_per_pixel, map_reuse_margin_deg: pvrr/method/pass_plan.h) are fields of
+// the base.
+struct RendererOptions : PassPlanOptions {
   // impostor: the longer side (texels) of a lens's refractor height maps (pvrr/impostor/lens_height_map.h), and the
   // side of a mirror's surface maps (pvrr/impostor/surface_map.h); each built once per renderer.
   int lens_height_map_size = 512;
   int surface_map_size = 512;
-  // pvrr: each top-level map's texels per image pixel of its patch (Scene render.map_texels_per_pixel); the
-  // map's longer side is lowered from map_size to that (topLevelMapSide). 0: always map_size.
-  double map_texels_per_pixel = 4;
   // Viewpoint options and channels. Channels empty: each element gets dispersionChannels(scene, element)
   // (the scene's render.dispersion and spectral_samples); otherwise every element gets these channels.
   VertexStageOptions vertex;
@@ -67,12 +66,6 @@ struct RendererOptions {
   // mode: -1 the fit channel (the middle one with dispersion, else the only one); c >= 0 channel c (clamped
   // to the last channel), e.g. 0 and 2 give red's and blue's seen points on a dispersive lens.
   int seen_channel = -1;
-  // Map reuse across frames (Scene render.map_reuse_margin_deg), with a FrameCache only: once a frame
-  // follows another, each top-level map is rendered this much wider on each side (at the same texel
-  // density), and later frames whose views still lie inside it, from a viewpoint that moved by under a
-  // quarter texel of parallax, draw from it without a first pass (stage "first-pass" says why, or why not).
-  // 0: every frame that moved renders its maps.
-  double map_reuse_margin_deg = 2;
   // Cull the back faces of closed convex environment meshes (EnvMesh::closed_convex: boxes, spheres) in each
   // pass whose depth is not reversed, where near clipping cannot cut the mesh open (NearClip: wholly beyond
   // the near plane, or out of the near rectangle's reach). The picture is the same, but where a back face tied
@@ -93,45 +86,11 @@ struct RendererOptions {
   bool sort_environment = true;
 };
 
-// Reuse across frames (paper section 5, eye-fixed caching): when an element has not moved relative to the
-// eye, its vertex rays and viewpoints are kept; when the environment has not changed either, its first
-// pass is kept too.
-struct FrameCache {
-  bool valid = false;
-  std::vector<Mat4> element_to_eye;  // per element, the element pose relative to the eye of the last frame
-  Mat4 view{1.0};                    // the observer's view matrix of the cached frame
-  Mat4 projection{1.0};              // and its projection: what it sees of each element (ElementFrame::in_view)
-  std::vector<ElementFrame> elements;
-  bool environment_changed = true;
-  // Map reuse (RendererOptions::map_reuse_margin_deg): the top-level maps the renderer last rendered, in map
-  // slot order, with the (widened) volume and the longer side each was rendered with. Empty when that
-  // first pass cannot be reused (it had nested passes or elements drawn dark, or was not widened).
-  struct Map {
-    int element = -1;
-    size_t view = 0;
-    ViewVolume volume;
-    int side = 0;
-    bool rendered = false;  // false: the patch was out of view, its map not drawn
-  };
-  std::vector<Map> maps;
-  uint64_t maps_serial = 0;  // the first pass that drew them (unique in the process; the renderer that holds
-                             // maps of another serial drew over them)
-  int maps_age = 0;          // frames drawn from them since
-  bool last_plan_nested = false;  // the last first pass had nested passes or dark elements: the next one is
-                                  // not widened (its maps could not be kept)
-  uint64_t frame_serial = 0;  // the first pass whose maps `elements` were drawn with (the renderer must still
-                              // hold them for a frame that skips its first pass)
-};
-
-// The map size (longer side, texels) of each of an element's top-level patches when `patches_in_view` of them
-// are in the observer's view: map_size up to four patches, beyond that shrunk so that all of them together
-// hold about as many texels as four full maps. Each map renders mapTexels(volume, this) (pvrr/method/view_volume.h).
-int patchMapSize(int map_size, size_t patches_in_view);
-
-// The longer side (texels) of the map of the top-level patch `pv` of `f`: patchMapSize, lowered to what the
-// patch's pixels in the observer's image need at options.map_texels_per_pixel (mapSideForPixels of
-// patchScreenPixels). It renders mapTexels(pv.volume, this) texels.
-int topLevelMapSide(const Scene& scene, const ElementFrame& f, const PatchView& pv, const RendererOptions& options);
+// The frame cache and the map sizes belong to the planning (pvrr/method/pass_plan.h); these names keep them where the
+// renderer's users look for them.
+using pvrr::FrameCache;
+using pvrr::patchMapSize;
+using pvrr::topLevelMapSide;
 
 class Renderer {
  public:

@@ -574,7 +574,7 @@ TEST_P(RendererTest, SeenChannelGivesEachChannelsSeenPoint) {
 TEST_P(RendererTest, MirrorSeenInAMirror) {
   // Measured 1.19' (nested) and 0.77' (all mirror pixels) at 160 x 120 with 512^2 maps: each nested
   // element is interpolated between its own vertices, whose rays are exact up to the interpolation of the
-  // outer mirror's ray origins (rayOrigins in pvrr/gl/renderer.cpp); starting them at the outer virtual
+  // outer mirror's ray origins (rayOrigins in pvrr/method/pass_plan.cpp); starting them at the outer virtual
   // viewpoint instead, as the paper does, gave 6.4'.
   constexpr double kNestedMedianArcmin = 2.0;
   auto ctx = test::glContextOrFail(GetParam());

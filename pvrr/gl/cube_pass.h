@@ -1,0 +1,54 @@
+// Envmap and impostor modes: a cube map from each element's centre (colour and seen points; in impostor mode
+// the seen points are each direction's distance, and with several elements a third cube holds the normals
+// and indices of the elements drawn in it), rendered before the second pass; impostor mode's second layers
+// (depth-peeled cubes at half the size), drawn within the second pass only where some pixel's search needs
+// them; and each element's second-pass draw from its cubes.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pvrr/gl/impostor_maps.h"
+#include "pvrr/gl/mode_pass.h"
+#include "pvrr/gl/stage_notes.h"
+
+namespace pvrr::gl {
+
+class CubePass : public ModePass {
+ public:
+  explicit CubePass(const RenderContext& c) : ctx(c), maps(c.scene, c.options, c.max_texture_units) {}
+
+  void prepare(RasterMode mode, FrameStages& stages, FrameCache* cache) override;
+  std::string drawElements(RasterMode mode, const PassCamera& eye, const Framebuffer& target) override;
+
+ private:
+  // The elements drawn in other elements' cubes: the mirrors, and the lens if it is the only one.
+  bool inCubes(size_t m) const;
+  // Element m drawn into a face of another element's impostor cubes, from a camera at `origin` (view_proj
+  // relative to it), before the environment (CUBE_GEOMETRY): a mirror's exact surface point and normal per
+  // fragment, a lens's mesh.
+  void drawCubeElement(size_t m, const Mat4& view_proj, const Vec3& origin, const MeshBuffers& mesh, bool peel);
+  // Layer `layer` of element e's cubes; returns their cull counts and the elements drawn in them.
+  std::pair<CullCount, int> drawCubes(size_t e, int layer);
+  // Element e in the second pass, from its mesh in element_slot[e]. Impostor with two layers (layer_draw): 0
+  // the first draw, 2 the probe, 1 the second draw (drawElements).
+  void drawElement(size_t e, int layer_draw, const PassCamera& eye);
+  // The probe, and where some pixel needs them, the second layers' cubes and second draws; returns the note.
+  std::string drawSecondLayers(const PassCamera& eye, const Framebuffer& target);
+
+  RenderContext ctx;
+  ImpostorMaps maps;
+  std::vector<std::unique_ptr<CubeTarget>> cubes;   // one per element
+  std::vector<std::unique_ptr<CubeTarget>> cubes1;  // impostor mode's second layers (impostorLayers), one per element
+  // This frame's plan (prepare):
+  RasterMode mode = RasterMode::Envmap;
+  int layers = 1;               // ImpostorMaps::impostorLayers
+  int follow = 0;               // ImpostorMaps::cubeElements: the elements the fragments follow through their cubes
+  bool lens_in_cubes = false;   // ImpostorMaps::lensInCubes
+  bool with_seen = false;       // the cubes hold seen points even in a colour-only frame (impostor mode)
+  bool second_layers = false;   // the second layers are to be drawn where needed (layers > 1)
+  std::vector<size_t> cube_mesh;     // per element drawn in other cubes: its mesh's pool index
+  std::vector<size_t> element_slot;  // per element: its second-pass mesh's pool index
+};
+
+}  // namespace pvrr::gl

@@ -1,0 +1,190 @@
+#include "pvrr/gl/environment_pass.h"
+
+#include <algorithm>
+
+#include "pvrr/gl/gl.h"
+#include "pvrr/gl/impostor_maps.h"
+#include "pvrr/method/view_volume.h"
+
+namespace pvrr::gl {
+
+void setLights(const Program& p, const Scene& scene, const Vec3& origin) {
+  Vec3 ambient(0.0);
+  std::vector<float> dir_vec, dir_rad, point_pos, point_rad;
+  auto push = [](std::vector<float>& to, const Vec3& v) { to.insert(to.end(), {float(v.x), float(v.y), float(v.z)}); };
+  for (const Light& l : scene.lights) {
+    switch (l.type) {
+      case Light::Type::Ambient: ambient += l.radiance; break;
+      case Light::Type::Directional: push(dir_vec, l.direction), push(dir_rad, l.radiance); break;
+      case Light::Type::Point: push(point_pos, l.position - origin), push(point_rad, l.radiance); break;
+    }
+  }
+  p.set("u_ambient", glm::vec3(ambient));
+  if (!dir_vec.empty()) {
+    p.setVec3("u_dir_light_dir", dir_vec.data(), int(dir_vec.size() / 3));
+    p.setVec3("u_dir_light_radiance", dir_rad.data(), int(dir_rad.size() / 3));
+  }
+  if (!point_pos.empty()) {
+    p.setVec3("u_point_light_pos", point_pos.data(), int(point_pos.size() / 3));
+    p.setVec3("u_point_light_radiance", point_rad.data(), int(point_rad.size() / 3));
+  }
+}
+
+EnvironmentPass::EnvironmentPass(const Scene& s, const RendererOptions& o, const Programs& p)
+    : scene(s), options(o), programs(p) {
+  programs.sky(false);  // built now, as the meshes' programs below
+  glGenVertexArrays(1, &empty_vao);
+  for (const pvrr::Texture& t : scene.textures) {
+    ImageRGB8 image;
+    image.width = t.width;
+    image.height = t.height;
+    image.rgb = t.rgb;
+    // sRGB, flipped so v = 0 is the image's bottom row, no mipmaps: bilinear sampling with repeat wrapping,
+    // exactly what the tracer does (pvrr/trace/shading.cpp).
+    textures.push_back(createTexture2D(image, TextureEncoding::Srgb, false));
+    glBindTexture(GL_TEXTURE_2D, textures.back().name());
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  }
+  env_meshes.resize(scene.meshes.size());
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    const EnvMesh& mesh = scene.meshes[m];
+    std::vector<float> data;
+    data.reserve(mesh.positions.size() * 8);
+    for (size_t i = 0; i < mesh.positions.size(); ++i) {
+      const glm::vec3 pos = mesh.positions[i], n = mesh.normals[i];
+      const glm::vec2 uv = mesh.uvs[i];
+      data.insert(data.end(), {pos.x, pos.y, pos.z, n.x, n.y, n.z, uv.x, uv.y});
+    }
+    std::vector<uint32_t> idx;
+    idx.reserve(mesh.triangles.size() * 3);
+    for (const auto& t : mesh.triangles) idx.insert(idx.end(), {t.x, t.y, t.z});
+    uploadMesh(env_meshes[m], data, {3, 3, 2}, idx);
+    // Faceted: each triangle's three normals equal and perpendicular to it (a supplied normal tilted from
+    // its face would make the per-vertex two-sided flip differ from the per-fragment one).
+    env_faceted.push_back(std::all_of(mesh.triangles.begin(), mesh.triangles.end(), [&](const auto& t) {
+      const glm::vec3 n = mesh.normals[t.x];
+      const Vec3 face = glm::cross(Vec3(mesh.positions[t.y] - mesh.positions[t.x]), Vec3(mesh.positions[t.z] - mesh.positions[t.x]));
+      const double len = glm::length(face);
+      const bool perpendicular = len == 0 || std::abs(glm::dot(face / len, Vec3(n))) >= 1 - 1e-6;
+      return perpendicular && glm::length(mesh.normals[t.y] - n) <= 1e-6f && glm::length(mesh.normals[t.z] - n) <= 1e-6f;
+    }));
+    Vec3 lo(mesh.positions.empty() ? glm::vec3(0) : mesh.positions[0]), hi(lo);
+    for (const glm::vec3& pos : mesh.positions) {
+      lo = glm::min(lo, Vec3(pos));
+      hi = glm::max(hi, Vec3(pos));
+    }
+    env_bounds.push_back({lo, hi});
+    env_textured.push_back(scene.materials[size_t(mesh.material)].texture >= 0);
+    // Its program, built now (not in the first frame's first pass) so that its compile time and any
+    // compile error come with the renderer.
+    programs.env(env_faceted.back(), env_textured.back(), false);
+  }
+  checkGlError("uploading the environment");
+}
+
+EnvironmentPass::~EnvironmentPass() {
+  for (auto& m : env_meshes) m.release();
+  if (empty_vao) glDeleteVertexArrays(1, &empty_vao);
+}
+
+std::vector<std::array<Vec3, 2>> EnvironmentPass::boxes(const Vec3& origin) const {
+  std::vector<std::array<Vec3, 2>> out(scene.meshes.size());
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    const Vec3 to_anchor = scene.meshes[m].anchor - origin;
+    out[m] = {env_bounds[m][0] + to_anchor, env_bounds[m][1] + to_anchor};
+  }
+  return out;
+}
+
+std::vector<size_t> EnvironmentPass::drawOrder(const std::vector<std::array<Vec3, 2>>& b, bool reversed_depth) const {
+  if (options.sort_environment) return depthSortedDrawOrder(b, reversed_depth);
+  std::vector<size_t> order(b.size());
+  for (size_t m = 0; m < order.size(); ++m) order[m] = m;
+  return order;
+}
+
+CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& origin, bool reversed_depth,
+                                const Vec3* rays_from, bool planes, bool with_seen, bool peel) const {
+  const Mat4 vp = relativeViewProj(proj, view, origin);
+  const Program& sky = programs.sky(planes, with_seen, peel);
+  auto drawSky = [&] {
+    sky.use();
+    if (peel) {
+      sky.set("u_peel", kPeelUnit);
+      sky.set("u_first_colour", kFirstCubeUnit);
+      sky.set("u_first_normal", kFirstCubeUnit + 1);
+    }
+    sky.set("u_inv_view_proj", toFloat(glm::inverse(vp)));
+    sky.set("u_background", glm::vec3(scene.render.background));
+    sky.set("u_far", float(scene.render.far_distance_m));
+    glBindVertexArray(empty_vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+  };
+  if (reversed_depth) {  // depth cleared to 0: the sky first, without depth
+    glDisable(GL_DEPTH_TEST);
+    glDepthMask(GL_FALSE);
+    drawSky();
+  }
+  glEnable(GL_DEPTH_TEST);
+  glDepthMask(GL_TRUE);
+  glDepthFunc(reversed_depth ? GL_GREATER : GL_LESS);
+  // The programs of the kinds of mesh the scene has, [faceted][textured], set up for this pass.
+  const Program* kinds[2][2] = {};
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    const bool faceted = env_faceted[m], textured = env_textured[m];
+    const Program*& p = kinds[faceted][textured];
+    if (p) continue;
+    p = &programs.env(faceted, textured, planes, with_seen, peel);
+    p->use();
+    if (peel) p->set("u_peel", kPeelUnit);
+    p->set("u_view_proj", toFloat(vp));
+    p->set("u_view_origin", rays_from ? glm::vec3(*rays_from - origin) : glm::vec3(0.0f));
+    if (textured) p->set("u_texture", 0);
+    setLights(*p, scene, origin);
+  }
+  glActiveTexture(GL_TEXTURE0);
+  // Back faces of closed convex meshes that near clipping cannot cut open (RendererOptions::cull_back_faces,
+  // NearClip): a ray from the centre of projection to a back-face point first crosses a front face
+  // of the same solid, itself beyond the near plane, which the depth test keeps instead. Not with reversed
+  // depth, where the farther face wins.
+  const bool may_cull = options.cull_back_faces && !reversed_depth;
+  const NearClip near_clip(vp);
+  glDisable(GL_CULL_FACE);  // whatever an interrupted pass left
+  if (may_cull) {
+    glCullFace(GL_BACK);
+    glFrontFace(facingTrianglesWindCounterClockwise(vp) ? GL_CCW : GL_CW);
+  }
+  bool culling = false;
+  CullCount count;
+  const std::vector<std::array<Vec3, 2>> relative = boxes(origin);  // camera-relative
+  for (const size_t m : drawOrder(relative, reversed_depth)) {
+    const EnvMesh& mesh = scene.meshes[m];
+    const DiffuseMaterial& mat = scene.materials[size_t(mesh.material)];
+    const Program& p = *kinds[env_faceted[m]][env_textured[m]];
+    const bool cull = may_cull && mesh.closed_convex && near_clip.cannotOpen(relative[m][0], relative[m][1]);
+    count.drawn += mesh.closed_convex;
+    count.culled += cull;
+    if (cull != culling) {
+      cull ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
+      culling = cull;
+    }
+    p.use();
+    p.set("u_offset", glm::vec3(mesh.anchor - origin));
+    p.set("u_albedo", glm::vec3(mat.color));
+    if (env_textured[m]) glBindTexture(GL_TEXTURE_2D, textures[size_t(mat.texture)].name());
+    gl::draw(env_meshes[m]);
+  }
+  glDisable(GL_CULL_FACE);
+  glFrontFace(GL_CCW);
+  if (!reversed_depth) {  // the sky triangle lies at depth 1: it passes only where nothing was drawn
+    glDepthFunc(GL_LEQUAL);
+    glDepthMask(GL_FALSE);
+    drawSky();
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_LESS);
+  }
+  return count;
+}
+
+}  // namespace pvrr::gl

@@ -1,0 +1,56 @@
+// The environment in every pass: the sky and the scene's environment meshes (uploaded once, with their
+// textures), drawn from any camera in camera-relative coordinates; the lights' uniforms every program shares.
+#pragma once
+#include <array>
+#include <vector>
+
+#include "pvrr/gl/framebuffer.h"
+#include "pvrr/gl/gl_objects.h"
+#include "pvrr/gl/programs.h"
+#include "pvrr/gl/renderer.h"
+#include "pvrr/gl/stage_notes.h"
+
+namespace pvrr::gl {
+
+// The uniforms of shaders/shading.glsl, for a pass whose camera origin is `origin`.
+void setLights(const Program& p, const Scene& scene, const Vec3& origin);
+
+class EnvironmentPass {
+ public:
+  // Uploads the scene's textures and meshes and builds the sky's and the meshes' programs.
+  EnvironmentPass(const Scene& scene, const RendererOptions& options, const Programs& programs);
+  ~EnvironmentPass();
+  EnvironmentPass(const EnvironmentPass&) = delete;
+  EnvironmentPass& operator=(const EnvironmentPass&) = delete;
+
+  // Sky and environment from a camera at `origin` (view and proj in world coordinates).
+  // reversed_depth: the zooming-region pass (view_volume.h): the fragment farthest from the camera wins.
+  // rays_from: where the viewing rays start (two-sided normals face it); the camera unless given.
+  // Forward passes (not reversed_depth) draw the sky last, where the depth buffer is still clear, so that
+  // no pixel is shaded twice for it; what was drawn into the target before (the elements of the second
+  // pass, drawn first so that the environment behind them fails the early depth test) stays.
+  // planes: into a planes map. with_seen: write seen points even when RendererOptions::seen_points is off
+  // (impostor cube maps). peel: an impostor cube's second layer (the first layer's cubes bound from kPeelUnit and
+  // kFirstCubeUnit).
+  // Returns how many closed convex meshes it drew and culled.
+  CullCount draw(const Mat4& view, const Mat4& proj, const Vec3& origin, bool reversed_depth = false,
+                 const Vec3* rays_from = nullptr, bool planes = false, bool with_seen = false, bool peel = false) const;
+
+ private:
+  // The environment meshes' bounding boxes relative to `origin`.
+  std::vector<std::array<Vec3, 2>> boxes(const Vec3& origin) const;
+  // The order to draw them in: the scene's, or sorted by their distance (RendererOptions::sort_environment).
+  std::vector<size_t> drawOrder(const std::vector<std::array<Vec3, 2>>& boxes, bool reversed_depth) const;
+
+  const Scene& scene;
+  const RendererOptions& options;
+  const Programs& programs;
+  unsigned empty_vao = 0;  // the sky's triangle, made in its vertex shader
+  std::vector<MeshBuffers> env_meshes;
+  std::vector<bool> env_faceted;  // per environment mesh: every triangle has one normal at its three corners
+  std::vector<bool> env_textured;  // per environment mesh: its material has a texture
+  std::vector<std::array<Vec3, 2>> env_bounds;  // per environment mesh: its bounding box, relative to its anchor
+  std::vector<Texture> textures;  // environment textures, in Scene::textures order
+};
+
+}  // namespace pvrr::gl

@@ -1,0 +1,123 @@
+#include "pvrr/gl/programs.h"
+
+#include <algorithm>
+
+namespace pvrr::gl {
+
+namespace {
+
+// GLSL has no #include: splice `#include "file"` lines with the embedded file (one level, as used).
+std::string resolveIncludes(const std::string& src) {
+  std::string out;
+  size_t pos = 0;
+  while (pos < src.size()) {
+    size_t eol = src.find('\n', pos);
+    if (eol == std::string::npos) eol = src.size();
+    const std::string line = src.substr(pos, eol - pos);
+    const size_t q1 = line.find('"');
+    if (line.rfind("#include", 0) == 0 && q1 != std::string::npos) {
+      const size_t q2 = line.find('"', q1 + 1);
+      out += shaderSource(line.substr(q1 + 1, q2 - q1 - 1)) + "\n";
+    } else {
+      out += line + "\n";
+    }
+    pos = eol + 1;
+  }
+  return out;
+}
+
+Program makeProgram(const std::string& vert, const std::string& frag, const std::vector<std::string>& defines = {}) {
+  return Program::fromSources({vert, resolveIncludes(shaderSource(vert))}, {frag, resolveIncludes(shaderSource(frag))},
+                              defines);
+}
+
+}  // namespace
+
+// A program's defines, plus the scene's light counts (shaders/shading.glsl) and NO_SEEN_POINTS when
+// RendererOptions::seen_points is off, unless the variant writes seen points all the same (kWithSeenPoints).
+std::vector<std::string> Programs::defines(std::vector<std::string> d) const {
+  int dir = 0, point = 0;
+  for (const Light& l : scene_.lights) {
+    dir += l.type == Light::Type::Directional;
+    point += l.type == Light::Type::Point;
+  }
+  d.push_back("#define NUM_DIR_LIGHTS " + std::to_string(dir));
+  d.push_back("#define NUM_POINT_LIGHTS " + std::to_string(point));
+  if (!seen_points_ && std::find(d.begin(), d.end(), kWithSeenPoints) == d.end()) d.push_back("#define NO_SEEN_POINTS");
+  return d;
+}
+
+const Program& Programs::built(const std::string& vert, const std::string& frag, const std::vector<std::string>& d) const {
+  std::string key = vert + " " + frag;
+  for (const std::string& x : d) key += "|" + x;
+  std::unique_ptr<Program>& p = built_[key];
+  if (!p) p = std::make_unique<Program>(makeProgram(vert, frag, defines(d)));
+  return *p;
+}
+
+const Program& Programs::planesVariant(const std::string& vert, const std::string& frag, std::vector<std::string> d) const {
+  d.push_back("#define PLANES");
+  return built(vert, frag, d);
+}
+
+const Program& Programs::env(bool faceted, bool textured, bool planes, bool with_seen, bool peel) const {
+  std::vector<std::string> d;
+  if (with_seen) d.push_back(kWithSeenPoints);
+  if (peel) d.push_back("#define PEEL");
+  if (faceted) d.push_back("#define FACETED");
+  if (textured) d.push_back("#define TEXTURED");
+  if (planes) d.push_back("#define PLANES");
+  return built("env.vert", "env.frag", d);
+}
+
+const Program& Programs::sky(bool planes, bool with_seen, bool first_layer) const {
+  if (first_layer) return built("sky.vert", "sky.frag", {kWithSeenPoints, "#define PEEL", "#define FIRST_LAYER"});
+  if (with_seen && !seen_points_) return built("sky.vert", "sky.frag", {kWithSeenPoints});
+  return planes ? planesVariant("sky.vert", "sky.frag", {}) : built("sky.vert", "sky.frag", {});
+}
+
+const Program& Programs::plain(bool planes) const {
+  return planes ? planesVariant("element.vert", "element.frag", {"#define MODE_PLAIN"})
+                : built("element.vert", "element.frag", {"#define MODE_PLAIN"});
+}
+
+const Program& Programs::envmap(bool lens) const {
+  return lens ? built("element.vert", "element.frag", {"#define MODE_ENVMAP", "#define LENS"})
+              : built("element.vert", "element.frag", {"#define MODE_ENVMAP"});
+}
+
+const Program& Programs::pvrr(bool lens, size_t channels, bool rgb, bool planes) const {
+  std::vector<std::string> d = {"#define MODE_PVRR", channels > 1 ? "#define CHANNELS 3" : "#define CHANNELS 1"};
+  if (lens) d.push_back("#define LENS");
+  if (rgb) d.push_back("#define RGB_CHANNELS");
+  return planes ? planesVariant("element.vert", "element.frag", d) : built("element.vert", "element.frag", d);
+}
+
+const Program& Programs::impostor(bool lens, int channels, int cube_elements, bool lens_in_cubes, int layers,
+                                  int layer_draw) const {
+  std::vector<std::string> d{"#define MODE_IMPOSTOR",
+                             "#define IMPOSTOR_ITERATIONS " + std::to_string(scene_.render.impostor_iterations),
+                             "#define IMPOSTOR_CHANNELS " + std::to_string(channels),
+                             "#define IMPOSTOR_LAYERS " + std::to_string(layers)};
+  if (lens) d.push_back("#define LENS");
+  if (cube_elements > 0) d.push_back("#define CUBE_ELEMENTS " + std::to_string(cube_elements));
+  if (cube_elements > 0 && lens_in_cubes) d.push_back("#define LENS_IN_CUBES");
+  if (layer_draw == 1) d.push_back("#define LAYER_MARCH");
+  if (layer_draw == 2) d.push_back("#define LAYER_PROBE");
+  return built("element.vert", "element.frag", d);
+}
+
+const Program& Programs::cubeGeometry(bool lens, bool peel) const {
+  std::vector<std::string> d{"#define MODE_IMPOSTOR", "#define IMPOSTOR_ITERATIONS 0", "#define IMPOSTOR_CHANNELS 1",
+                             "#define IMPOSTOR_LAYERS 1", "#define CUBE_GEOMETRY", kWithSeenPoints};
+  if (lens) d.push_back("#define LENS");
+  if (peel) d.push_back("#define PEEL");
+  return built("element.vert", "element.frag", d);
+}
+
+const Program& Programs::mask() const {
+  if (!mask_) mask_ = std::make_unique<Program>(makeProgram("map_mask.vert", "map_mask.frag"));
+  return *mask_;
+}
+
+}  // namespace pvrr::gl

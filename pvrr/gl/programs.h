@@ -1,0 +1,66 @@
+// The renderer's GL programs, each compiled on first use and kept: by sources and defines, plus the scene's
+// light counts (shaders/shading.glsl) and NO_SEEN_POINTS when RendererOptions::seen_points is off. A renderer
+// compiles the sky and its scene's kinds of environment mesh when it is made (EnvironmentPass), so that their
+// compile errors come with it; the element programs of a mode when a frame of that mode first needs them.
+#pragma once
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pvrr/gl/program.h"
+#include "pvrr/scene/scene.h"
+
+namespace pvrr::gl {
+
+class Programs {
+ public:
+  Programs(const Scene& scene, bool seen_points) : scene_(scene), seen_points_(seen_points) {}
+
+  // A variant that writes seen points even with RendererOptions::seen_points off (the impostor cube maps,
+  // whose seen points are the distances the search reads).
+  static constexpr const char* kWithSeenPoints = "#define WITH_SEEN_POINTS";
+
+  // The program of these sources and defines (the scene's added), built on first use.
+  const Program& built(const std::string& vert, const std::string& frag, const std::vector<std::string>& d) const;
+  // The variant that draws into a planes map (PLANES, shaders/outputs.glsl), which only scenes with a lens with
+  // RGB dispersion need.
+  const Program& planesVariant(const std::string& vert, const std::string& frag, std::vector<std::string> d) const;
+
+  // Environment meshes (shaders/env.frag): FACETED (one normal per triangle), TEXTURED (a material with a
+  // texture; without, no texture is sampled: llvmpipe samples inside a uniform branch all the same).
+  // PEEL: the second layer of an impostor's distance map (shaders/outputs.glsl).
+  const Program& env(bool faceted, bool textured, bool planes, bool with_seen = false, bool peel = false) const;
+  // first_layer: an impostor cube's second layer, where nothing lies beyond the first (shaders/sky.frag).
+  const Program& sky(bool planes, bool with_seen = false, bool first_layer = false) const;
+  // Elements as plain surfaces (raster mode, and elements drawn dark at the depth limit).
+  const Program& plain(bool planes) const;
+  // Elements in envmap mode: a mirror, or a lens (LENS, the "refraction vectors" baseline).
+  const Program& envmap(bool lens) const;
+  // A pvrr element: its channels in one draw (1) or in sets of three (more: CHANNELS 3), a lens (LENS), with
+  // RGB dispersion (RGB_CHANNELS: its maps are planes); planes: drawn into a planes map.
+  const Program& pvrr(bool lens, size_t channels, bool rgb, bool planes) const;
+  // Distance-impostor elements (shaders/element.frag, MODE_IMPOSTOR): a mirror, or a lens with one or three
+  // wavelengths; cube_elements > 0: searches that meet a mirror in a cube go on in its cubes (CUBE_ELEMENTS).
+  // lens_in_cubes: the scene's one lens is drawn in the other elements' cubes and refracted through there.
+  // layers: of each distance map (IMPOSTOR_LAYERS; 2: the second depth-peeled, searched where the first fails).
+  // layer_draw, with two layers: 0 the first draw (it discards where it would search them), 1 the second
+  // (LAYER_MARCH), 2 the probe between them (LAYER_PROBE: no search; pvrr/gl/cube_pass.cpp).
+  const Program& impostor(bool lens, int channels, int cube_elements, bool lens_in_cubes, int layers,
+                          int layer_draw) const;
+  // An element drawn into another element's impostor cubes (CUBE_GEOMETRY): a mirror's exact surface point
+  // and normal, a lens's mesh point; and its index.
+  const Program& cubeGeometry(bool lens, bool peel) const;
+  // The depth mask of a first pass's unread texels (shaders/map_mask.*; no scene defines).
+  const Program& mask() const;
+
+ private:
+  std::vector<std::string> defines(std::vector<std::string> d) const;
+
+  const Scene& scene_;
+  bool seen_points_;
+  mutable std::map<std::string, std::unique_ptr<Program>> built_;
+  mutable std::unique_ptr<Program> mask_;
+};
+
+}  // namespace pvrr::gl

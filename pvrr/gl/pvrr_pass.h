@@ -1,0 +1,59 @@
+// Pvrr mode (the paper's two passes): the CPU stages (vertex rays, refraction, viewpoint fit, texture
+// coordinates, with eye-fixed caching), the first-pass maps the plan (pvrr/method/pass_plan.h) asks for, rendered
+// deepest first, and each element's draw with its maps, in the second pass or inside another element's map.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pvrr/gl/mode_pass.h"
+#include "pvrr/gl/stage_notes.h"
+#include "pvrr/method/pass_plan.h"
+
+namespace pvrr::gl {
+
+class PvrrPass : public ModePass {
+ public:
+  explicit PvrrPass(const RenderContext& c) : ctx(c) {}
+  ~PvrrPass() override;
+  PvrrPass(const PvrrPass&) = delete;
+  PvrrPass& operator=(const PvrrPass&) = delete;
+
+  void prepare(RasterMode mode, FrameStages& stages, FrameCache* cache) override;
+  bool additiveDraws() const override;
+  std::string drawElements(RasterMode mode, const PassCamera& eye, const Framebuffer& target) override;
+  std::vector<ElementFrame> takeElements() override { return std::move(frames); }
+
+ private:
+  // The CPU stages of the frame into `frames` and `opts`; returns whether nothing moved since the cached
+  // frame (its first pass is then kept).
+  bool cpuStages(FrameStages& stages, FrameCache* cache);
+  // The first pass and the nested passes, or why not (map reuse, the eye-fixed cache). skip_first_pass: nothing
+  // moved since the cached frame; continuing: a cache that holds an earlier frame (maps are widened for reuse).
+  void firstPass(FrameStages& stages, FrameCache* cache, bool skip_first_pass, bool continuing);
+  VertexStageOptions optionsFor(size_t e) const;
+  // Per map slot held: whether it is in R, G and B planes.
+  std::vector<bool> planesSlots() const;
+  Framebuffer& mapTarget(size_t i, int size, bool planes);
+  void uploadPatch(MeshBuffers& mb, const ElementFrame& f, const PatchView& pv, const Vec3& anchor, size_t set,
+                   size_t seen_channel) const;
+  void drawPvrrElement(const ElementFrame& f, size_t first_slot, const PassCamera& cam, int seen_channel);
+  void drawDarkElement(const ElementFrame& f, const PassCamera& cam);
+  int64_t closeUnreadTexels(const MapPass& mp, const std::array<int, 2>& region);
+  CullCount renderPasses(size_t whole_slots, int64_t* skipped, int64_t* texels);
+
+  RenderContext ctx;
+  std::vector<ElementFrame> frames;     // this frame's elements as seen from the eye
+  std::vector<VertexStageOptions> opts;  // and their vertex-stage options
+  PassPlan plan;                         // the last first pass's
+  std::vector<std::unique_ptr<Framebuffer>> maps;  // first-pass maps, one per patch view (reused)
+  std::vector<int> map_side;  // per map slot: the longer side its last first pass rendered (MapPass::side)
+  // The serial of the first pass whose maps this renderer holds (FrameCache::maps_serial): unique in the
+  // process (nextFirstPassSerial), so a cache filled by another renderer never matches.
+  uint64_t first_pass_serial = 0;
+  unsigned mask_vao = 0, mask_vbo = 0;  // closeUnreadTexels' quads
+};
+
+}  // namespace pvrr::gl
