@@ -158,31 +158,6 @@ void draw(const MeshBuffers& mb) {
   glDrawElements(GL_TRIANGLES, mb.count, GL_UNSIGNED_INT, nullptr);
 }
 
-// GLSL has no #include: splice `#include "file"` lines with the embedded file (one level, as used).
-std::string resolveIncludes(const std::string& src) {
-  std::string out;
-  size_t pos = 0;
-  while (pos < src.size()) {
-    size_t eol = src.find('\n', pos);
-    if (eol == std::string::npos) eol = src.size();
-    const std::string line = src.substr(pos, eol - pos);
-    const size_t q1 = line.find('"');
-    if (line.rfind("#include", 0) == 0 && q1 != std::string::npos) {
-      const size_t q2 = line.find('"', q1 + 1);
-      out += shaderSource(line.substr(q1 + 1, q2 - q1 - 1)) + "\n";
-    } else {
-      out += line + "\n";
-    }
-    pos = eol + 1;
-  }
-  return out;
-}
-
-Program makeProgram(const std::string& vert, const std::string& frag, const std::vector<std::string>& defines = {}) {
-  return Program::fromSources({vert, resolveIncludes(shaderSource(vert))}, {frag, resolveIncludes(shaderSource(frag))},
-                              defines);
-}
-
 // Element vertices (shaders/element.vert): position, normal, three texture-coordinate sets, three weights,
 // the seen point's coordinates, the traced colour of totally reflected vertices (rgb, and 1 where the seen
 // channel's is) and their traced seen point.
@@ -304,16 +279,16 @@ struct Renderer::Impl {
       d.push_back("#define NO_SEEN_POINTS");
     return d;
   }
-  Program sky_program = makeProgram("sky.vert", "sky.frag", defines({}));
-  Program plain_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_PLAIN"}));
-  Program envmap_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_ENVMAP"}));
-  Program lens_envmap_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_ENVMAP", "#define LENS"}));
-  Program pvrr_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_PVRR", "#define CHANNELS 1"}));
-  Program pvrr3_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_PVRR", "#define CHANNELS 3"}));
-  Program lens_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_PVRR", "#define CHANNELS 1", "#define LENS"}));
-  Program lens3_program = makeProgram("element.vert", "element.frag", defines({"#define MODE_PVRR", "#define CHANNELS 3", "#define LENS"}));
+  Program sky_program = Program("sky.vert", "sky.frag", defines({}));
+  Program plain_program = Program("element.vert", "element.frag", defines({"#define MODE_PLAIN"}));
+  Program envmap_program = Program("element.vert", "element.frag", defines({"#define MODE_ENVMAP"}));
+  Program lens_envmap_program = Program("element.vert", "element.frag", defines({"#define MODE_ENVMAP", "#define LENS"}));
+  Program pvrr_program = Program("element.vert", "element.frag", defines({"#define MODE_PVRR", "#define CHANNELS 1"}));
+  Program pvrr3_program = Program("element.vert", "element.frag", defines({"#define MODE_PVRR", "#define CHANNELS 3"}));
+  Program lens_program = Program("element.vert", "element.frag", defines({"#define MODE_PVRR", "#define CHANNELS 1", "#define LENS"}));
+  Program lens3_program = Program("element.vert", "element.frag", defines({"#define MODE_PVRR", "#define CHANNELS 3", "#define LENS"}));
   // RGB dispersion: its maps are R, G and B planes.
-  Program lens_rgb_program = makeProgram("element.vert", "element.frag",
+  Program lens_rgb_program = Program("element.vert", "element.frag",
                                          defines({"#define MODE_PVRR", "#define CHANNELS 3", "#define LENS", "#define RGB_CHANNELS"}));
   // Programs built on demand, by sources and defines: the environment's kinds of mesh that a scene has (built
   // with the renderer), and the variants that draw into a planes map (PLANES, on first use), which only scenes
@@ -323,7 +298,7 @@ struct Renderer::Impl {
     std::string key = vert + " " + frag;
     for (const std::string& x : d) key += "|" + x;
     std::unique_ptr<Program>& p = built_programs[key];
-    if (!p) p = std::make_unique<Program>(makeProgram(vert, frag, defines(d)));
+    if (!p) p = std::make_unique<Program>(vert, frag, defines(d));
     return *p;
   }
   const Program& planesVariant(const std::string& vert, const std::string& frag, std::vector<std::string> d) const {
@@ -388,7 +363,7 @@ struct Renderer::Impl {
       if (channelWeight(f.channels, c) != Vec3(c == 0, c == 1, c == 2)) return false;
     return true;
   }
-  Program mask_program = makeProgram("map_mask.vert", "map_mask.frag");
+  Program mask_program = Program("map_mask.vert", "map_mask.frag");
   GLuint empty_vao = 0;
   GLuint mask_vao = 0, mask_vbo = 0;  // closeUnreadTexels' quads
   int max_texture_size = 0;  // GL_MAX_TEXTURE_SIZE
