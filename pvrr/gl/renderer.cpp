@@ -229,7 +229,7 @@ bool mayBeInVolume(const std::vector<Vec3>& points, const Mat4& m) {
 }
 
 // A 2D float texture of w x h texels, 1 or 4 floats each, made or replaced in `tex`. The impostor shader
-// reads these maps with texelFetch and filters them in float itself (shaders/element.frag `bilinear`):
+// reads these maps with texelFetch and filters them in float itself (shaders/bilinear.glsl):
 // nearest, clamped.
 void uploadDataTexture(GLuint& tex, GLint internal_format, int w, int h, int channels, const float* data) {
   if (!tex) glGenTextures(1, &tex);
@@ -280,16 +280,16 @@ struct Renderer::Impl {
     return d;
   }
   Program sky_program = Program("sky.vert", "sky.frag", defines({}));
-  Program plain_program = Program("element.vert", "element.frag", defines({"#define MODE_PLAIN"}));
-  Program envmap_program = Program("element.vert", "element.frag", defines({"#define MODE_ENVMAP"}));
-  Program lens_envmap_program = Program("element.vert", "element.frag", defines({"#define MODE_ENVMAP", "#define LENS"}));
-  Program pvrr_program = Program("element.vert", "element.frag", defines({"#define MODE_PVRR", "#define CHANNELS 1"}));
-  Program pvrr3_program = Program("element.vert", "element.frag", defines({"#define MODE_PVRR", "#define CHANNELS 3"}));
-  Program lens_program = Program("element.vert", "element.frag", defines({"#define MODE_PVRR", "#define CHANNELS 1", "#define LENS"}));
-  Program lens3_program = Program("element.vert", "element.frag", defines({"#define MODE_PVRR", "#define CHANNELS 3", "#define LENS"}));
+  Program plain_program = Program("element.vert", "element_plain.frag", defines({}));
+  Program envmap_program = Program("element.vert", "element_envmap.frag", defines({}));
+  Program lens_envmap_program = Program("element.vert", "element_envmap.frag", defines({"#define LENS"}));
+  Program pvrr_program = Program("element.vert", "element_pvrr.frag", defines({"#define CHANNELS 1"}));
+  Program pvrr3_program = Program("element.vert", "element_pvrr.frag", defines({"#define CHANNELS 3"}));
+  Program lens_program = Program("element.vert", "element_pvrr.frag", defines({"#define CHANNELS 1", "#define LENS"}));
+  Program lens3_program = Program("element.vert", "element_pvrr.frag", defines({"#define CHANNELS 3", "#define LENS"}));
   // RGB dispersion: its maps are R, G and B planes.
-  Program lens_rgb_program = Program("element.vert", "element.frag",
-                                         defines({"#define MODE_PVRR", "#define CHANNELS 3", "#define LENS", "#define RGB_CHANNELS"}));
+  Program lens_rgb_program = Program("element.vert", "element_pvrr.frag",
+                                     defines({"#define CHANNELS 3", "#define LENS", "#define RGB_CHANNELS"}));
   // Programs built on demand, by sources and defines: the environment's kinds of mesh that a scene has (built
   // with the renderer), and the variants that draw into a planes map (PLANES, on first use), which only scenes
   // with a lens with RGB dispersion need.
@@ -324,7 +324,7 @@ struct Renderer::Impl {
     if (with_seen && !options.seen_points) return builtProgram("sky.vert", "sky.frag", {kWithSeenPoints});
     return planes ? planesVariant("sky.vert", "sky.frag", {}) : sky_program;
   }
-  // Distance-impostor elements (shaders/element.frag, MODE_IMPOSTOR): a mirror, or a lens with one or three
+  // Distance-impostor elements (shaders/element_impostor.frag): a mirror, or a lens with one or three
   // wavelengths; cube_elements > 0: searches that meet a mirror in a cube go on in its cubes (CUBE_ELEMENTS).
   // lens_in_cubes: the scene's one lens is drawn in the other elements' cubes and refracted through there.
   // layers: of each distance map (IMPOSTOR_LAYERS; 2: the second depth-peeled, searched where the first fails).
@@ -332,8 +332,7 @@ struct Renderer::Impl {
   // (LAYER_MARCH), 2 the probe between them (LAYER_PROBE: no search; pvrr/gl/renderer.cpp).
   const Program& impostorProgram(bool lens, int channels, int cube_elements, bool lens_in_cubes, int layers,
                                  int layer_draw) const {
-    std::vector<std::string> d{"#define MODE_IMPOSTOR",
-                               "#define IMPOSTOR_ITERATIONS " + std::to_string(scene.render.impostor_iterations),
+    std::vector<std::string> d{"#define IMPOSTOR_ITERATIONS " + std::to_string(scene.render.impostor_iterations),
                                "#define IMPOSTOR_CHANNELS " + std::to_string(channels),
                                "#define IMPOSTOR_LAYERS " + std::to_string(layers)};
     if (lens) d.push_back("#define LENS");
@@ -341,19 +340,19 @@ struct Renderer::Impl {
     if (cube_elements > 0 && lens_in_cubes) d.push_back("#define LENS_IN_CUBES");
     if (layer_draw == 1) d.push_back("#define LAYER_MARCH");
     if (layer_draw == 2) d.push_back("#define LAYER_PROBE");
-    return builtProgram("element.vert", "element.frag", d);
+    return builtProgram("element.vert", "element_impostor.frag", d);
   }
   // An element drawn into another element's impostor cubes (CUBE_GEOMETRY): a mirror's exact surface point
   // and normal, a lens's mesh point; and its index.
   const Program& cubeGeometryProgram(bool lens, bool peel) const {
-    std::vector<std::string> d{"#define MODE_IMPOSTOR", "#define IMPOSTOR_ITERATIONS 0", "#define IMPOSTOR_CHANNELS 1",
+    std::vector<std::string> d{"#define IMPOSTOR_ITERATIONS 0", "#define IMPOSTOR_CHANNELS 1",
                                "#define IMPOSTOR_LAYERS 1", "#define CUBE_GEOMETRY", kWithSeenPoints};
     if (lens) d.push_back("#define LENS");
     if (peel) d.push_back("#define PEEL");
-    return builtProgram("element.vert", "element.frag", d);
+    return builtProgram("element.vert", "element_impostor.frag", d);
   }
   const Program& plainProgram(bool planes) const {
-    return planes ? planesVariant("element.vert", "element.frag", {"#define MODE_PLAIN"}) : plain_program;
+    return planes ? planesVariant("element.vert", "element_plain.frag", {}) : plain_program;
   }
   // A lens with RGB dispersion (three channels of unit R, G and B weights): its maps are planes, its second
   // pass reads one component per channel.
@@ -664,7 +663,7 @@ struct Renderer::Impl {
     p.set("u_to_local", glm::mat3(Mat3(scene.elements[e].world_to_local)));
   }
 
-  // The uniforms of a lens's impostor draw (shaders/element.frag, MODE_IMPOSTOR with LENS): its height maps
+  // The uniforms of a lens's impostor draw (shaders/element_impostor.frag with LENS): its height maps
   // and outline mask on units 2 to 4, their placement, its pose, its index at the R, G and B wavelengths, and
   // the tracer's depth limit and far distance.
   // first_unit and rotation: where a mirror's program that meets the lens in its cubes takes them
@@ -1218,10 +1217,10 @@ struct Renderer::Impl {
     const Program* base = lens ? (rgb ? &lens_rgb_program : channels > 1 ? &lens3_program : &lens_program)
                                : (channels > 1 ? &pvrr3_program : &pvrr_program);
     if (cam.planes) {  // drawn into a planes map (only RGB scenes have them: never more than three channels)
-      std::vector<std::string> d = {"#define MODE_PVRR", channels > 1 ? "#define CHANNELS 3" : "#define CHANNELS 1"};
+      std::vector<std::string> d = {channels > 1 ? "#define CHANNELS 3" : "#define CHANNELS 1"};
       if (lens) d.push_back("#define LENS");
       if (rgb) d.push_back("#define RGB_CHANNELS");
-      base = &planesVariant("element.vert", "element.frag", d);
+      base = &planesVariant("element.vert", "element_pvrr.frag", d);
     }
     const Program& p = *base;
     p.use();
