@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cstddef>
 #include <cstring>
+#include <limits>
 
 #include "cad/error.h"
 #include "pvrr/gl/gl.h"
@@ -49,8 +50,9 @@ std::string programLog(GLuint program) {
   return log.empty() ? "(empty info log)" : log;
 }
 
-// `log` with each message's location "S:L(C)" (Mesa), "S(L)" (NVIDIA) or "ERROR: S:L:" (others), S a GLSL
-// source-string number of `files`, written with that file's name in place of S.
+// `log` with each message's location "S:L(C)" (Mesa), "S(L)" (NVIDIA) or "ERROR: S:L:" (others) written as
+// "file:line(C)", "file(line)", "ERROR: file:line:", the file files[L / kShaderFileLines] (shaderWithIncludes;
+// S, the GLSL source-string number, is not reliable: see there) and line L % kShaderFileLines.
 std::string translateLog(const std::string& log, const std::vector<std::string>& files) {
   if (files.empty()) return log;
   std::string out;
@@ -63,11 +65,20 @@ std::string translateLog(const std::string& log, const std::vector<std::string>&
     std::size_t at = 0;
     for (const char* prefix : {"ERROR: ", "WARNING: "})
       if (line.compare(0, std::strlen(prefix), prefix) == 0) at = std::strlen(prefix);
-    std::size_t digits = at;
-    while (digits < line.size() && std::isdigit(static_cast<unsigned char>(line[digits]))) ++digits;
-    if (digits > at && digits - at < 6 && digits < line.size() && (line[digits] == ':' || line[digits] == '(')) {
-      const std::size_t number = std::stoul(line.substr(at, digits - at));
-      if (number < files.size()) line = line.substr(0, at) + files[number] + line.substr(digits);
+    const auto digitsFrom = [&line](std::size_t i) {
+      while (i < line.size() && std::isdigit(static_cast<unsigned char>(line[i]))) ++i;
+      return i;
+    };
+    const std::size_t source_end = digitsFrom(at);
+    const std::size_t line_end = source_end < line.size() ? digitsFrom(source_end + 1) : source_end;
+    if (source_end > at && source_end - at < 6 && line_end > source_end + 1 && line_end - source_end < 12 &&
+        (line[source_end] == ':' || line[source_end] == '(')) {
+      const long long number = std::stoll(line.substr(source_end + 1, line_end - source_end - 1));
+      const auto file = static_cast<std::size_t>(number / kShaderFileLines);
+      if (file < files.size()) {
+        line = line.substr(0, at) + files[file] + line[source_end] + std::to_string(number % kShaderFileLines) +
+               line.substr(line_end);
+      }
     }
     out += line;
   }
@@ -137,7 +148,8 @@ void spliceIncludes(IncludeState& state, const std::string& name, int number, co
     if (eol == std::string::npos) eol = text.size();
     const std::string line = text.substr(pos, eol - pos);
     pos = eol + 1;
-    ++line_number;
+    if (++line_number >= kShaderFileLines)
+      throw Error(name + ": more than " + std::to_string(kShaderFileLines - 1) + " lines");
     const std::string where = name + ":" + std::to_string(line_number) + ": ";
     if (isDirective(line, "if") || isDirective(line, "ifdef") || isDirective(line, "ifndef")) ++depth;
     if (isDirective(line, "endif")) --depth;
@@ -164,10 +176,14 @@ void spliceIncludes(IncludeState& state, const std::string& name, int number, co
     }
     const int included_number = static_cast<int>(state.files.size());
     state.files.push_back(included);
+    if (included_number >= std::numeric_limits<int>::max() / kShaderFileLines - 1)
+      throw Error(where + "more than " + std::to_string(included_number) + " files included");
     // GLSL >= 3.30: "#line N S" numbers the following line N, of source string S.
-    out += "#line 1 " + std::to_string(included_number) + "\n";
+    out += "#line " + std::to_string(included_number * kShaderFileLines + 1) + " " + std::to_string(included_number) +
+           "\n";
     spliceIncludes(state, included, included_number, included_text, out);
-    out += "#line " + std::to_string(line_number + 1) + " " + std::to_string(number) + "\n";
+    out += "#line " + std::to_string(number * kShaderFileLines + line_number + 1) + " " + std::to_string(number) +
+           "\n";
   }
 }
 

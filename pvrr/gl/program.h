@@ -24,23 +24,29 @@ std::vector<std::string> embeddedShaderNames();
 // names when there is none. Needs no GL context.
 std::string shaderSource(const std::string& file_name);
 
-// A shader's file name (used in every message) and its text. `files`: the file of each GLSL source-string
-// number that `text`'s "#line N S" directives use (files[0] is `name`; empty: the text has no other); compiler
-// messages are translated through it ("1:12(3): error" -> "optics.glsl:12(3): error").
+// A shader's file name (used in every message) and its text. `files`: the files spliced into `text` by
+// shaderWithIncludes, by number (files[0] is `name`; empty: the text has no other); compiler messages are
+// translated through it ("0:100012(3): error" -> "optics.glsl:12(3): error" for files[1]).
 struct ShaderSource {
   std::string name;
   std::string text;
   std::vector<std::string> files = {};
 };
 
+// Line numbers of shader file S (shaderWithIncludes) start at S kShaderFileLines + 1: no file has more lines.
+inline constexpr int kShaderFileLines = 100000;
+
 // The text of a shader file by name (shaderSource for the embedded files; tests give their own).
 using ShaderFileLookup = std::function<std::string(const std::string& file_name)>;
 
 // The shader `file_name` with every line `#include "other.glsl"` replaced by that file's text, recursively; a
 // file already included into this shader is not included again (once-only: libraries need no include guards).
-// Each file gets a GLSL source-string number in order of first inclusion (0: `file_name`) and its text is framed
-// by "#line 1 S" before and "#line N P" after (P, N: the including file's number and next line), so that
-// compiler messages name the true file and line (ShaderSource::files). GLSL has no #include, and the splicing
+// Each file gets a number S in order of first inclusion (0: `file_name`) and its text is framed by
+// "#line (S kShaderFileLines + 1) S" before and "#line (P kShaderFileLines + N) P" after (P, N: the including
+// file's number and next line), so that compiler messages name the true file and line (ShaderSource::files).
+// The file is in the line number as well as in GLSL's source-string number because Mesa reports source string
+// 0 for every location its parser derives from a rule rather than a token (YYLLOC_DEFAULT), with the right line
+// and column: the line number is what the log translation reads. GLSL has no #include, and the splicing
 // happens before the preprocessor: an #include inside #if/#ifdef/#ifndef throws pvrr::Error (it would be
 // spliced, and counted once-only, whatever the condition), as does an unknown file (naming the including
 // file and line). `lookup` defaults to the embedded files.
