@@ -3,6 +3,7 @@
 // reflects there and goes on in that mirror's cubes (followCubes); LENS_IN_CUBES: the other elements' cubes
 // show the scene's one lens too, and a search that meets it refracts through its height maps and goes on in
 // the lens's cubes.
+#include "cpp_constants.glsl"
 #include "impostor_search.glsl"
 #include "lens_march.glsl"
 #include "optics.glsl"
@@ -126,7 +127,7 @@ vec3 followCubes(int cur, vec3 x, vec3 R, int depth, int channel, out vec4 seen,
     seen = vec4(p, 1.0);
     if (depth >= u_max_depth) return vec3(0.0);  // the tracer's depth limit: absorbed
     float cos_i = -dot(R, n);
-    if (cos_i <= 0.0) return throughput * 0.05 * shadeDiffuse(vec3(1.0), p, -n);  // the mirror's back
+    if (cos_i <= 0.0) return throughput * MIRROR_BACK_ALBEDO * shadeDiffuse(vec3(1.0), p, -n);  // the mirror's back
     throughput *= u_el_metal[hit] ? vec3(fresnelConductor(cos_i, u_el_metal_n[hit].r, u_el_metal_k[hit].r),
                                          fresnelConductor(cos_i, u_el_metal_n[hit].g, u_el_metal_k[hit].g),
                                          fresnelConductor(cos_i, u_el_metal_n[hit].b, u_el_metal_k[hit].b))

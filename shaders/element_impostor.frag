@@ -148,8 +148,8 @@ void main() {
   return;
 #endif
   vec3 weight = vec3(1.0);
-  if (cos_i <= 0.0) {  // the mirror's back: dark (tracer: kMirrorBackAlbedo), once, not in each additive draw
-    o_color = u_additive ? vec4(0.0) : vec4(0.05 * shadeDiffuse(vec3(1.0), v_pos, -n), 1.0);
+  if (cos_i <= 0.0) {  // the mirror's back: dark (as the tracer), once, not in each additive draw
+    o_color = u_additive ? vec4(0.0) : vec4(MIRROR_BACK_ALBEDO * shadeDiffuse(vec3(1.0), v_pos, -n), 1.0);
     o_seen = vec4(v_pos, 1.0);
     return;
   }

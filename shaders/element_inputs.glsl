@@ -1,5 +1,6 @@
 // The inputs of every element fragment shader (element_plain.frag, element_pvrr.frag, element_envmap.frag,
 // element_impostor.frag): element.vert's outputs and the uniforms all modes share.
+#include "cpp_constants.glsl"
 in vec3 v_pos;
 in vec3 v_normal;
 in vec3 v_st0;

@@ -1,13 +1,16 @@
 #include "pvrr/gl/program.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cctype>
+#include <cmath>
 #include <cstddef>
 #include <cstring>
 #include <limits>
 
 #include "cad/error.h"
 #include "pvrr/gl/gl.h"
+#include "pvrr/shading.h"
 
 namespace pvrr::gl {
 namespace detail {
@@ -196,8 +199,21 @@ ShaderSource shaderWithIncludes(const std::string& file_name, const ShaderFileLo
   return {file_name, text, state.files};
 }
 
+std::string glslFloat(double value) {
+  if (!std::isfinite(static_cast<float>(value)))
+    throw Error("glslFloat: " + std::to_string(value) + " has no GLSL float literal");
+  char buffer[32];
+  const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, static_cast<float>(value));
+  if (ec != std::errc()) throw Error("glslFloat: cannot write " + std::to_string(value));
+  std::string text(buffer, end);
+  if (text.find_first_of(".eE") == std::string::npos && text.find_first_of("0123456789") != std::string::npos)
+    text += ".0";
+  return text;
+}
+
 std::string cppConstantsSource() {
-  return "// Values owned by C++ (pvrr/gl/program.cpp cppConstantsSource), not retyped in shaders.\n";
+  return "// Values owned by C++ (pvrr/gl/program.cpp cppConstantsSource), not retyped in shaders.\n"
+         "#define MIRROR_BACK_ALBEDO " + glslFloat(kMirrorBackAlbedo) + "  // pvrr/shading.h kMirrorBackAlbedo\n";
 }
 
 std::string insertDefines(const std::string& source, const std::vector<std::string>& defines) {

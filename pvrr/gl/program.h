@@ -57,6 +57,9 @@ ShaderSource shaderWithIncludes(const std::string& file_name, const ShaderFileLo
 // are written so that GLSL parses the same float as the C++ constant rounded to float.
 inline constexpr const char* kCppConstantsFile = "cpp_constants.glsl";
 std::string cppConstantsSource();
+// `value` rounded to float, as a GLSL float literal that parses to exactly that float: the shortest decimal that
+// round-trips ("0.05", "1e-05", "2.0"); infinities and NaN throw pvrr::Error (GLSL has no literal for them).
+std::string glslFloat(double value);
 
 // `source` with `defines` inserted after its #version line (at the top when it has none), followed by a #line
 // directive so that compiler messages keep the file's own line numbers. Each define is a full line

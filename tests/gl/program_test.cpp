@@ -70,6 +70,16 @@ TEST(ShaderIncludes, CppConstantsAreAVirtualInclude) {
   EXPECT_NE(s.text.find(cppConstantsSource()), std::string::npos) << s.text;
 }
 
+TEST(ShaderIncludes, CppFloatsAreWrittenAsTheSameGlslFloat) {
+  EXPECT_EQ(glslFloat(0.05), "0.05");
+  EXPECT_EQ(glslFloat(2.0), "2.0");
+  EXPECT_EQ(glslFloat(-0.25), "-0.25");
+  for (double v : {0.05, 1.0 / 3.0, 1e-5, 6.02e23, -7.5e-12})
+    EXPECT_EQ(std::strtof(glslFloat(v).c_str(), nullptr), static_cast<float>(v)) << glslFloat(v);
+  EXPECT_THROW(glslFloat(1e300), Error);
+  EXPECT_NE(cppConstantsSource().find("#define MIRROR_BACK_ALBEDO 0.05 "), std::string::npos) << cppConstantsSource();
+}
+
 TEST(ShaderIncludes, EveryEmbeddedShaderResolves) {
   for (const std::string& name : embeddedShaderNames()) {
     const std::string text = shaderWithIncludes(name).text;
