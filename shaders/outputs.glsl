@@ -1,4 +1,4 @@
-// The fragment outputs of every program that draws into a pass (env.frag, sky.frag, element.frag), by
+// The fragment outputs of every program that draws into a pass (env.frag, sky.frag, element_*.frag), by
 // variant. The shader writes o_color, o_seen and o_surface; what they become:
 //   default          location 0 colour, 1 seen point, 2 surface point (second pass; pvrr maps have no 2; the
 //                    impostor cubes of a scene of several elements take there the normal and index of the
