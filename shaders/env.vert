@@ -13,11 +13,11 @@ uniform vec3 u_offset;
 out vec3 v_pos;            // relative to the camera origin
 out vec3 v_normal;
 out vec2 v_uv;
+#include "shading.glsl"
 #if defined(FACETED)
 uniform vec3 u_view_origin;
 flat out vec3 v_face_normal;  // facing the viewer
 flat out vec3 v_face_light;   // ambientAndDirectional(v_face_normal)
-#include "shading.glsl"
 #endif
 void main() {
   v_pos = a_pos + u_offset;

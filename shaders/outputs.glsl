@@ -1,4 +1,4 @@
-// The fragment outputs of every program that draws into a pass (env.frag, sky.frag, element.frag), by
+// The fragment outputs of every program that draws into a pass (env.frag, sky.frag, element_*.frag), by
 // variant. The shader writes o_color, o_seen and o_surface; what they become:
 //   default          location 0 colour, 1 seen point, 2 surface point (second pass; pvrr maps have no 2; the
 //                    impostor cubes of a scene of several elements take there the normal and index of the
@@ -24,7 +24,7 @@ vec4 o_surface;  // maps have no surface attachment
 layout(location = 1) out vec4 o_seen;
 layout(location = 2) out vec4 o_surface;
 #endif
-// PEEL: the second layer of an impostor's distance map (seeds 001, depth peeling): a fragment no farther from
+// PEEL: the second layer of an impostor's distance map ([Umenhoffer et al.], depth peeling): a fragment no farther from
 // the cube's origin than the first layer's surface in its direction (u_peel, the first layer's seen points,
 // relative to the same origin) is dropped, so the layer holds the nearest surface beyond it. PEEL_GAP: the
 // relative margin that drops the first layer's own surface, whose filtered distance between the first layer's

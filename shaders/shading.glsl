@@ -1,7 +1,7 @@
 // The environment shading model; keep in step with pvrr/trace/shading.cpp (the reference tracer's copy).
 //   colour = albedo(uv) * (sum ambient + sum_dir max(0, n.(-dir)) L + sum_point max(0, n.l) L / d^2)
 // Positions are relative to the camera origin of the current pass (camera-relative rendering).
-// Specialised to the scene's lights when the program is built (pvrr/gl/renderer.cpp prepends
+// Specialised to the scene's lights when the program is built (pvrr/gl/programs.cpp prepends
 // NUM_DIR_LIGHTS and NUM_POINT_LIGHTS): constant loop bounds and no per-light branches, the ambient lights
 // summed into one colour. A loop over a uniform light count with a type switch per light cost llvmpipe
 // more than half of a 1280 x 720 raster frame.

@@ -1,5 +1,5 @@
 // Bilinear interpolation of a grid of RGBA float samples, as the impostor shader reads its maps
-// (shaders/element.frag `bilinear`: GL_LINEAR with clamp-to-edge, in float weights). For the maps' CPU twins
+// (shaders/bilinear.glsl: GL_LINEAR with clamp-to-edge, in float weights). For the maps' CPU twins
 // and their tests.
 #pragma once
 #include <algorithm>

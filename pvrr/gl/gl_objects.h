@@ -50,7 +50,7 @@ void uploadMesh(MeshBuffers& mb, const std::vector<float>& data, const std::vect
 void draw(const MeshBuffers& mb);
 
 // A 2D float texture of w x h texels, 1 or 4 floats each, made or replaced in `tex`. The impostor shader
-// reads these maps with texelFetch and filters them in float itself (shaders/element.frag `bilinear`):
+// reads these maps with texelFetch and filters them in float itself (shaders/bilinear.glsl):
 // nearest, clamped.
 void uploadDataTexture(unsigned& tex, int internal_format, int w, int h, int channels, const float* data);
 

@@ -43,7 +43,7 @@ class ImpostorMaps {
   // The uniforms of a mirror's impostor draw: its surface maps on units 2 to 5, the samples' placement in
   // their textures, and its pose.
   void setMirrorMaps(const Program& p, size_t e) const;
-  // The uniforms of a lens's impostor draw (shaders/element.frag, MODE_IMPOSTOR with LENS): its height maps
+  // The uniforms of a lens's impostor draw (shaders/element_impostor.frag with LENS): its height maps
   // and outline mask on units 2 to 4, their placement, its pose, its index at the R, G and B wavelengths, and
   // the tracer's depth limit and far distance.
   // first_unit and rotation: where a mirror's program that meets the lens in its cubes takes them

@@ -1,10 +1,16 @@
 #include "pvrr/gl/program.h"
 
 #include <algorithm>
+#include <charconv>
+#include <cctype>
+#include <cmath>
 #include <cstddef>
+#include <cstring>
+#include <limits>
 
 #include "pvrr/base/error.h"
 #include "pvrr/gl/gl.h"
+#include "pvrr/trace/shading.h"
 
 namespace pvrr::gl {
 namespace detail {
@@ -47,6 +53,41 @@ std::string programLog(GLuint program) {
   return log.empty() ? "(empty info log)" : log;
 }
 
+// `log` with each message's location "S:L(C)" (Mesa), "S(L)" (NVIDIA) or "ERROR: S:L:" (others) written as
+// "file:line(C)", "file(line)", "ERROR: file:line:", the file files[L / kShaderFileLines] (shaderWithIncludes;
+// S, the GLSL source-string number, is not reliable: see there) and line L % kShaderFileLines.
+std::string translateLog(const std::string& log, const std::vector<std::string>& files) {
+  if (files.empty()) return log;
+  std::string out;
+  std::size_t pos = 0;
+  while (pos < log.size()) {
+    std::size_t end = log.find('\n', pos);
+    end = end == std::string::npos ? log.size() : end + 1;
+    std::string line = log.substr(pos, end - pos);
+    pos = end;
+    std::size_t at = 0;
+    for (const char* prefix : {"ERROR: ", "WARNING: "})
+      if (line.compare(0, std::strlen(prefix), prefix) == 0) at = std::strlen(prefix);
+    const auto digitsFrom = [&line](std::size_t i) {
+      while (i < line.size() && std::isdigit(static_cast<unsigned char>(line[i]))) ++i;
+      return i;
+    };
+    const std::size_t source_end = digitsFrom(at);
+    const std::size_t line_end = source_end < line.size() ? digitsFrom(source_end + 1) : source_end;
+    if (source_end > at && source_end - at < 6 && line_end > source_end + 1 && line_end - source_end < 12 &&
+        (line[source_end] == ':' || line[source_end] == '(')) {
+      const long long number = std::stoll(line.substr(source_end + 1, line_end - source_end - 1));
+      const auto file = static_cast<std::size_t>(number / kShaderFileLines);
+      if (file < files.size()) {
+        line = line.substr(0, at) + files[file] + line[source_end] + std::to_string(number % kShaderFileLines) +
+               line.substr(line_end);
+      }
+    }
+    out += line;
+  }
+  return out;
+}
+
 GLuint compile(GLenum stage, const ShaderSource& source, const std::vector<std::string>& defines) {
   const char* stage_name = stage == GL_VERTEX_SHADER ? "vertex" : "fragment";
   const std::string text = insertDefines(source.text, defines);
@@ -58,7 +99,8 @@ GLuint compile(GLenum stage, const ShaderSource& source, const std::vector<std::
   GLint ok = GL_FALSE;
   glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
   if (ok != GL_TRUE) {
-    const std::string log = shaderLog(shader);
+    const std::string log = translateLog(shaderLog(shader), source.files.empty() ? std::vector<std::string>{source.name}
+                                                                                 : source.files);
     glDeleteShader(shader);
     throw Error(source.name + ": " + stage_name + " shader compile failed" + definesLabel(defines) + ":\n" + log);
   }
@@ -79,6 +121,99 @@ std::string shaderSource(const std::string& file_name) {
     if (file_name == detail::kEmbeddedShaders[i].name) return detail::kEmbeddedShaders[i].source;
   }
   throw Error("no embedded shader \"" + file_name + "\"; available: " + joined(embeddedShaderNames(), ", "));
+}
+
+namespace {
+
+// Whether `line` is the preprocessor directive `name` ("#  include" counts as "#include").
+bool isDirective(const std::string& line, const char* name) {
+  std::size_t i = line.find_first_not_of(" \t");
+  if (i == std::string::npos || line[i] != '#') return false;
+  i = line.find_first_not_of(" \t", i + 1);
+  const std::size_t n = std::strlen(name);
+  if (i == std::string::npos || line.compare(i, n, name) != 0) return false;
+  return i + n == line.size() || !(std::isalnum(static_cast<unsigned char>(line[i + n])) || line[i + n] == '_');
+}
+
+struct IncludeState {
+  const ShaderFileLookup& lookup;
+  std::vector<std::string> files;  // by source-string number
+};
+
+// Appends `name`'s text (numbered `number`) to `out` with its includes spliced in.
+void spliceIncludes(IncludeState& state, const std::string& name, int number, const std::string& text,
+                    std::string& out) {
+  int depth = 0;  // of #if/#ifdef/#ifndef in this file
+  int line_number = 0;
+  std::size_t pos = 0;
+  while (pos < text.size()) {
+    std::size_t eol = text.find('\n', pos);
+    if (eol == std::string::npos) eol = text.size();
+    const std::string line = text.substr(pos, eol - pos);
+    pos = eol + 1;
+    if (++line_number >= kShaderFileLines)
+      throw Error(name + ": more than " + std::to_string(kShaderFileLines - 1) + " lines");
+    const std::string where = name + ":" + std::to_string(line_number) + ": ";
+    if (isDirective(line, "if") || isDirective(line, "ifdef") || isDirective(line, "ifndef")) ++depth;
+    if (isDirective(line, "endif")) --depth;
+    if (!isDirective(line, "include")) {
+      out += line + "\n";
+      continue;
+    }
+    const std::size_t q1 = line.find('"'), q2 = q1 == std::string::npos ? q1 : line.find('"', q1 + 1);
+    if (q2 == std::string::npos) throw Error(where + "expected #include \"file\", got: " + line);
+    if (depth > 0) {
+      throw Error(where + "#include inside #if/#ifdef/#ifndef: includes are spliced before the preprocessor "
+                          "runs, whatever the condition; include at the top level");
+    }
+    const std::string included = line.substr(q1 + 1, q2 - q1 - 1);
+    if (std::find(state.files.begin(), state.files.end(), included) != state.files.end()) {
+      out += "// " + line.substr(line.find('#')) + ": included already\n";  // once-only; keeps the numbering
+      continue;
+    }
+    std::string included_text;
+    try {
+      included_text = included == kCppConstantsFile ? cppConstantsSource() : state.lookup(included);
+    } catch (const Error& e) {
+      throw Error(where + e.what());
+    }
+    const int included_number = static_cast<int>(state.files.size());
+    state.files.push_back(included);
+    if (included_number >= std::numeric_limits<int>::max() / kShaderFileLines - 1)
+      throw Error(where + "more than " + std::to_string(included_number) + " files included");
+    // GLSL >= 3.30: "#line N S" numbers the following line N, of source string S.
+    out += "#line " + std::to_string(included_number * kShaderFileLines + 1) + " " + std::to_string(included_number) +
+           "\n";
+    spliceIncludes(state, included, included_number, included_text, out);
+    out += "#line " + std::to_string(number * kShaderFileLines + line_number + 1) + " " + std::to_string(number) +
+           "\n";
+  }
+}
+
+}  // namespace
+
+ShaderSource shaderWithIncludes(const std::string& file_name, const ShaderFileLookup& lookup) {
+  IncludeState state{lookup, {file_name}};
+  std::string text;
+  spliceIncludes(state, file_name, 0, lookup(file_name), text);
+  return {file_name, text, state.files};
+}
+
+std::string glslFloat(double value) {
+  if (!std::isfinite(static_cast<float>(value)))
+    throw Error("glslFloat: " + std::to_string(value) + " has no GLSL float literal");
+  char buffer[32];
+  const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, static_cast<float>(value));
+  if (ec != std::errc()) throw Error("glslFloat: cannot write " + std::to_string(value));
+  std::string text(buffer, end);
+  if (text.find_first_of(".eE") == std::string::npos && text.find_first_of("0123456789") != std::string::npos)
+    text += ".0";
+  return text;
+}
+
+std::string cppConstantsSource() {
+  return "// Values owned by C++ (pvrr/gl/program.cpp cppConstantsSource), not retyped in shaders.\n"
+         "#define MIRROR_BACK_ALBEDO " + glslFloat(kMirrorBackAlbedo) + "  // pvrr/trace/shading.h kMirrorBackAlbedo\n";
 }
 
 std::string insertDefines(const std::string& source, const std::vector<std::string>& defines) {
@@ -108,8 +243,7 @@ std::string insertDefines(const std::string& source, const std::vector<std::stri
 
 Program::Program(const std::string& vertex_file, const std::string& fragment_file,
                  const std::vector<std::string>& defines)
-    : Program(fromSources({vertex_file, shaderSource(vertex_file)}, {fragment_file, shaderSource(fragment_file)},
-                          defines)) {}
+    : Program(fromSources(shaderWithIncludes(vertex_file), shaderWithIncludes(fragment_file), defines)) {}
 
 Program Program::fromSources(const ShaderSource& vertex, const ShaderSource& fragment,
                              const std::vector<std::string>& defines) {

@@ -2,6 +2,7 @@
 // file name, see cmake/EmbedShaders.cmake). Variants are made by #define lines inserted after the #version line.
 // Everything here needs a current pvrr::gl::GlContext.
 #pragma once
+#include <functional>
 #include <string>
 #include <unordered_map>
 #include <utility>
@@ -23,11 +24,42 @@ std::vector<std::string> embeddedShaderNames();
 // names when there is none. Needs no GL context.
 std::string shaderSource(const std::string& file_name);
 
-// A shader's file name (used in every message) and its text.
+// A shader's file name (used in every message) and its text. `files`: the files spliced into `text` by
+// shaderWithIncludes, by number (files[0] is `name`; empty: the text has no other); compiler messages are
+// translated through it ("0:100012(3): error" -> "optics.glsl:12(3): error" for files[1]).
 struct ShaderSource {
   std::string name;
   std::string text;
+  std::vector<std::string> files = {};
 };
+
+// Line numbers of shader file S (shaderWithIncludes) start at S kShaderFileLines + 1: no file has more lines.
+inline constexpr int kShaderFileLines = 100000;
+
+// The text of a shader file by name (shaderSource for the embedded files; tests give their own).
+using ShaderFileLookup = std::function<std::string(const std::string& file_name)>;
+
+// The shader `file_name` with every line `#include "other.glsl"` replaced by that file's text, recursively; a
+// file already included into this shader is not included again (once-only: libraries need no include guards).
+// Each file gets a number S in order of first inclusion (0: `file_name`) and its text is framed by
+// "#line (S kShaderFileLines + 1) S" before and "#line (P kShaderFileLines + N) P" after (P, N: the including
+// file's number and next line), so that compiler messages name the true file and line (ShaderSource::files).
+// The file is in the line number as well as in GLSL's source-string number because Mesa reports source string
+// 0 for every location its parser derives from a rule rather than a token (YYLLOC_DEFAULT), with the right line
+// and column: the line number is what the log translation reads. GLSL has no #include, and the splicing
+// happens before the preprocessor: an #include inside #if/#ifdef/#ifndef throws pvrr::Error (it would be
+// spliced, and counted once-only, whatever the condition), as does an unknown file (naming the including
+// file and line). `lookup` defaults to the embedded files.
+ShaderSource shaderWithIncludes(const std::string& file_name, const ShaderFileLookup& lookup = shaderSource);
+
+// GLSL source texts for values that C++ owns (one constant, not retyped in shaders), as the virtual include
+// file kCppConstantsFile: shaders `#include "cpp_constants.glsl"` and shaderWithIncludes supplies it. Floats
+// are written so that GLSL parses the same float as the C++ constant rounded to float.
+inline constexpr const char* kCppConstantsFile = "cpp_constants.glsl";
+std::string cppConstantsSource();
+// `value` rounded to float, as a GLSL float literal that parses to exactly that float: the shortest decimal that
+// round-trips ("0.05", "1e-05", "2.0"); infinities and NaN throw pvrr::Error (GLSL has no literal for them).
+std::string glslFloat(double value);
 
 // `source` with `defines` inserted after its #version line (at the top when it has none), followed by a #line
 // directive so that compiler messages keep the file's own line numbers. Each define is a full line
@@ -36,8 +68,9 @@ std::string insertDefines(const std::string& source, const std::vector<std::stri
 
 class Program {
  public:
-  // Compiles and links the embedded files `vertex_file` and `fragment_file`. A compile or link failure throws
-  // pvrr::Error with the file name(s), the defines and the driver's info log.
+  // Compiles and links the embedded files `vertex_file` and `fragment_file`, their #includes resolved
+  // (shaderWithIncludes). A compile or link failure throws pvrr::Error with the file name(s), the defines and the
+  // driver's info log, its locations translated to file names.
   Program(const std::string& vertex_file, const std::string& fragment_file,
           const std::vector<std::string>& defines = {});
   // The same from given texts (tests, and shaders generated at run time); names are used only in messages.

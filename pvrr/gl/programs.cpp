@@ -4,35 +4,6 @@
 
 namespace pvrr::gl {
 
-namespace {
-
-// GLSL has no #include: splice `#include "file"` lines with the embedded file (one level, as used).
-std::string resolveIncludes(const std::string& src) {
-  std::string out;
-  size_t pos = 0;
-  while (pos < src.size()) {
-    size_t eol = src.find('\n', pos);
-    if (eol == std::string::npos) eol = src.size();
-    const std::string line = src.substr(pos, eol - pos);
-    const size_t q1 = line.find('"');
-    if (line.rfind("#include", 0) == 0 && q1 != std::string::npos) {
-      const size_t q2 = line.find('"', q1 + 1);
-      out += shaderSource(line.substr(q1 + 1, q2 - q1 - 1)) + "\n";
-    } else {
-      out += line + "\n";
-    }
-    pos = eol + 1;
-  }
-  return out;
-}
-
-Program makeProgram(const std::string& vert, const std::string& frag, const std::vector<std::string>& defines = {}) {
-  return Program::fromSources({vert, resolveIncludes(shaderSource(vert))}, {frag, resolveIncludes(shaderSource(frag))},
-                              defines);
-}
-
-}  // namespace
-
 // A program's defines, plus the scene's light counts (shaders/shading.glsl) and NO_SEEN_POINTS when
 // RendererOptions::seen_points is off, unless the variant writes seen points all the same (kWithSeenPoints).
 std::vector<std::string> Programs::defines(std::vector<std::string> d) const {
@@ -51,7 +22,7 @@ const Program& Programs::built(const std::string& vert, const std::string& frag,
   std::string key = vert + " " + frag;
   for (const std::string& x : d) key += "|" + x;
   std::unique_ptr<Program>& p = built_[key];
-  if (!p) p = std::make_unique<Program>(makeProgram(vert, frag, defines(d)));
+  if (!p) p = std::make_unique<Program>(vert, frag, defines(d));
   return *p;
 }
 
@@ -77,26 +48,24 @@ const Program& Programs::sky(bool planes, bool with_seen, bool first_layer) cons
 }
 
 const Program& Programs::plain(bool planes) const {
-  return planes ? planesVariant("element.vert", "element.frag", {"#define MODE_PLAIN"})
-                : built("element.vert", "element.frag", {"#define MODE_PLAIN"});
+  return planes ? planesVariant("element.vert", "element_plain.frag", {}) : built("element.vert", "element_plain.frag", {});
 }
 
 const Program& Programs::envmap(bool lens) const {
-  return lens ? built("element.vert", "element.frag", {"#define MODE_ENVMAP", "#define LENS"})
-              : built("element.vert", "element.frag", {"#define MODE_ENVMAP"});
+  return lens ? built("element.vert", "element_envmap.frag", {"#define LENS"})
+              : built("element.vert", "element_envmap.frag", {});
 }
 
 const Program& Programs::pvrr(bool lens, size_t channels, bool rgb, bool planes) const {
-  std::vector<std::string> d = {"#define MODE_PVRR", channels > 1 ? "#define CHANNELS 3" : "#define CHANNELS 1"};
+  std::vector<std::string> d = {channels > 1 ? "#define CHANNELS 3" : "#define CHANNELS 1"};
   if (lens) d.push_back("#define LENS");
   if (rgb) d.push_back("#define RGB_CHANNELS");
-  return planes ? planesVariant("element.vert", "element.frag", d) : built("element.vert", "element.frag", d);
+  return planes ? planesVariant("element.vert", "element_pvrr.frag", d) : built("element.vert", "element_pvrr.frag", d);
 }
 
 const Program& Programs::impostor(bool lens, int channels, int cube_elements, bool lens_in_cubes, int layers,
                                   int layer_draw) const {
-  std::vector<std::string> d{"#define MODE_IMPOSTOR",
-                             "#define IMPOSTOR_ITERATIONS " + std::to_string(scene_.render.impostor_iterations),
+  std::vector<std::string> d{"#define IMPOSTOR_ITERATIONS " + std::to_string(scene_.render.impostor_iterations),
                              "#define IMPOSTOR_CHANNELS " + std::to_string(channels),
                              "#define IMPOSTOR_LAYERS " + std::to_string(layers)};
   if (lens) d.push_back("#define LENS");
@@ -104,19 +73,19 @@ const Program& Programs::impostor(bool lens, int channels, int cube_elements, bo
   if (cube_elements > 0 && lens_in_cubes) d.push_back("#define LENS_IN_CUBES");
   if (layer_draw == 1) d.push_back("#define LAYER_MARCH");
   if (layer_draw == 2) d.push_back("#define LAYER_PROBE");
-  return built("element.vert", "element.frag", d);
+  return built("element.vert", "element_impostor.frag", d);
 }
 
 const Program& Programs::cubeGeometry(bool lens, bool peel) const {
-  std::vector<std::string> d{"#define MODE_IMPOSTOR", "#define IMPOSTOR_ITERATIONS 0", "#define IMPOSTOR_CHANNELS 1",
+  std::vector<std::string> d{"#define IMPOSTOR_ITERATIONS 0", "#define IMPOSTOR_CHANNELS 1",
                              "#define IMPOSTOR_LAYERS 1", "#define CUBE_GEOMETRY", kWithSeenPoints};
   if (lens) d.push_back("#define LENS");
   if (peel) d.push_back("#define PEEL");
-  return built("element.vert", "element.frag", d);
+  return built("element.vert", "element_impostor.frag", d);
 }
 
 const Program& Programs::mask() const {
-  if (!mask_) mask_ = std::make_unique<Program>(makeProgram("map_mask.vert", "map_mask.frag"));
+  if (!mask_) mask_ = std::make_unique<Program>("map_mask.vert", "map_mask.frag");
   return *mask_;
 }
 

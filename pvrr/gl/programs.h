@@ -40,7 +40,7 @@ class Programs {
   // A pvrr element: its channels in one draw (1) or in sets of three (more: CHANNELS 3), a lens (LENS), with
   // RGB dispersion (RGB_CHANNELS: its maps are planes); planes: drawn into a planes map.
   const Program& pvrr(bool lens, size_t channels, bool rgb, bool planes) const;
-  // Distance-impostor elements (shaders/element.frag, MODE_IMPOSTOR): a mirror, or a lens with one or three
+  // Distance-impostor elements (shaders/element_impostor.frag): a mirror, or a lens with one or three
   // wavelengths; cube_elements > 0: searches that meet a mirror in a cube go on in its cubes (CUBE_ELEMENTS).
   // lens_in_cubes: the scene's one lens is drawn in the other elements' cubes and refracted through there.
   // layers: of each distance map (IMPOSTOR_LAYERS; 2: the second depth-peeled, searched where the first fails).

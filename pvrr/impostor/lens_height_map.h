@@ -8,7 +8,7 @@
 // local height z and the unit normal facing out of the glass: +z side for the front (eye-side) surface, -z
 // side for the back, and a mask of the outline (1 inside, 0 outside: the reference tracer's lens has no rim,
 // so light that reaches the surfaces beyond the outline is absorbed there). The fragment shader
-// (shaders/element.frag, MODE_IMPOSTOR with LENS) finds where a ray inside the glass meets a surface again by
+// (shaders/element_impostor.frag with LENS, shaders/lens_march.glsl) finds where a ray inside the glass meets a surface again by
 // stepping out and then false position on the bilinearly filtered heights.
 //
 // Units and frames: the lens's local frame, metres. Texel (i, j) is centred on (x0 + (i + 0.5) dx,

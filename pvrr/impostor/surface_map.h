@@ -13,7 +13,7 @@
 // radius, in a corner of the outline's box) or has no normal, the sample is taken from the nearest point
 // towards the domain's centre that can, and marked outside. Texture coordinate of normalised parameter s:
 // s (n - 1) / n + 0.5 / n, so that bilinear filtering interpolates between the samples. The fragment shader
-// (shaders/element.frag, MODE_IMPOSTOR) starts from the fragment's interpolated (s, t) and takes Gauss-Newton
+// (shaders/element_impostor.frag, shaders/surface_maps.glsl) starts from the fragment's interpolated (s, t) and takes Gauss-Newton
 // steps on the distance of the map's point from its view ray.
 #pragma once
 #include <vector>

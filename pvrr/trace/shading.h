@@ -11,6 +11,10 @@
 
 namespace pvrr {
 
+// Albedo of a mirror's dark back (its housing), shaded as a diffuse surface; the tracer's and the shaders'
+// (MIRROR_BACK_ALBEDO, injected by pvrr/gl/program.cpp cppConstantsSource).
+inline constexpr double kMirrorBackAlbedo = 0.05;
+
 Vec3 sampleTexture(const Texture& t, Vec2 uv);
 Vec3 shadeDiffuse(const Scene& scene, const DiffuseMaterial& m, const Vec3& p, const Vec3& n_facing, Vec2 uv);
 

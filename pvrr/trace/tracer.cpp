@@ -31,9 +31,6 @@ Tracer::Tracer(const RayScene& rays, TraceOptions options)
 
 namespace {
 
-// Colour of the dark back of a mirror (its housing), the same constant as the raster path's.
-constexpr double kMirrorBackAlbedo = 0.05;
-
 double lensIndex(const Element& el, double wavelength_nm) {
   return el.dispersion.index(wavelength_nm > 0 ? wavelength_nm : kLineD_nm);
 }

@@ -1,4 +1,4 @@
-// The distance-impostor glass mode (`--mode impostor`, shaders/element.frag MODE_IMPOSTOR) against the reference
+// The distance-impostor glass mode (`--mode impostor`, shaders/element_impostor.frag) against the reference
 // tracer, on OSMesa and EGL: mirrors (the exact reflected ray of each fragment searched in the cube map's
 // distances) and lenses (the ray refracted through the lens's refractor height maps, then searched).
 //

@@ -1,0 +1,121 @@
+// The search of a distance impostor's cube ([Szirmay-Kalos et al.]) and of its depth-peeled second layer ([Umenhoffer et al.],
+// IMPOSTOR_LAYERS 2) for the point a ray meets. Positions relative to the cube's origin.
+// The distance from the cube's origin to what it sees in direction dir (the sky's seen point lies u_far along
+// its ray: a sure overshoot for every nearer point).
+float envDistance(samplerCube seen, vec3 dir) { return length(texture(seen, dir).xyz); }
+
+// [Szirmay-Kalos et al.], section 2.2: the point of the ray x + d R (x relative to the cube's origin, R unit, d >= 0) at the
+// distance the impostor holds for its own direction. The first guesses assume a surface perpendicular to R at
+// the distance seen along R, then a plane through the two samples; then false position between the last
+// undershooting (in front of the surface) and overshooting parameters, 0 while there is none (the direction
+// R itself, at infinity, stands in for a missing overshoot, as in the paper).
+// falsePosition: that search from parameter dl, with the last undershooting (dun, ratio |l| / distance pun) and
+// overshooting (dov, pov) parameters so far (0: none); r1 the distance the impostor holds along R.
+vec3 falsePosition(samplerCube seen, vec3 x, vec3 R, float r1, float dl, float dun, float pun, float dov, float pov) {
+  vec3 l = x + R * dl;
+  for (int i = 0; i < IMPOSTOR_ITERATIONS; ++i) {
+    float llp = length(l) / envDistance(seen, l);
+    if (abs(1.0 - llp) < 1e-6) break;  // as close as float distances resolve
+    float ddl;
+    if (llp < 1.0) {  // undershooting
+      dun = dl, pun = llp;
+      ddl = dov == 0.0 ? r1 * (1.0 - llp) : (dl - dov) * (1.0 - llp) / (llp - pov);
+    } else {          // overshooting
+      dov = dl, pov = llp;
+      ddl = dun == 0.0 ? r1 * (1.0 - llp) : (dl - dun) * (1.0 - llp) / (llp - pun);
+    }
+    dl = max(dl + ddl, 0.0);
+    l = x + R * dl;
+  }
+  return dot(l, l) > 0.0 ? l : R;  // x at the cube's origin and d = 0: the direction itself
+}
+vec3 impostorHit(samplerCube seen, vec3 x, vec3 R) {
+  float r1 = envDistance(seen, R);
+  float dp = r1 - dot(x, R);
+  vec3 p = x + R * dp;
+  float ppp = length(p) / envDistance(seen, p);
+  float dun = 0.0, dov = 0.0, pun = ppp, pov = ppp;
+  if (ppp < 1.0) dun = dp; else dov = dp;
+  float dl = max(dp + r1 * (1.0 - ppp), 0.0);
+  return falsePosition(seen, x, R, r1, dl, dun, pun, dov, pov);
+}
+
+#if IMPOSTOR_LAYERS > 1
+// The layered distance maps of [Umenhoffer et al.], for what an occluder near the element hides from the cube's
+// origin ([Szirmay-Kalos et al.], Fig. 6): the second layer holds the nearest surfaces beyond the first (depth
+// peeling).
+//
+// Whether l, found by a search on the ray from x along R, lies on a surface of the layer: the search came within
+// 1e-3 of the distance there, and it did not end where the ray passes behind a depth edge. There the layer's
+// distance jumps (1.5 texels to either side, across the ray's sweep, the farther more than 1.5 x the nearer),
+// the filtered distance blends the two surfaces, and the search ends between them, at a point on neither:
+// more than 1.25 x the nearer's distance and less than 0.8 x the farther's.
+bool onSurface(samplerCube seen, vec3 l, vec3 R) {
+  float len = length(l), d = envDistance(seen, l);
+  if (!(abs(len - d) <= 1e-3 * d)) return false;
+  vec3 u = l / len, t = R - dot(R, u) * u;
+  float tl = length(t);
+  if (tl < 1e-4) return true;  // the ray runs along the origin's line of sight: it sweeps no edge
+  t *= 3.0 / (float(textureSize(seen, 0).x) * tl);  // 1.5 texels at a face's centre (2 / size a texel)
+  float d0 = envDistance(seen, u - t), d1 = envDistance(seen, u + t);
+  float dn = min(d0, d1), df = max(d0, d1);
+  return !(df > 1.5 * dn && len > 1.25 * dn && len < 0.8 * df);
+}
+
+// |p| / the layer's distance in p's direction: below 1 in front of the layer, above behind it.
+float rayRatio(samplerCube seen, vec3 p) {
+  float len = length(p);
+  return len > 0.0 ? len / envDistance(seen, p) : 0.0;
+}
+
+// A crossing of a layer between the march's parameters d0 (ratio r0 < 1) and d1 (ratio r1 >= 1; at_end: the
+// ray's end at infinity), refined by false position; whether it lies on the layer's surface.
+bool layerCrossing(samplerCube seen, vec3 x, vec3 R, float d0, float r0, float d1, float r1, bool at_end,
+                   out vec3 l) {
+  float rR = envDistance(seen, R);
+  float dl = at_end ? max(d0 + rR * (1.0 - r0), d0) : d0 + (d1 - d0) * (1.0 - r0) / (r1 - r0);
+  l = falsePosition(seen, x, R, rR, dl, d0, r0, at_end ? 0.0 : d1, r1);
+  return onSurface(seen, l, R);
+}
+
+// The first hit of the ray x + d R (x relative to the cube's origin, R unit) in the two layers; `layer`: which
+// holds it. The first layer's search as above; where its result is not on a surface, [Umenhoffer et al.]'s linear search:
+// LAYER_STEPS steps over both layers, uniform in the direction from the origin (from x's to R's: d = |x| t /
+// (1 - t)), each bracket of an undershooting and an overshooting sample refined by false position and kept if
+// on a surface, the nearer of the two layers' first. Nothing kept: the first layer's result. The march starts
+// a quarter step out (t = 1 / (4 LAYER_STEPS)), so that no bracket starts at d = 0, which falsePosition
+// reads as no undershoot yet.
+const int LAYER_STEPS = 16;
+vec3 layeredHit(samplerCube seen0, samplerCube seen1, vec3 x, vec3 R, out int layer) {
+  layer = 0;
+  vec3 l0 = impostorHit(seen0, x, R);
+  if (onSurface(seen0, l0, R)) return l0;
+#if !defined(LAYER_MARCH)
+  discard;  // the second draw, LAYER_MARCH, shades this pixel (pvrr/gl/cube_pass.cpp)
+  return l0;
+#else
+  float a = length(x), t0 = 0.25 / float(LAYER_STEPS), d_prev = a * t0 / (1.0 - t0);
+  vec3 p0 = x + R * d_prev;
+  vec2 r_prev = vec2(rayRatio(seen0, p0), rayRatio(seen1, p0));
+  for (int i = 1; i <= LAYER_STEPS; ++i) {
+    bool at_end = i == LAYER_STEPS;
+    float t = float(i) / float(LAYER_STEPS), d = at_end ? 0.0 : a * t / (1.0 - t);
+    vec3 p = x + R * d;
+    vec2 r = at_end ? vec2(2.0) : vec2(rayRatio(seen0, p), rayRatio(seen1, p));
+    vec3 l, best = l0;
+    float d_best = -1.0;
+    if (r_prev.x < 1.0 && r.x >= 1.0 && layerCrossing(seen0, x, R, d_prev, r_prev.x, d, r.x, at_end, l))
+      best = l, d_best = dot(l - x, R);
+    if (r_prev.y < 1.0 && r.y >= 1.0 && layerCrossing(seen1, x, R, d_prev, r_prev.y, d, r.y, at_end, l) &&
+        (d_best < 0.0 || dot(l - x, R) < d_best)) {
+      layer = 1;
+      return l;
+    }
+    if (d_best >= 0.0) return best;
+    d_prev = d;
+    r_prev = r;
+  }
+  return l0;
+#endif
+}
+#endif
