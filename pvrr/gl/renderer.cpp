@@ -23,24 +23,6 @@
 
 namespace pvrr::gl {
 
-RasterMode parseRasterMode(const std::string& mode) {
-  if (mode == "raster") return RasterMode::Raster;
-  if (mode == "pvrr") return RasterMode::Pvrr;
-  if (mode == "envmap") return RasterMode::Envmap;
-  if (mode == "impostor") return RasterMode::Impostor;
-  throw Error("mode: expected one of pvrr, raster, envmap, impostor, raytrace; got \"" + mode + "\"");
-}
-
-std::string modeName(RasterMode mode) {
-  switch (mode) {
-    case RasterMode::Raster: return "raster";
-    case RasterMode::Pvrr: return "pvrr";
-    case RasterMode::Envmap: return "envmap";
-    case RasterMode::Impostor: return "impostor";
-  }
-  return "?";
-}
-
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -723,32 +705,32 @@ struct Renderer::Impl {
     return size_t(std::count_if(scene.elements.begin(), scene.elements.end(),
                                 [](const Element& e) { return e.type == ElementType::Lens; }));
   }
-  int cubeElements(RasterMode mode) const {
+  int cubeElements(RenderMode mode) const {
     const int n = int(scene.elements.size());
     const bool mirror = lensCount() < size_t(n);
     // Three cubes per element, and the lens's three height maps for the mirrors that meet it.
-    if (mode != RasterMode::Impostor || n < 2 || !mirror || n > kMaxCubeElements ||
+    if (mode != RenderMode::Impostor || n < 2 || !mirror || n > kMaxCubeElements ||
         kFirstCubeUnit + 3 * n + (lensCount() == 1 ? 3 : 0) > max_texture_units)
       return 0;
     return n;
   }
   // The layers of each impostor distance map (render.impostor_layers; seeds 001): 2 where the texture units allow
   // the second layer's cubes (two more for one element, three more an element with CUBE_ELEMENTS), else 1.
-  int impostorLayers(RasterMode mode) const {
-    if (mode != RasterMode::Impostor || scene.render.impostor_layers < 2) return 1;
+  int impostorLayers(RenderMode mode) const {
+    if (mode != RenderMode::Impostor || scene.render.impostor_layers < 2) return 1;
     const int follow = cubeElements(mode);
     const int units = follow > 0 ? kFirstCubeUnit + 6 * follow + (lensCount() == 1 ? 3 : 0) : kFirstCubeUnit + 2;
     return units <= max_texture_units ? 2 : 1;
   }
   // Whether the lens is drawn in the other elements' cubes: the scene has one (the mirrors' programs take its
   // maps; its own program, which meets it again through a mirror, has them already).
-  bool lensInCubes(RasterMode mode) const { return cubeElements(mode) > 0 && lensCount() == 1; }
+  bool lensInCubes(RenderMode mode) const { return cubeElements(mode) > 0 && lensCount() == 1; }
   // The colour channels of element e's impostor program (IMPOSTOR_CHANNELS): a lens with dispersion refracts R,
   // G and B with their own indices, and so does a mirror that can show such a lens in its cubes.
   int impostorChannels(size_t e) const {
     auto dispersive = [&](size_t k) { return dispersionChannels(scene, int(k)).size() > 1; };
     if (scene.elements[e].type == ElementType::Lens) return dispersive(e) ? 3 : 1;
-    if (!lensInCubes(RasterMode::Impostor)) return 1;
+    if (!lensInCubes(RenderMode::Impostor)) return 1;
     for (size_t k = 0; k < scene.elements.size(); ++k)
       if (scene.elements[k].type == ElementType::Lens && dispersive(k)) return 3;
     return 1;
@@ -781,7 +763,7 @@ struct Renderer::Impl {
     p.set("u_max_depth", scene.render.max_depth);
     // The scene's lens, which the search can meet: a mirror's program takes its maps after the cubes; the
     // lens's own has them (setLensMaps) and needs its rotation under the loop's name too.
-    if (lensInCubes(RasterMode::Impostor))
+    if (lensInCubes(RenderMode::Impostor))
       for (size_t k = 0; k < scene.elements.size(); ++k) {
         if (scene.elements[k].type != ElementType::Lens) continue;
         if (k == e) p.set("u_lens_to_local", glm::mat3(Mat3(scene.elements[k].world_to_local)));
@@ -1420,17 +1402,20 @@ struct Renderer::Impl {
     return count;
   }
 
-  RasterFrame render(RasterMode mode, FrameCache* cache);
+  RasterFrame render(RenderMode mode, FrameCache* cache);
 };
 
 Renderer::Renderer(const Scene& scene, const RayScene& rays, RendererOptions options)
     : impl_(std::make_unique<Impl>(scene, rays, std::move(options))) {}
 Renderer::~Renderer() = default;
 
-RasterFrame Renderer::render(RasterMode mode, FrameCache* cache) { return impl_->render(mode, cache); }
+RasterFrame Renderer::render(RenderMode mode, FrameCache* cache) {
+  PVRR_CHECK(isRasterMode(mode), "(raytrace is the reference tracer's mode)");
+  return impl_->render(mode, cache);
+}
 void Renderer::setReadBack(bool on) { impl_->options.read_back = on; }
 
-RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
+RasterFrame Renderer::Impl::render(RenderMode mode, FrameCache* cache) {
   const auto frame_start = Clock::now();
   const Observer& ob = scene.observer;
   RasterFrame out;
@@ -1446,7 +1431,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   std::vector<VertexStageOptions> opts;
   bool skip_first_pass = false;
   bool continuing = false;  // a cache that holds an earlier frame: maps are widened for reuse
-  if (mode == RasterMode::Pvrr && n_el > 0) {
+  if (mode == RenderMode::Pvrr && n_el > 0) {
     frames.resize(n_el);
     // Each element's views are fitted to what the observer sees of it.
     const Mat4 observer_projection = ob.visibilityProjection(), observer_clip = observer_projection * ob.view();
@@ -1534,17 +1519,17 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     skip_first_pass = nothing_moved;
     continuing = cache && cache->valid;
   } else {
-    const std::string why = n_el == 0 ? "no mirror or lens in the scene" : "mode " + modeName(mode);
-    out.stages.skipped("vertex-rays", mode == RasterMode::Impostor && n_el > 0
+    const std::string why = n_el == 0 ? "no mirror or lens in the scene" : std::string("mode ") + nameOf(mode);
+    out.stages.skipped("vertex-rays", mode == RenderMode::Impostor && n_el > 0
                                           ? why + ": each fragment reflects or refracts its own ray (second pass)"
                                           : why);
-    if (mode == RasterMode::Impostor && has_lens)
+    if (mode == RenderMode::Impostor && has_lens)
       out.stages.skipped("refraction", why + ": per fragment, through the lens's refractor height maps (second pass)");
     else
       out.stages.skipped("refraction", has_lens ? why : "no lens in the scene");
     out.stages.skipped("viewpoint-fit", why);
     out.stages.skipped("texture-coordinates", why);
-    if (mode == RasterMode::Impostor && has_lens) {
+    if (mode == RenderMode::Impostor && has_lens) {
       int most = 1;
       bool spectral = false;
       for (size_t e = 0; e < n_el; ++e) {
@@ -1576,7 +1561,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   }
   // Map reuse (RendererOptions::map_reuse_margin_deg): a frame that follows another draws from the maps of
   // an earlier one while its views stay inside them; otherwise its maps are drawn widened by the margin.
-  const bool reuse_on = mode == RasterMode::Pvrr && !frames.empty() && options.map_reuse_margin_deg > 0 && continuing;
+  const bool reuse_on = mode == RenderMode::Pvrr && !frames.empty() && options.map_reuse_margin_deg > 0 && continuing;
   std::string reuse_note;
   if (reuse_on && !skip_first_pass && !cache->environment_changed && reuseMaps(frames, *cache, &reuse_note)) {
     skip_first_pass = true;
@@ -1590,12 +1575,12 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     return std::any_of(f.views.begin(), f.views.end(), [](const PatchView& v) { return !v.volume.backward; });
   });
   const bool widen = reuse_on && !cache->last_plan_nested && any_forward;
-  if (mode == RasterMode::Pvrr && !frames.empty() && skip_first_pass) {
+  if (mode == RenderMode::Pvrr && !frames.empty() && skip_first_pass) {
     const std::string why = !reuse_note.empty() ? reuse_note
                                                 : "eye-fixed cache: neither the elements nor the environment moved relative to the eye";
     out.stages.skipped("first-pass", why);
     out.stages.skipped("nested-passes", why);
-  } else if (mode == RasterMode::Pvrr && !frames.empty()) {
+  } else if (mode == RenderMode::Pvrr && !frames.empty()) {
     size_t dark = 0;
     bool budget_hit = false;
     std::vector<std::array<int, 2>> widened;  // per top-level slot: texture size, rendered side
@@ -1664,7 +1649,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       out.stages.skipped("nested-passes", dark_note);
     else
       out.stages.skipped("nested-passes", "no element is inside another element's view volume");
-  } else if ((mode == RasterMode::Envmap || mode == RasterMode::Impostor) && n_el > 0) {
+  } else if ((mode == RenderMode::Envmap || mode == RenderMode::Impostor) && n_el > 0) {
     while (cubes.size() < n_el) cubes.push_back(std::make_unique<CubeTarget>());
     const int layers = impostorLayers(mode);
     while (layers > 1 && cubes1.size() < n_el) cubes1.push_back(std::make_unique<CubeTarget>());
@@ -1673,7 +1658,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     CullCount culled;
     // Impostor cube maps hold the seen points (each direction's distance) even in a colour-only frame, and with
     // other elements in them (cubeElements) a third cube of their normals and indices.
-    const bool with_seen = mode == RasterMode::Impostor;
+    const bool with_seen = mode == RenderMode::Impostor;
     const int follow = cubeElements(mode);
     const bool lens_in_cubes = lensInCubes(mode);
     // The elements drawn in other elements' cubes: the mirrors, and the lens if it is the only one.
@@ -1684,7 +1669,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     if (options.seen_points || with_seen) formats.push_back(GL_RGBA32F);
     if (follow > 0) formats.push_back(GL_RGBA32F);
     int height_maps = 0, surface_maps = 0;
-    for (size_t e = 0; e < n_el && mode == RasterMode::Impostor; ++e) {
+    for (size_t e = 0; e < n_el && mode == RenderMode::Impostor; ++e) {
       if (scene.elements[e].type == ElementType::Lens) height_maps += updateLensMaps(e);
       else surface_maps += updateMirrorMaps(e);
     }
@@ -1760,11 +1745,11 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
         return culled;
       };
     glFinish();
-    std::string note = mode == RasterMode::Impostor ? "distance impostors: colour and seen-point cube maps" : "";
+    std::string note = mode == RenderMode::Impostor ? "distance impostors: colour and seen-point cube maps" : "";
     if (layers > 1)
       appendNote(note, "two layers each where needed (the second depth-peeled, " + std::to_string(layer1_size) +
                            "^2 a face)");
-    else if (mode == RasterMode::Impostor && scene.render.impostor_layers > 1)
+    else if (mode == RenderMode::Impostor && scene.render.impostor_layers > 1)
       appendNote(note, "one layer each: too few texture units for the second layers' cubes");
     if (follow > 0) appendNote(note, "normal and index cube maps of the elements in them");
     if (height_maps > 0) appendNote(note, "refractor height maps of " + std::to_string(height_maps) + " lens(es) built");
@@ -1781,22 +1766,22 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
                                             : ""));
     else if (n_el == 1)
       out.stages.skipped("nested-passes", std::string("one ") + (has_lens ? "lens" : "mirror") + ": no nesting");
-    else if (mode == RasterMode::Impostor && lensCount() == n_el)
+    else if (mode == RenderMode::Impostor && lensCount() == n_el)
       out.stages.skipped("nested-passes", "mode impostor: lenses are absent from other elements' cube maps");
-    else if (mode == RasterMode::Impostor)
+    else if (mode == RenderMode::Impostor)
       out.stages.skipped("nested-passes", "mode impostor: more than " + std::to_string(kMaxCubeElements) +
                                               " elements (or too few texture units): other elements are absent from "
                                               "the cube maps");
     else
-      out.stages.skipped("nested-passes", "mode " + modeName(mode) + ": other elements are absent from the cube maps");
+      out.stages.skipped("nested-passes", std::string("mode ") + nameOf(mode) + ": other elements are absent from the cube maps");
   } else {
-    out.stages.skipped("first-pass", n_el == 0 ? "no mirror or lens in the scene" : "mode " + modeName(mode));
+    out.stages.skipped("first-pass", n_el == 0 ? "no mirror or lens in the scene" : std::string("mode ") + nameOf(mode));
     out.stages.skipped("nested-passes", n_el == 0 ? "no mirror or lens in the scene" : "mode raster");
   }
 
   // The cache takes this frame whole, once its maps are drawn: the poses, and the elements with the volumes
   // and texture coordinates of the maps now held.
-  if (cache && mode == RasterMode::Pvrr && n_el > 0) {
+  if (cache && mode == RenderMode::Pvrr && n_el > 0) {
     const Mat4 view = ob.view();
     cache->element_to_eye.resize(n_el);
     for (size_t e = 0; e < n_el; ++e) cache->element_to_eye[e] = view * scene.elements[e].local_to_world;
@@ -1812,7 +1797,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
   // A picture-only frame goes into 16 bits a channel (RendererOptions::seen_points), unless an element is
   // drawn in several additive draws (more than three channels): their partial sums can be negative or above
   // 1 (spectral weights), and a normalised target would clamp each before the sum.
-  const bool additive = mode == RasterMode::Pvrr && std::any_of(frames.begin(), frames.end(), [](const ElementFrame& f) {
+  const bool additive = mode == RenderMode::Pvrr && std::any_of(frames.begin(), frames.end(), [](const ElementFrame& f) {
                           return f.rays.size() > 3;
                         });
   const ColorFormat colour = options.seen_points || additive ? ColorFormat::RGBA32F : ColorFormat::RGBA16;
@@ -1850,8 +1835,8 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     const Element& el = scene.elements[e];
     const Vec3 anchor = Vec3(el.local_to_world[3]);
     const bool lens = el.type == ElementType::Lens;
-    const Program& p = mode == RasterMode::Raster ? plain_program
-                       : mode == RasterMode::Impostor
+    const Program& p = mode == RenderMode::Raster ? plain_program
+                       : mode == RenderMode::Impostor
                            ? impostorProgram(lens, impostorChannels(e), follow, lensInCubes(mode), layers, layer_draw)
                            : (lens ? lens_envmap_program : envmap_program);
     p.use();
@@ -1860,8 +1845,8 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
     p.set("u_view_origin", glm::vec3(0.0f));
     setLights(p, ob.eye);
     setElementMaterial(p, el, int(e));
-    if (mode == RasterMode::Raster) p.set("u_dark", 0);
-    if (mode == RasterMode::Envmap || mode == RasterMode::Impostor) {
+    if (mode == RenderMode::Raster) p.set("u_dark", 0);
+    if (mode == RenderMode::Envmap || mode == RenderMode::Impostor) {
       glActiveTexture(GL_TEXTURE0);
       glBindTexture(GL_TEXTURE_CUBE_MAP, cubes[e]->colors[0]);
       glActiveTexture(GL_TEXTURE1);
@@ -1880,21 +1865,21 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
       p.set("u_cube1", kFirstCubeUnit);
       p.set("u_seen_cube1", kFirstCubeUnit + 1);
     }
-    if (mode == RasterMode::Impostor && !lens) setMirrorMaps(p, e);
+    if (mode == RenderMode::Impostor && !lens) setMirrorMaps(p, e);
     if (follow > 0) setCubeElements(p, e, ob.eye, layers);
-    if (mode == RasterMode::Impostor && lens) setLensMaps(p, e);
-    if (mode == RasterMode::Impostor)
+    if (mode == RenderMode::Impostor && lens) setLensMaps(p, e);
+    if (mode == RenderMode::Impostor)
       p.set("u_seen_channel", options.seen_channel < 0 ? 1 : std::min(options.seen_channel, 2));
     draw(element_meshes[element_slot[e]]);
   };
   for (size_t e = 0; e < n_el; ++e) {
     frame_target->bind();
-    if (mode == RasterMode::Pvrr) {
+    if (mode == RenderMode::Pvrr) {
       if (beyondDepth(frames[e])) drawDarkElement(frames[e], eye_cam);
       else drawPvrrElement(frames[e], top_slot[e], eye_cam, options.seen_channel);
     } else {
       ElementFrame f = prepareElement(scene, int(e), &grid_cache.get(scene, int(e)));
-      if (scene.elements[e].type == ElementType::Lens && mode == RasterMode::Envmap)
+      if (scene.elements[e].type == ElementType::Lens && mode == RenderMode::Envmap)
         traceVertexRays(rays, f, ob.eye, VertexStageOptions{});
       element_slot[e] = next_mesh;
       uploadElementGrid(meshSlot(), f, Vec3(scene.elements[e].local_to_world[3]));
