@@ -158,7 +158,15 @@ void takePixels(RenderedFrame& out, Frame& f) {
 }
 }  // namespace
 
-RenderedFrame timedFrame(LoadedScene& ls, const std::string& mode, const std::string& gl_backend_name, int frames,
+RenderMode parseModeOption(const std::string& text, bool raytrace_ok) {
+  const std::optional<RenderMode> mode = parseName<RenderMode>(text);
+  if (!mode || (!raytrace_ok && !isRasterMode(*mode)))
+    throw Error("mode: expected one of " + nameListIf<RenderMode>(isRasterMode) + ", " + nameOf(RenderMode::Raytrace) +
+                "; got \"" + text + "\"");
+  return *mode;
+}
+
+RenderedFrame timedFrame(LoadedScene& ls, RenderMode mode, const std::string& gl_backend_name, int frames,
                          double* median_ms) {
   // Timed as pvrr render draws for viewing (colour only, no seen-point attachments): one warm-up frame
   // (shader compilation, first uploads), then the median of N with the cache cleared, so every measured
@@ -178,7 +186,7 @@ RenderedFrame timedFrame(LoadedScene& ls, const std::string& mode, const std::st
   }
   std::sort(times.begin(), times.end());
   *median_ms = times[times.size() / 2];
-  if (mode == "raytrace") return timed;
+  if (mode == RenderMode::Raytrace) return timed;
   RenderSession accuracy;
   RenderedFrame f = renderFrame(ls, mode, gl_backend_name, &accuracy);
   f.stages = std::move(timed.stages);
@@ -190,16 +198,15 @@ RenderedFrame timedFrame(LoadedScene& ls, const std::string& mode, const std::st
 }
 
 // Renders one frame of a loaded scene in `mode` (raytrace or a raster mode). Used by render and compare.
-RenderedFrame renderFrame(LoadedScene& ls, const std::string& mode, const std::string& gl_backend_name,
+RenderedFrame renderFrame(LoadedScene& ls, RenderMode mode, const std::string& gl_backend_name,
                           RenderSession* session) {
   RenderedFrame out;
   Scene& scene = ls.scene;
-  const DispersionMode disp = parseDispersionMode(scene.render.dispersion);
-  if (mode == "raytrace") {
+  if (mode == RenderMode::Raytrace) {
     RayScene rays(scene);
     TraceOptions to;
     to.max_depth = scene.render.max_depth;
-    to.dispersion = disp;
+    to.dispersion = scene.render.dispersion;
     to.spectral_samples = scene.render.spectral_samples;
     Tracer tracer(rays, to);
     const auto t0 = std::chrono::steady_clock::now();
@@ -219,7 +226,6 @@ RenderedFrame renderFrame(LoadedScene& ls, const std::string& mode, const std::s
     out.gl_backend = "none (CPU, Embree)";
     return out;
   }
-  const gl::RasterMode rm = gl::parseRasterMode(mode);
   if (!session->context) session->context = gl::GlContext::create(gl::parseGlBackend(gl_backend_name));
   session->context->makeCurrent();
   if (!session->rays) {
@@ -238,7 +244,7 @@ RenderedFrame renderFrame(LoadedScene& ls, const std::string& mode, const std::s
     session->renderer = std::make_unique<gl::Renderer>(scene, *session->rays, ro);
   }
   session->renderer->setReadBack(session->read_back);
-  gl::RasterFrame f = session->renderer->render(rm, &session->cache);
+  gl::RasterFrame f = session->renderer->render(mode, &session->cache);
   takePixels(out, f);
   out.stages = std::move(f.stages);
   out.elements = elementsJson(scene, f.elements);
@@ -254,8 +260,9 @@ int cmdRender(const std::vector<std::string>& argv) {
   const int frames = a.getInt("frames", 1, 1);
   const double orbit_deg = a.getDouble("orbit", 0.0);
   LoadedScene ls = loadScene(scene_path, a.all("set"), size ? size->first : 0, size ? size->second : 0);
-  const std::string mode = a.get("mode", ls.scene.render.mode);
-  if (mode != "raytrace") gl::parseRasterMode(mode);  // validate before any work
+  const auto mode_arg = a.get("mode");
+  // Validated before any work.
+  const RenderMode mode = mode_arg ? parseModeOption(*mode_arg, true) : ls.scene.render.mode;
   const std::string out_path = a.get("out", ls.scene.render.output);
   const std::string gl_name = gl::glBackendName(backendArg(a));
 
@@ -323,9 +330,9 @@ int cmdRender(const std::vector<std::string>& argv) {
                                               " ms, slowest " + fmt("%.3f", max_ms) + " ms"
                                         : "";
   std::printf("frame time: %.3f ms (%s, %dx%d, mode %s%s)\n", frame_ms, last.gl_backend.c_str(), last.width, last.height,
-              mode.c_str(), spread.c_str());
+              nameOf(mode), spread.c_str());
   if (auto stats = a.get("stats")) {
-    json j = {{"scene", scene_path}, {"mode", mode}, {"size", {last.width, last.height}}, {"gl", last.gl_backend},
+    json j = {{"scene", scene_path}, {"mode", nameOf(mode)}, {"size", {last.width, last.height}}, {"gl", last.gl_backend},
               {"frame_ms", frame_ms}, {"frame_ms_mean", mean_ms}, {"frame_ms_max", max_ms}, {"frames", frames},
               {"stages", stagesJson(last.stages)},
               {"elements", last.elements}, {"peak_rss_mb", peakRssMb()}};

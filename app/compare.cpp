@@ -320,7 +320,7 @@ std::vector<Vec3> supersampledReference(const LoadedScene& ls, const std::string
   fine.scene.observer.width *= 2;
   fine.scene.observer.height *= 2;
   RenderSession none;
-  const RenderedFrame f = renderFrame(fine, "raytrace", gl_name, &none);
+  const RenderedFrame f = renderFrame(fine, RenderMode::Raytrace, gl_name, &none);
   const int w = ls.scene.observer.width, h = ls.scene.observer.height;
   std::vector<Vec3> out(size_t(w) * size_t(h), Vec3(0.0));
   for (int y = 0; y < h; ++y)
@@ -352,15 +352,14 @@ int cmdCompare(const std::vector<std::string>& argv) {
   if (!out_dir) usageError("compare", "--out DIR is required");
   const auto size = a.getSize("size");
   const int frames = a.getInt("frames", 5, 1);
-  std::vector<std::string> modes;
+  std::vector<RenderMode> modes;
   {
     std::stringstream ss(a.get("modes", "pvrr,envmap"));
     std::string m;
     while (std::getline(ss, m, ','))
       if (!m.empty()) {
-        if (m == "raytrace" || m == "reference") usageError("compare", "the reference is always rendered; list only raster modes");
-        gl::parseRasterMode(m);
-        modes.push_back(m);
+        if (parseName<RenderMode>(m) == RenderMode::Raytrace || m == "reference") usageError("compare", "the reference is always rendered; list only raster modes");
+        modes.push_back(parseModeOption(m, false));
       }
   }
   const std::string scene_path = a.positional()[0];
@@ -370,7 +369,7 @@ int cmdCompare(const std::vector<std::string>& argv) {
   gl::parseGlBackend(gl_name);
 
   RenderSession none;
-  RenderedFrame ref = renderFrame(ls, "raytrace", gl_name, &none);
+  RenderedFrame ref = renderFrame(ls, RenderMode::Raytrace, gl_name, &none);
   const int w = ref.width, h = ref.height;
   json metrics = {{"scene", scene_path}, {"size", {w, h}}, {"reference", {{"frame_ms", ref.frame_ms}}}};
   json definitions = json::object();
@@ -405,9 +404,10 @@ int cmdCompare(const std::vector<std::string>& argv) {
 
   json jm = json::object();
   std::string gl_used;
-  for (const std::string& m : modes) {
+  for (const RenderMode mode : modes) {
+    const std::string m = nameOf(mode);
     double frame_ms = 0;
-    const RenderedFrame f = timedFrame(ls, m, gl_name, frames, &frame_ms);
+    const RenderedFrame f = timedFrame(ls, mode, gl_name, frames, &frame_ms);
     gl_used = f.gl_backend;
     std::vector<double> err;
     const ErrorStats st = compareToReference(ref, f, &err);
@@ -446,7 +446,7 @@ int cmdCompare(const std::vector<std::string>& argv) {
       // frame is the middle channel's); impostor: each channel's own refracted ray, likewise. Other modes
       // have one seen point for every channel.
       std::array<std::vector<Vec3>, 3> seen;
-      const bool own = m == "pvrr" || m == "impostor";
+      const bool own = mode == RenderMode::Pvrr || mode == RenderMode::Impostor;
       for (int c = 0; c < 3; ++c) {
         if (!own || c == 1) {
           seen[size_t(c)] = f.seen;
@@ -454,7 +454,7 @@ int cmdCompare(const std::vector<std::string>& argv) {
         }
         RenderSession s;
         s.seen_channel = c;
-        seen[size_t(c)] = renderFrame(ls, m, gl_name, &s).seen;
+        seen[size_t(c)] = renderFrame(ls, mode, gl_name, &s).seen;
       }
       json ch = json::object();
       for (int c = 0; c < 3; ++c) {
@@ -546,7 +546,7 @@ int cmdVertices(const std::vector<std::string>& argv) {
           const Vec3 p = f.world_pos[vi], n = f.world_normal[vi];
           csv << el.name << ',' << pv.patch << ',' << vi << ',' << c << ',' << p.x << ',' << p.y << ',' << p.z << ','
               << n.x << ',' << n.y << ',' << n.z << ',' << r.dir.x << ',' << r.dir.y << ',' << r.dir.z << ','
-              << toString(r.status) << ',' << r.hit.x << ',' << r.hit.y << ',' << r.hit.z << ',' << pv.st[c][k].x << ','
+              << nameOf(r.status) << ',' << r.hit.x << ',' << r.hit.y << ',' << r.hit.z << ',' << pv.st[c][k].x << ','
               << pv.st[c][k].y;
           if (any_lens)
             csv << ',' << r.internal_dir.x << ',' << r.internal_dir.y << ',' << r.internal_dir.z << ',' << r.back_point.x

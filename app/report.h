@@ -41,10 +41,13 @@ struct RenderSession {
   bool read_back = true;
 };
 
-RenderedFrame renderFrame(LoadedScene& ls, const std::string& mode, const std::string& gl_backend_name,
+// A --mode or --modes value: a raster mode (isRasterMode), or also raytrace where `raytrace_ok`. Throws
+// pvrr::Error "mode: expected one of pvrr, raster, envmap, impostor, raytrace; got ..." for another value.
+RenderMode parseModeOption(const std::string& text, bool raytrace_ok);
+RenderedFrame renderFrame(LoadedScene& ls, RenderMode mode, const std::string& gl_backend_name,
                           RenderSession* session);
 // A measured frame: one warm-up, then the median frame time of `frames` frames, each doing every stage.
-RenderedFrame timedFrame(LoadedScene& ls, const std::string& mode, const std::string& gl_backend_name, int frames,
+RenderedFrame timedFrame(LoadedScene& ls, RenderMode mode, const std::string& gl_backend_name, int frames,
                          double* median_ms);
 nlohmann::json elementsJson(const Scene& scene, const std::vector<ElementFrame>& frames);
 // The stages of a frame: [{"name", "ms", "ran", "reason"[, "count"][, "note"]}].

@@ -56,8 +56,8 @@ int cmdSweep(const std::vector<std::string>& argv) {
   const auto size = a.getSize("size");
   const int frames = a.getInt("frames", 3, 1);
   const std::vector<int> tess = intList(a, "tessellation", {7, 15, 33});
-  const std::vector<std::string> modes = splitList(a.get("modes", "pvrr,envmap"), ',');
-  for (const std::string& m : modes) gl::parseRasterMode(m);
+  std::vector<RenderMode> modes;
+  for (const std::string& m : splitList(a.get("modes", "pvrr,envmap"), ',')) modes.push_back(parseModeOption(m, false));
   // --vary PATH=V1,V2: the cartesian product of all --vary lists.
   std::vector<std::vector<std::string>> vary_sets = {{}};
   for (const std::string& v : a.all("vary")) {
@@ -88,7 +88,7 @@ int cmdSweep(const std::vector<std::string>& argv) {
     // The reference depends on the scene only, not on the tessellation or the map size.
     LoadedScene ref_scene = loadScene(scene_path, base_sets, size ? size->first : 0, size ? size->second : 0);
     RenderSession none;
-    const RenderedFrame ref = renderFrame(ref_scene, "raytrace", gl_name, &none);
+    const RenderedFrame ref = renderFrame(ref_scene, RenderMode::Raytrace, gl_name, &none);
     std::string vary_label;
     for (const std::string& v : vary) vary_label += (vary_label.empty() ? "" : ";") + v;
     for (int n : tess)
@@ -103,12 +103,12 @@ int cmdSweep(const std::vector<std::string>& argv) {
         LoadedScene ls = loadScene(scene_path, sets, size ? size->first : 0, size ? size->second : 0);
         long vertices = 0;
         for (const Element& el : ls.scene.elements) vertices += long(el.tess_u) * long(el.tess_v);
-        for (const std::string& m : modes) {
+        for (const RenderMode m : modes) {
           double frame_ms = 0;
           const RenderedFrame f = timedFrame(ls, m, gl_name, frames, &frame_ms);
           const ErrorStats st = compareToReference(ref, f, nullptr);
           SweepRow r;
-          r.mode = m;
+          r.mode = nameOf(m);
           r.tessellation = n;
           r.map_size = map;
           r.vary = vary_label;

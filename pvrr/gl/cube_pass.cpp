@@ -16,7 +16,7 @@ bool CubePass::inCubes(size_t m) const {
   return follow > 0 && (ctx.scene.elements[m].type == ElementType::Mirror || lens_in_cubes);
 }
 
-void CubePass::prepare(RasterMode frame_mode, FrameStages& stages, FrameCache*) {
+void CubePass::prepare(RenderMode frame_mode, FrameStages& stages, FrameCache*) {
   const Scene& scene = ctx.scene;
   mode = frame_mode;
   noteCpuStagesSkipped(stages, scene, mode);
@@ -31,13 +31,13 @@ void CubePass::prepare(RasterMode frame_mode, FrameStages& stages, FrameCache*) 
   s.layer1_size = std::max(16, ctx.options.map_size / 2);
   // Impostor cube maps hold the seen points (each direction's distance) even in a colour-only frame, and with
   // other elements in them (cubeElements) a third cube of their normals and indices.
-  with_seen = mode == RasterMode::Impostor;
+  with_seen = mode == RenderMode::Impostor;
   follow = maps.cubeElements(mode);
   lens_in_cubes = maps.lensInCubes(mode);
   std::vector<unsigned> formats{GL_RGBA16F};
   if (ctx.options.seen_points || with_seen) formats.push_back(GL_RGBA32F);
   if (follow > 0) formats.push_back(GL_RGBA32F);
-  for (size_t e = 0; e < n_el && mode == RasterMode::Impostor; ++e) {
+  for (size_t e = 0; e < n_el && mode == RenderMode::Impostor; ++e) {
     if (scene.elements[e].type == ElementType::Lens) s.height_maps += maps.updateLensMaps(e);
     else s.surface_maps += maps.updateMirrorMaps(e);
   }
@@ -148,7 +148,7 @@ void CubePass::drawElement(size_t e, int layer_draw, const PassCamera& eye) {
   const Element& el = ctx.scene.elements[e];
   const Vec3 anchor = Vec3(el.local_to_world[3]);
   const bool lens = el.type == ElementType::Lens;
-  const bool impostor = mode == RasterMode::Impostor;
+  const bool impostor = mode == RenderMode::Impostor;
   const Program& p = impostor ? ctx.programs.impostor(lens, maps.impostorChannels(e), follow, lens_in_cubes, layers,
                                                       layer_draw)
                               : ctx.programs.envmap(lens);
@@ -182,14 +182,14 @@ void CubePass::drawElement(size_t e, int layer_draw, const PassCamera& eye) {
   draw(ctx.meshes.at(element_slot[e]));
 }
 
-std::string CubePass::drawElements(RasterMode, const PassCamera& eye, const Framebuffer& target) {
+std::string CubePass::drawElements(RenderMode, const PassCamera& eye, const Framebuffer& target) {
   const Scene& scene = ctx.scene;
   const size_t n_el = scene.elements.size();
   element_slot.assign(n_el, 0);
   for (size_t e = 0; e < n_el; ++e) {
     target.bind();
     ElementFrame f = prepareElement(scene, int(e), &ctx.grid_cache.get(scene, int(e)));
-    if (scene.elements[e].type == ElementType::Lens && mode == RasterMode::Envmap)
+    if (scene.elements[e].type == ElementType::Lens && mode == RenderMode::Envmap)
       traceVertexRays(ctx.rays, f, eye.origin, VertexStageOptions{});
     element_slot[e] = ctx.meshes.next();
     uploadElementGrid(ctx.meshes.slot(), scene, f, Vec3(scene.elements[e].local_to_world[3]));

@@ -18,8 +18,8 @@ class CubePass : public ModePass {
  public:
   explicit CubePass(const RenderContext& c) : ctx(c), maps(c.scene, c.options, c.max_texture_units) {}
 
-  void prepare(RasterMode mode, FrameStages& stages, FrameCache* cache) override;
-  std::string drawElements(RasterMode mode, const PassCamera& eye, const Framebuffer& target) override;
+  void prepare(RenderMode mode, FrameStages& stages, FrameCache* cache) override;
+  std::string drawElements(RenderMode mode, const PassCamera& eye, const Framebuffer& target) override;
 
  private:
   // The elements drawn in other elements' cubes: the mirrors, and the lens if it is the only one.
@@ -41,7 +41,7 @@ class CubePass : public ModePass {
   std::vector<std::unique_ptr<CubeTarget>> cubes;   // one per element
   std::vector<std::unique_ptr<CubeTarget>> cubes1;  // impostor mode's second layers (impostorLayers), one per element
   // This frame's plan (prepare):
-  RasterMode mode = RasterMode::Envmap;
+  RenderMode mode = RenderMode::Envmap;
   int layers = 1;               // ImpostorMaps::impostorLayers
   int follow = 0;               // ImpostorMaps::cubeElements: the elements the fragments follow through their cubes
   bool lens_in_cubes = false;   // ImpostorMaps::lensInCubes

@@ -85,18 +85,18 @@ size_t ImpostorMaps::lensCount() const {
                               [](const Element& e) { return e.type == ElementType::Lens; }));
 }
 
-int ImpostorMaps::cubeElements(RasterMode mode) const {
+int ImpostorMaps::cubeElements(RenderMode mode) const {
   const int n = int(scene.elements.size());
   const bool mirror = lensCount() < size_t(n);
   // Three cubes per element, and the lens's three height maps for the mirrors that meet it.
-  if (mode != RasterMode::Impostor || n < 2 || !mirror || n > kMaxCubeElements ||
+  if (mode != RenderMode::Impostor || n < 2 || !mirror || n > kMaxCubeElements ||
       kFirstCubeUnit + 3 * n + (lensCount() == 1 ? 3 : 0) > max_texture_units)
     return 0;
   return n;
 }
 
-int ImpostorMaps::impostorLayers(RasterMode mode) const {
-  if (mode != RasterMode::Impostor || scene.render.impostor_layers < 2) return 1;
+int ImpostorMaps::impostorLayers(RenderMode mode) const {
+  if (mode != RenderMode::Impostor || scene.render.impostor_layers < 2) return 1;
   const int follow = cubeElements(mode);
   const int units = follow > 0 ? kFirstCubeUnit + 6 * follow + (lensCount() == 1 ? 3 : 0) : kFirstCubeUnit + 2;
   return units <= max_texture_units ? 2 : 1;
@@ -105,7 +105,7 @@ int ImpostorMaps::impostorLayers(RasterMode mode) const {
 int ImpostorMaps::impostorChannels(size_t e) const {
   auto dispersive = [&](size_t k) { return dispersionChannels(scene, int(k)).size() > 1; };
   if (scene.elements[e].type == ElementType::Lens) return dispersive(e) ? 3 : 1;
-  if (!lensInCubes(RasterMode::Impostor)) return 1;
+  if (!lensInCubes(RenderMode::Impostor)) return 1;
   for (size_t k = 0; k < scene.elements.size(); ++k)
     if (scene.elements[k].type == ElementType::Lens && dispersive(k)) return 3;
   return 1;
@@ -138,7 +138,7 @@ void ImpostorMaps::setCubeElements(const Program& p, size_t e, const Vec3& origi
   p.set("u_max_depth", scene.render.max_depth);
   // The scene's lens, which the search can meet: a mirror's program takes its maps after the cubes; the
   // lens's own has them (setLensMaps) and needs its rotation under the loop's name too.
-  if (lensInCubes(RasterMode::Impostor))
+  if (lensInCubes(RenderMode::Impostor))
     for (size_t k = 0; k < scene.elements.size(); ++k) {
       if (scene.elements[k].type != ElementType::Lens) continue;
       if (k == e) p.set("u_lens_to_local", glm::mat3(Mat3(scene.elements[k].world_to_local)));

@@ -52,13 +52,13 @@ class ImpostorMaps {
 
   // --- the texture-unit plan ---
   size_t lensCount() const;
-  int cubeElements(RasterMode mode) const;
+  int cubeElements(RenderMode mode) const;
   // The layers of each impostor distance map (render.impostor_layers; [Umenhoffer et al.]): 2 where the texture units allow
   // the second layer's cubes (two more for one element, three more an element with CUBE_ELEMENTS), else 1.
-  int impostorLayers(RasterMode mode) const;
+  int impostorLayers(RenderMode mode) const;
   // Whether the lens is drawn in the other elements' cubes: the scene has one (the mirrors' programs take its
   // maps; its own program, which meets it again through a mirror, has them already).
-  bool lensInCubes(RasterMode mode) const { return cubeElements(mode) > 0 && lensCount() == 1; }
+  bool lensInCubes(RenderMode mode) const { return cubeElements(mode) > 0 && lensCount() == 1; }
   // The colour channels of element e's impostor program (IMPOSTOR_CHANNELS): a lens with dispersion refracts R,
   // G and B with their own indices, and so does a mirror that can show such a lens in its cubes.
   int impostorChannels(size_t e) const;

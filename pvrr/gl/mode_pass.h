@@ -42,13 +42,13 @@ class ModePass {
   virtual ~ModePass() = default;
   // Everything before the second pass: the CPU stages and the first passes (maps, cube maps), with their
   // stage notes, in the order of pvrr/base/stats.h.
-  virtual void prepare(RasterMode mode, FrameStages& stages, FrameCache* cache) = 0;
+  virtual void prepare(RenderMode mode, FrameStages& stages, FrameCache* cache) = 0;
   // Whether an element's second-pass draws add partial sums (more than three channels): the target must then
   // be float.
   virtual bool additiveDraws() const { return false; }
   // The elements into `target` (cleared depth, depth test on, GL_LESS) as seen by `eye`, before the
   // environment; returns what the second pass's note adds for them.
-  virtual std::string drawElements(RasterMode mode, const PassCamera& eye, const Framebuffer& target) = 0;
+  virtual std::string drawElements(RenderMode mode, const PassCamera& eye, const Framebuffer& target) = 0;
   // The frame's per-element PVRR state (RasterFrame::elements), once drawn.
   virtual std::vector<ElementFrame> takeElements() { return {}; }
 };

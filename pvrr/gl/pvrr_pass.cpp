@@ -41,7 +41,7 @@ VertexStageOptions PvrrPass::optionsFor(size_t e) const {
   return o;
 }
 
-void PvrrPass::prepare(RasterMode, FrameStages& stages, FrameCache* cache) {
+void PvrrPass::prepare(RenderMode, FrameStages& stages, FrameCache* cache) {
   const bool nothing_moved = cpuStages(stages, cache);
   firstPass(stages, cache, nothing_moved, cache && cache->valid);
   // The cache takes this frame whole, once its maps are drawn: the poses, and the elements with the volumes
@@ -437,7 +437,7 @@ bool PvrrPass::additiveDraws() const {
   return std::any_of(frames.begin(), frames.end(), [](const ElementFrame& f) { return f.rays.size() > 3; });
 }
 
-std::string PvrrPass::drawElements(RasterMode, const PassCamera& eye, const Framebuffer& target) {
+std::string PvrrPass::drawElements(RenderMode, const PassCamera& eye, const Framebuffer& target) {
   size_t slot = 0;  // the map slot of frames[e].views[0]
   for (const ElementFrame& f : frames) {
     target.bind();

@@ -21,9 +21,9 @@ class PvrrPass : public ModePass {
   PvrrPass(const PvrrPass&) = delete;
   PvrrPass& operator=(const PvrrPass&) = delete;
 
-  void prepare(RasterMode mode, FrameStages& stages, FrameCache* cache) override;
+  void prepare(RenderMode mode, FrameStages& stages, FrameCache* cache) override;
   bool additiveDraws() const override;
-  std::string drawElements(RasterMode mode, const PassCamera& eye, const Framebuffer& target) override;
+  std::string drawElements(RenderMode mode, const PassCamera& eye, const Framebuffer& target) override;
   std::vector<ElementFrame> takeElements() override { return std::move(frames); }
 
  private:

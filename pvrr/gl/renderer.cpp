@@ -18,24 +18,6 @@
 
 namespace pvrr::gl {
 
-RasterMode parseRasterMode(const std::string& mode) {
-  if (mode == "raster") return RasterMode::Raster;
-  if (mode == "pvrr") return RasterMode::Pvrr;
-  if (mode == "envmap") return RasterMode::Envmap;
-  if (mode == "impostor") return RasterMode::Impostor;
-  throw Error("mode: expected one of pvrr, raster, envmap, impostor, raytrace; got \"" + mode + "\"");
-}
-
-std::string modeName(RasterMode mode) {
-  switch (mode) {
-    case RasterMode::Raster: return "raster";
-    case RasterMode::Pvrr: return "pvrr";
-    case RasterMode::Envmap: return "envmap";
-    case RasterMode::Impostor: return "impostor";
-  }
-  return "?";
-}
-
 namespace {
 
 // Raster mode, and every mode in a scene without an element: the elements as plain surfaces, no CPU stage,
@@ -43,11 +25,11 @@ namespace {
 class RasterPass : public ModePass {
  public:
   explicit RasterPass(const RenderContext& c) : ctx(c) {}
-  void prepare(RasterMode mode, FrameStages& stages, FrameCache*) override {
+  void prepare(RenderMode mode, FrameStages& stages, FrameCache*) override {
     noteCpuStagesSkipped(stages, ctx.scene, mode);
     noteFirstPassesSkipped(stages, ctx.scene, mode);
   }
-  std::string drawElements(RasterMode, const PassCamera& eye, const Framebuffer& target) override {
+  std::string drawElements(RenderMode, const PassCamera& eye, const Framebuffer& target) override {
     const Scene& scene = ctx.scene;
     for (size_t e = 0; e < scene.elements.size(); ++e) {
       target.bind();
@@ -103,19 +85,20 @@ struct Renderer::Impl {
   }
 
   // The one place that chooses by mode: raster mode and scenes without elements draw them plain.
-  ModePass& passFor(RasterMode mode) {
+  ModePass& passFor(RenderMode mode) {
     if (scene.elements.empty()) return raster_pass;
     switch (mode) {
-      case RasterMode::Pvrr: return pvrr_pass;
-      case RasterMode::Envmap:
-      case RasterMode::Impostor: return cube_pass;
-      case RasterMode::Raster: break;
+      case RenderMode::Pvrr: return pvrr_pass;
+      case RenderMode::Envmap:
+      case RenderMode::Impostor: return cube_pass;
+      case RenderMode::Raster:
+      case RenderMode::Raytrace: break;  // Renderer::render refuses raytrace
     }
     return raster_pass;
   }
 
-  RasterFrame render(RasterMode mode, FrameCache* cache);
-  std::string secondPass(RasterMode mode, ModePass& pass, CullCount* culled);
+  RasterFrame render(RenderMode mode, FrameCache* cache);
+  std::string secondPass(RenderMode mode, ModePass& pass, CullCount* culled);
   void readBack(RasterFrame& out) const;
 };
 
@@ -123,10 +106,13 @@ Renderer::Renderer(const Scene& scene, const RayScene& rays, RendererOptions opt
     : impl_(std::make_unique<Impl>(scene, rays, std::move(options))) {}
 Renderer::~Renderer() = default;
 
-RasterFrame Renderer::render(RasterMode mode, FrameCache* cache) { return impl_->render(mode, cache); }
+RasterFrame Renderer::render(RenderMode mode, FrameCache* cache) {
+  PVRR_CHECK(isRasterMode(mode), "(raytrace is the reference tracer's mode)");
+  return impl_->render(mode, cache);
+}
 void Renderer::setReadBack(bool on) { impl_->options.read_back = on; }
 
-RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
+RasterFrame Renderer::Impl::render(RenderMode mode, FrameCache* cache) {
   const auto frame_start = Clock::now();
   const Observer& ob = scene.observer;
   RasterFrame out;
@@ -147,7 +133,7 @@ RasterFrame Renderer::Impl::render(RasterMode mode, FrameCache* cache) {
 }
 
 // The second pass: the elements, then the environment behind them; returns the elements' note.
-std::string Renderer::Impl::secondPass(RasterMode mode, ModePass& pass, CullCount* culled) {
+std::string Renderer::Impl::secondPass(RenderMode mode, ModePass& pass, CullCount* culled) {
   const Observer& ob = scene.observer;
   // A picture-only frame goes into 16 bits a channel (RendererOptions::seen_points), unless an element is
   // drawn in several additive draws (more than three channels): their partial sums can be negative or above

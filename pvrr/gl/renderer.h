@@ -24,10 +24,6 @@
 
 namespace pvrr::gl {
 
-enum class RasterMode { Raster, Pvrr, Envmap, Impostor };
-RasterMode parseRasterMode(const std::string& mode);  // throws pvrr::Error
-std::string modeName(RasterMode mode);                 // the name parseRasterMode takes
-
 // What one frame produced, read back from the GPU. Rows top-down. `seen` and `surface` are world points
 // (double, reconstructed from camera-relative floats).
 struct RasterFrame {
@@ -100,8 +96,9 @@ class Renderer {
   Renderer& operator=(const Renderer&) = delete;
 
   // Renders one frame of `scene` (which may have moved since construction only in its observer and in the
-  // poses of elements attached to the observer) as seen by the scene's observer.
-  RasterFrame render(RasterMode mode, FrameCache* cache = nullptr);
+  // poses of elements attached to the observer) as seen by the scene's observer. `mode`: a raster mode
+  // (isRenderMode); RenderMode::Raytrace is the tracer's (an internal error here).
+  RasterFrame render(RenderMode mode, FrameCache* cache = nullptr);
   // RendererOptions::read_back for the next frames (e.g. only the last of a run is written out).
   void setReadBack(bool on);
 

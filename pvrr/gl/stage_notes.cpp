@@ -6,6 +6,7 @@
 #include <map>
 
 #include "pvrr/base/format.h"
+#include "pvrr/base/names.h"
 #include "pvrr/gl/impostor_maps.h"
 #include "pvrr/optics/spectrum.h"
 #include "pvrr/method/view_volume.h"
@@ -25,20 +26,20 @@ bool hasLens(const Scene& scene) {
 }
 }  // namespace
 
-void noteCpuStagesSkipped(FrameStages& stages, const Scene& scene, RasterMode mode) {
+void noteCpuStagesSkipped(FrameStages& stages, const Scene& scene, RenderMode mode) {
   const size_t n_el = scene.elements.size();
   const bool has_lens = hasLens(scene);
-  const std::string why = n_el == 0 ? "no mirror or lens in the scene" : "mode " + modeName(mode);
-  stages.skipped(stage::kVertexRays, mode == RasterMode::Impostor && n_el > 0
+  const std::string why = n_el == 0 ? "no mirror or lens in the scene" : std::string("mode ") + nameOf(mode);
+  stages.skipped(stage::kVertexRays, mode == RenderMode::Impostor && n_el > 0
                                          ? why + ": each fragment reflects or refracts its own ray (second pass)"
                                          : why);
-  if (mode == RasterMode::Impostor && has_lens)
+  if (mode == RenderMode::Impostor && has_lens)
     stages.skipped(stage::kRefraction, why + ": per fragment, through the lens's refractor height maps (second pass)");
   else
     stages.skipped(stage::kRefraction, has_lens ? why : "no lens in the scene");
   stages.skipped(stage::kViewpointFit, why);
   stages.skipped(stage::kTextureCoordinates, why);
-  if (mode == RasterMode::Impostor && has_lens) {
+  if (mode == RenderMode::Impostor && has_lens) {
     int most = 1;
     bool spectral = false;
     for (size_t e = 0; e < n_el; ++e) {
@@ -93,9 +94,9 @@ void notePvrrCpuStages(FrameStages& stages, const PvrrCpuStages& s, const std::v
   }
 }
 
-void noteFirstPassesSkipped(FrameStages& stages, const Scene& scene, RasterMode mode) {
+void noteFirstPassesSkipped(FrameStages& stages, const Scene& scene, RenderMode mode) {
   const bool none = scene.elements.empty();
-  stages.skipped(stage::kFirstPass, none ? "no mirror or lens in the scene" : "mode " + modeName(mode));
+  stages.skipped(stage::kFirstPass, none ? "no mirror or lens in the scene" : std::string("mode ") + nameOf(mode));
   stages.skipped(stage::kNestedPasses, none ? "no mirror or lens in the scene" : "mode raster");
 }
 
@@ -156,13 +157,13 @@ void notePvrrFirstPass(FrameStages& stages, const Scene& scene, const RendererOp
     stages.skipped(stage::kNestedPasses, "no element is inside another element's view volume");
 }
 
-void noteCubeFirstPass(FrameStages& stages, const Scene& scene, RasterMode mode, bool cull_on, const CubeFirstPass& s) {
+void noteCubeFirstPass(FrameStages& stages, const Scene& scene, RenderMode mode, bool cull_on, const CubeFirstPass& s) {
   const size_t n_el = scene.elements.size();
-  std::string note = mode == RasterMode::Impostor ? "distance impostors: colour and seen-point cube maps" : "";
+  std::string note = mode == RenderMode::Impostor ? "distance impostors: colour and seen-point cube maps" : "";
   if (s.layers > 1)
     appendNote(note, "two layers each where needed (the second depth-peeled, " + std::to_string(s.layer1_size) +
                          "^2 a face)");
-  else if (mode == RasterMode::Impostor && scene.render.impostor_layers > 1)
+  else if (mode == RenderMode::Impostor && scene.render.impostor_layers > 1)
     appendNote(note, "one layer each: too few texture units for the second layers' cubes");
   if (s.follow > 0) appendNote(note, "normal and index cube maps of the elements in them");
   if (s.height_maps > 0) appendNote(note, "refractor height maps of " + std::to_string(s.height_maps) + " lens(es) built");
@@ -179,14 +180,14 @@ void noteCubeFirstPass(FrameStages& stages, const Scene& scene, RasterMode mode,
                                        : ""));
   else if (n_el == 1)
     stages.skipped(stage::kNestedPasses, std::string("one ") + (hasLens(scene) ? "lens" : "mirror") + ": no nesting");
-  else if (mode == RasterMode::Impostor && s.lens_count == n_el)
+  else if (mode == RenderMode::Impostor && s.lens_count == n_el)
     stages.skipped(stage::kNestedPasses, "mode impostor: lenses are absent from other elements' cube maps");
-  else if (mode == RasterMode::Impostor)
+  else if (mode == RenderMode::Impostor)
     stages.skipped(stage::kNestedPasses, "mode impostor: more than " + std::to_string(kMaxCubeElements) +
                                              " elements (or too few texture units): other elements are absent from "
                                              "the cube maps");
   else
-    stages.skipped(stage::kNestedPasses, "mode " + modeName(mode) + ": other elements are absent from the cube maps");
+    stages.skipped(stage::kNestedPasses, std::string("mode ") + nameOf(mode) + ": other elements are absent from the cube maps");
 }
 
 std::string secondLayersNote(double ms, const std::string& cull_note, uint64_t pixels) {

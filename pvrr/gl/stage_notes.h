@@ -42,7 +42,7 @@ std::string cullNote(const CullCount& c, bool cull_on);
 
 // Modes other than pvrr, and scenes without an element: none of them runs (impostor mode does their work per
 // fragment and says so).
-void noteCpuStagesSkipped(FrameStages& stages, const Scene& scene, RasterMode mode);
+void noteCpuStagesSkipped(FrameStages& stages, const Scene& scene, RenderMode mode);
 
 // What pvrr mode's CPU stages did this frame.
 struct PvrrCpuStages {
@@ -58,7 +58,7 @@ void notePvrrCpuStages(FrameStages& stages, const PvrrCpuStages& s, const std::v
 // --- first-pass and nested-passes ---
 
 // Raster mode, or no element.
-void noteFirstPassesSkipped(FrameStages& stages, const Scene& scene, RasterMode mode);
+void noteFirstPassesSkipped(FrameStages& stages, const Scene& scene, RenderMode mode);
 
 // Pvrr mode without a first pass: `reuse_note` says which maps it draws from (empty: the eye-fixed cache's).
 void notePvrrFirstPassSkipped(FrameStages& stages, const std::string& reuse_note);
@@ -88,7 +88,7 @@ struct CubeFirstPass {
   int drawn_in_cubes = 0;                 // (cube, element) pairs
   CullCount culled;
 };
-void noteCubeFirstPass(FrameStages& stages, const Scene& scene, RasterMode mode, bool cull_on, const CubeFirstPass& s);
+void noteCubeFirstPass(FrameStages& stages, const Scene& scene, RenderMode mode, bool cull_on, const CubeFirstPass& s);
 
 // --- second-pass and seen-points ---
 

@@ -13,15 +13,6 @@
 
 namespace pvrr {
 
-const char* toString(VertexStatus s) {
-  switch (s) {
-    case VertexStatus::Hit: return "hit";
-    case VertexStatus::Escape: return "escape";
-    case VertexStatus::Tir: return "tir";
-  }
-  return "?";
-}
-
 Vec3 channelWeight(const std::vector<ChannelSpec>& channels, size_t c) {
   if (channels[c].rgb_weight) return *channels[c].rgb_weight;
   if (channels.size() == 3) {
@@ -32,17 +23,23 @@ Vec3 channelWeight(const std::vector<ChannelSpec>& channels, size_t c) {
   return Vec3(1.0);
 }
 
-std::vector<ChannelSpec> dispersionChannels(const Scene& scene, int element, const std::string& dispersion,
+std::vector<ChannelSpec> dispersionChannels(const Scene& scene, int element, DispersionMode dispersion,
                                             int spectral_samples) {
-  if (dispersion != "off" && dispersion != "rgb" && dispersion != "spectral")
-    throw Error("render.dispersion: expected one of off, rgb, spectral; got \"" + dispersion + "\"");
   const Element& el = scene.elements.at(size_t(element));
-  if (dispersion == "off" || el.type != ElementType::Lens || !el.dispersion_on) return {ChannelSpec{}};
+  if (dispersion == DispersionMode::Off || el.type != ElementType::Lens || !el.dispersion_on) return {ChannelSpec{}};
   const std::vector<SpectralSample> samples =
-      dispersion == "rgb" ? rgbSamples() : spectralSamples(spectral_samples);  // throws for n < 3
+      dispersion == DispersionMode::Rgb ? rgbSamples() : spectralSamples(spectral_samples);  // throws for n < 3
   std::vector<ChannelSpec> out;
   for (const SpectralSample& s : samples) out.push_back(ChannelSpec{s.wavelength_nm, s.rgb_weight});
   return out;
+}
+
+std::vector<ChannelSpec> dispersionChannels(const Scene& scene, int element, const std::string& dispersion,
+                                            int spectral_samples) {
+  const std::optional<DispersionMode> mode = parseName<DispersionMode>(dispersion);
+  if (!mode)
+    throw Error("render.dispersion: expected one of " + nameList<DispersionMode>() + "; got \"" + dispersion + "\"");
+  return dispersionChannels(scene, element, *mode, spectral_samples);
 }
 
 std::vector<ChannelSpec> dispersionChannels(const Scene& scene, int element) {

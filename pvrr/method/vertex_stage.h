@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cad/tessellate.h"
+#include "pvrr/base/names.h"
 #include "pvrr/trace/ray_scene.h"
 #include "pvrr/method/view_volume.h"
 #include "pvrr/method/viewpoint.h"
@@ -15,7 +16,11 @@
 namespace pvrr {
 
 enum class VertexStatus { Hit, Escape, Tir };
-const char* toString(VertexStatus s);
+// The names in pvrr vertices' CSV ("status" column).
+inline constexpr NameTable<VertexStatus, 3> kVertexStatusNames = {
+    {{VertexStatus::Hit, "hit"}, {VertexStatus::Escape, "escape"}, {VertexStatus::Tir, "tir"}}};
+constexpr const NameTable<VertexStatus, 3>& nameTable(VertexStatus) { return kVertexStatusNames; }
+static_assert(namesAreUnique(kVertexStatusNames));
 
 // One vertex of the element's front surface, for one colour channel.
 struct VertexRay {
@@ -78,9 +83,12 @@ Vec3 channelWeight(const std::vector<ChannelSpec>& channels, size_t c);
 
 // THE choice of colour channels for one element, used by every raster path and report: one channel at the
 // d line with weight (1, 1, 1) for a mirror, for a lens whose material disperses not ("dispersion": false)
-// and when `dispersion` is "off"; "rgb": the three channels of spectrum.h's RGB mode (C, d, F lines, unit
-// weights); "spectral": the `spectral_samples` samples of spectrum.h's spectral mode with their weights,
-// the same the tracer's spectral mode sums. Throws pvrr::Error for another `dispersion` or too few samples.
+// and when `dispersion` is Off; Rgb: the three channels of spectrum.h's RGB mode (C, d, F lines, unit
+// weights); Spectral: the `spectral_samples` samples of spectrum.h's spectral mode with their weights,
+// the same the tracer's spectral mode sums. Throws pvrr::Error for too few samples.
+std::vector<ChannelSpec> dispersionChannels(const Scene& scene, int element, DispersionMode dispersion,
+                                            int spectral_samples);
+// The same with the dispersion mode by name (kDispersionModeNames); throws pvrr::Error for another name.
 std::vector<ChannelSpec> dispersionChannels(const Scene& scene, int element, const std::string& dispersion,
                                             int spectral_samples);
 // The same with the scene's own settings (RenderSettings::dispersion and spectral_samples).

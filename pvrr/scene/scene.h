@@ -13,6 +13,7 @@
 #include "pvrr/base/math.h"
 #include "cad/tessellate.h"
 #include "pvrr/optics/material.h"
+#include "pvrr/scene/render_desc.h"
 
 namespace pvrr {
 
@@ -103,19 +104,9 @@ struct Element {
   Vec3 toLocalDir(const Vec3& d) const { return Vec3(world_to_local * Vec4(d, 0.0)); }
 };
 
-struct RenderSettings {
-  std::string mode = "pvrr";
-  int map_size = 1024;               // a map's longer side at most (texels)
-  double map_texels_per_pixel = 4;   // a top-level map's texels per image pixel of its patch; 0: map_size
-  double map_reuse_margin_deg = 2;   // maps widened this much for reuse by later frames; 0: none
-  int impostor_iterations = 8;       // impostor mode: false-position steps of each fragment's search
-  int impostor_layers = 2;           // impostor mode: layers of each distance map (2: the second depth-peeled)
-  std::string output;
-  int max_depth = 4;
-  std::string dispersion = "off";  // off | rgb | spectral
-  int spectral_samples = 16;
-  Vec3 background{0.55, 0.7, 0.9};  // linear RGB of escaping rays (the sky)
-  double far_distance_m = 1e4;      // where escaping rays get their far point
+// The scene file's render settings (their defaults are RenderDesc's) and what the build derives from the scene.
+struct RenderSettings : RenderDesc {
+  double far_distance_m = 1e4;  // where escaping rays get their far point
 };
 
 struct Scene {

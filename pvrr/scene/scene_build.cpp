@@ -223,7 +223,7 @@ Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
         break;
       }
     }
-    mesh.name = o.name.empty() ? std::string(toString(o.type)) + std::to_string(i) : o.name;
+    mesh.name = o.name.empty() ? std::string(nameOf(o.type)) + std::to_string(i) : o.name;
     mesh.material = int(scene.materials.size());
     scene.materials.push_back(mat);
     scene.meshes.push_back(std::move(mesh));
@@ -262,7 +262,7 @@ Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
       if (el.type == ElementType::Mirror) {
         const SurfaceDesc& s = e.surface;
         if (s.isSag()) {
-          if (!e.outline) throw Error("a " + std::string(toString(s.type)) + " mirror needs an outline");
+          if (!e.outline) throw Error("a " + std::string(nameOf(s.type)) + " mirror needs an outline");
           el.surface = makeSag(s, el.outline, 0.0);
         } else if (s.type == SurfaceDesc::Type::Cad) {
           cad::ImportedModel model = cad::importCadFile(s.file);
@@ -346,17 +346,8 @@ Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
   updateAttachedElements(scene, desc);
 
   RenderSettings& rs = scene.render;
-  rs.mode = toString(desc.render.mode);
-  rs.map_size = desc.render.map_size;
-  rs.map_texels_per_pixel = desc.render.map_texels_per_pixel;
-  rs.map_reuse_margin_deg = desc.render.map_reuse_margin_deg;
-  rs.impostor_iterations = desc.render.impostor_iterations;
-  rs.impostor_layers = desc.render.impostor_layers;
-  rs.output = desc.render.output.empty() ? "out/" + scene.name + ".png" : desc.render.output;
-  rs.max_depth = desc.render.max_depth;
-  rs.dispersion = toString(desc.render.dispersion);
-  rs.spectral_samples = desc.render.spectral_samples;
-  rs.background = desc.render.background;
+  static_cast<RenderDesc&>(rs) = desc.render;
+  if (rs.output.empty()) rs.output = "out/" + scene.name + ".png";
   scene.updateBounds();
   rs.far_distance_m = std::max(1e3, 100.0 * scene.boundsRadius());
   return scene;

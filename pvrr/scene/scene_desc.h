@@ -1,5 +1,6 @@
 // The plain description of a scene: what a scene file (docs/scene-format.md) says, after parsing and
-// validation (pvrr/scene/scene_json.h) and before anything is built from it. No behaviour here beyond names.
+// validation (pvrr/scene/scene_json.h) and before anything is built from it. No behaviour here beyond names:
+// each enum's names in the scene format are its name table (pvrr/base/names.h), beside it.
 //
 // Conventions of every field below:
 // - Lengths are in metres (the loader has already converted the file's "units"); names end in _m where a
@@ -18,6 +19,8 @@
 #include <vector>
 
 #include "pvrr/base/math.h"
+#include "pvrr/base/names.h"
+#include "pvrr/scene/render_desc.h"
 
 namespace pvrr {
 
@@ -40,6 +43,18 @@ struct TextureDesc {
   std::string symbol = "arrow";      // sign: "arrow" | "bar" | "ring" | "cross"
   uint32_t seed = 1;                 // variation of page, bricks, road, windows, eye-chart orientations
 };
+// The scene format's names: "image" is the {"image": ...} form, the others are "procedural" names.
+inline constexpr NameTable<TextureDesc::Kind, 9> kTextureKindNames = {{{TextureDesc::Kind::Image, "image"},
+                                                                       {TextureDesc::Kind::Checker, "checker"},
+                                                                       {TextureDesc::Kind::EyeChart, "eye-chart"},
+                                                                       {TextureDesc::Kind::Page, "page"},
+                                                                       {TextureDesc::Kind::Bricks, "bricks"},
+                                                                       {TextureDesc::Kind::Road, "road"},
+                                                                       {TextureDesc::Kind::Windows, "windows"},
+                                                                       {TextureDesc::Kind::Sky, "sky"},
+                                                                       {TextureDesc::Kind::Sign, "sign"}}};
+constexpr const NameTable<TextureDesc::Kind, 9>& nameTable(TextureDesc::Kind) { return kTextureKindNames; }
+static_assert(namesAreUnique(kTextureKindNames));
 
 // A diffuse material of an environment object: albedo = color x texture (the texture decoded to linear).
 struct MaterialDesc {
@@ -67,6 +82,11 @@ struct LightDesc {
   Vec3 color{1};
   double intensity = 1;  // directional, point; ambient: radiance added is albedo * color * intensity
 };
+inline constexpr NameTable<LightDesc::Type, 3> kLightTypeNames = {{{LightDesc::Type::Directional, "directional"},
+                                                                   {LightDesc::Type::Point, "point"},
+                                                                   {LightDesc::Type::Ambient, "ambient"}}};
+constexpr const NameTable<LightDesc::Type, 3>& nameTable(LightDesc::Type) { return kLightTypeNames; }
+static_assert(namesAreUnique(kLightTypeNames));
 
 struct EnvObjectDesc {
   enum class Type { Mesh, Ground, Box, Sphere, Quad };
@@ -86,6 +106,13 @@ struct EnvObjectDesc {
   Vec3 v_axis{0, 0, -1};
   double radius_m = 0;  // sphere
 };
+inline constexpr NameTable<EnvObjectDesc::Type, 5> kEnvObjectTypeNames = {{{EnvObjectDesc::Type::Mesh, "mesh"},
+                                                                            {EnvObjectDesc::Type::Ground, "ground"},
+                                                                            {EnvObjectDesc::Type::Box, "box"},
+                                                                            {EnvObjectDesc::Type::Sphere, "sphere"},
+                                                                            {EnvObjectDesc::Type::Quad, "quad"}}};
+constexpr const NameTable<EnvObjectDesc::Type, 5>& nameTable(EnvObjectDesc::Type) { return kEnvObjectTypeNames; }
+static_assert(namesAreUnique(kEnvObjectTypeNames));
 
 // A surface in an element's local frame (cad/sag.h): vertex at the origin, +z the normal at the vertex
 // (towards the observer for a mirror, towards the eye for a lens), radius sign as in cad/sag.h (R > 0 convex
@@ -105,6 +132,13 @@ struct SurfaceDesc {
   double file_unit_m = 1;
   bool isSag() const { return type != Type::Cad && type != Type::Subdivision; }
 };
+inline constexpr NameTable<SurfaceDesc::Type, 7> kSurfaceTypeNames = {
+    {{SurfaceDesc::Type::Plane, "plane"}, {SurfaceDesc::Type::Sphere, "sphere"},
+     {SurfaceDesc::Type::Asphere, "asphere"}, {SurfaceDesc::Type::Toric, "toric"},
+     {SurfaceDesc::Type::Cylinder, "cylinder"}, {SurfaceDesc::Type::Cad, "cad"},
+     {SurfaceDesc::Type::Subdivision, "subdivision"}}};
+constexpr const NameTable<SurfaceDesc::Type, 7>& nameTable(SurfaceDesc::Type) { return kSurfaceTypeNames; }
+static_assert(namesAreUnique(kSurfaceTypeNames));
 
 // In the element's local xy plane (metres), centred on the vertex. Circle: width = height = diameter.
 struct OutlineDesc {
@@ -113,6 +147,11 @@ struct OutlineDesc {
   double width_m = 0, height_m = 0;
   double corner_radius_m = 0;  // rectangle
 };
+inline constexpr NameTable<OutlineDesc::Shape, 3> kOutlineShapeNames = {{{OutlineDesc::Shape::Rectangle, "rectangle"},
+                                                                         {OutlineDesc::Shape::Ellipse, "ellipse"},
+                                                                         {OutlineDesc::Shape::Circle, "circle"}}};
+constexpr const NameTable<OutlineDesc::Shape, 3>& nameTable(OutlineDesc::Shape) { return kOutlineShapeNames; }
+static_assert(namesAreUnique(kOutlineShapeNames));
 
 struct TessellationDesc {
   enum class Mode { Grid, Adaptive };
@@ -180,27 +219,15 @@ struct ElementDesc {
   double min_edge_thickness_m = 0;  // 0: not given
   LensMaterialDesc lens_material;
 };
+inline constexpr NameTable<ElementDesc::Type, 2> kElementTypeNames = {
+    {{ElementDesc::Type::Mirror, "mirror"}, {ElementDesc::Type::Lens, "lens"}}};
+constexpr const NameTable<ElementDesc::Type, 2>& nameTable(ElementDesc::Type) { return kElementTypeNames; }
+static_assert(namesAreUnique(kElementTypeNames));
 
 struct ObserverDesc {
   Vec3 eye{0}, target{0, 0, -1}, up{0, 1, 0};  // up: unit, not parallel to target - eye
   double fov_y_deg = 50;
   int image_width = 800, image_height = 600;
-};
-
-struct RenderDesc {
-  enum class Mode { Pvrr, Raster, Raytrace, Envmap, Impostor };
-  enum class Dispersion { Off, Rgb, Spectral };
-  Mode mode = Mode::Pvrr;
-  int map_size = 1024;
-  double map_texels_per_pixel = 4;  // 0: every map at map_size
-  double map_reuse_margin_deg = 2;  // 0: no map reuse across frames
-  int impostor_iterations = 8;      // impostor mode: false-position steps of each fragment's search
-  int impostor_layers = 2;          // impostor mode: layers of each distance map (2: the second depth-peeled)
-  std::string output;  // relative to the current directory, as written (default out/<scene name>.png)
-  int max_depth = 4;
-  Dispersion dispersion = Dispersion::Off;
-  int spectral_samples = 16;
-  Vec3 background{0.55, 0.7, 0.9};
 };
 
 struct SceneDesc {
@@ -216,15 +243,5 @@ struct SceneDesc {
   std::vector<ElementDesc> elements;
   RenderDesc render;
 };
-
-// The names the scene format uses for each enum value.
-const char* toString(TextureDesc::Kind k);
-const char* toString(EnvObjectDesc::Type t);
-const char* toString(LightDesc::Type t);
-const char* toString(SurfaceDesc::Type t);
-const char* toString(OutlineDesc::Shape s);
-const char* toString(ElementDesc::Type t);
-const char* toString(RenderDesc::Mode m);
-const char* toString(RenderDesc::Dispersion d);
 
 }  // namespace pvrr

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pvrr/base/error.h"
+#include "pvrr/base/names.h"
 #include "pvrr/optics/material.h"
 #include "pvrr/scene/texture_gen.h"
 
@@ -62,6 +63,14 @@ std::string joinQuoted(const std::vector<std::string>& v, const char* last_sep =
     if (i > 0) out += (i + 1 == v.size()) ? last_sep : ", ";
     out += inQuotes(v[i]);
   }
+  return out;
+}
+
+// E's names in quotes, as alternatives: "\"mirror\" | \"lens\"".
+template <class E>
+std::string alternatives() {
+  std::string out;
+  for (const std::string& name : nameVector<E>()) out += (out.empty() ? "" : " | ") + inQuotes(name);
   return out;
 }
 
@@ -276,6 +285,15 @@ class Obj {
   std::string choice(const std::string& k, const std::vector<std::string>& options, const std::string& def) const {
     return has(k) ? choice(k, options) : def;
   }
+  // A name from E's table (pvrr/base/names.h); the message lists the choices in the table's order.
+  template <class E>
+  E choice(const std::string& k) const {
+    return *parseName<E>(choice(k, nameVector<E>()));
+  }
+  template <class E>
+  E choice(const std::string& k, E def) const {
+    return has(k) ? choice<E>(k) : def;
+  }
   Vec3 vec3(const std::string& k, VecKind kind) const { return readVec<3>(c_, get(k), at(k), kind); }
   Vec3 vec3(const std::string& k, VecKind kind, Vec3 def) const { return has(k) ? vec3(k, kind) : def; }
   Vec2 vec2(const std::string& k, VecKind kind) const { return readVec<2>(c_, get(k), at(k), kind); }
@@ -310,6 +328,16 @@ std::string peekChoice(const Ctx& c, const json* j, const std::string& path, con
   // Only `key` is checked here; the caller's Obj checks the rest against the set for the chosen option.
   return Obj(c, j, path, what, keys).choice(key, options);
 }
+// The same for a name from E's table, of the values `keep` accepts (in the table's order).
+template <class E, class Keep>
+E peekChoice(const Ctx& c, const json* j, const std::string& path, const std::string& what, const std::string& key,
+             Keep keep) {
+  return *parseName<E>(peekChoice(c, j, path, what, key, nameVectorIf<E>(keep)));
+}
+template <class E>
+E peekChoice(const Ctx& c, const json* j, const std::string& path, const std::string& what, const std::string& key) {
+  return peekChoice<E>(c, j, path, what, key, [](E) { return true; });
+}
 
 const json* arrayAt(const Ctx& c, const json* j, const std::string& path, const std::string& what) {
   if (j && !j->is_array()) c.expected(path, what, j);
@@ -342,8 +370,7 @@ Mat3 readRotation(const Obj& o) {
 // Textures and materials
 
 struct ProceduralSpec {
-  const char* name;
-  TextureDesc::Kind kind;
+  TextureDesc::Kind kind;  // named by kTextureKindNames
   int resolution;
   Vec3 a, b;
   std::vector<std::string> keys;  // besides procedural, resolution, seed, a, b
@@ -351,14 +378,14 @@ struct ProceduralSpec {
 
 const std::vector<ProceduralSpec>& proceduralSpecs() {
   static const std::vector<ProceduralSpec> specs = {
-      {"checker", TextureDesc::Kind::Checker, 256, Vec3(0.9), Vec3(0.1), {"squares"}},
-      {"eye-chart", TextureDesc::Kind::EyeChart, 512, Vec3(1.0), Vec3(0.0), {"rows"}},
-      {"page", TextureDesc::Kind::Page, 512, Vec3(0.85, 0.82, 0.75), Vec3(0.02, 0.02, 0.025), {"lines"}},
-      {"bricks", TextureDesc::Kind::Bricks, 256, Vec3(0.45, 0.12, 0.07), Vec3(0.55, 0.53, 0.5), {"courses"}},
-      {"road", TextureDesc::Kind::Road, 512, Vec3(0.045, 0.045, 0.05), Vec3(0.8, 0.8, 0.75), {"lanes"}},
-      {"windows", TextureDesc::Kind::Windows, 512, Vec3(0.6, 0.45, 0.32), Vec3(0.05, 0.08, 0.12), {"grid"}},
-      {"sky", TextureDesc::Kind::Sky, 256, Vec3(0.75, 0.85, 1.0), Vec3(0.15, 0.3, 0.75), {}},
-      {"sign", TextureDesc::Kind::Sign, 256, Vec3(0.01, 0.1, 0.5), Vec3(0.9), {"symbol"}},
+      {TextureDesc::Kind::Checker, 256, Vec3(0.9), Vec3(0.1), {"squares"}},
+      {TextureDesc::Kind::EyeChart, 512, Vec3(1.0), Vec3(0.0), {"rows"}},
+      {TextureDesc::Kind::Page, 512, Vec3(0.85, 0.82, 0.75), Vec3(0.02, 0.02, 0.025), {"lines"}},
+      {TextureDesc::Kind::Bricks, 256, Vec3(0.45, 0.12, 0.07), Vec3(0.55, 0.53, 0.5), {"courses"}},
+      {TextureDesc::Kind::Road, 512, Vec3(0.045, 0.045, 0.05), Vec3(0.8, 0.8, 0.75), {"lanes"}},
+      {TextureDesc::Kind::Windows, 512, Vec3(0.6, 0.45, 0.32), Vec3(0.05, 0.08, 0.12), {"grid"}},
+      {TextureDesc::Kind::Sky, 256, Vec3(0.75, 0.85, 1.0), Vec3(0.15, 0.3, 0.75), {}},
+      {TextureDesc::Kind::Sign, 256, Vec3(0.01, 0.1, 0.5), Vec3(0.9), {"symbol"}},
   };
   return specs;
 }
@@ -375,10 +402,10 @@ TextureDesc readTexture(const Ctx& c, const json* j, const std::string& path) {
   }
   if (!j->contains("procedural")) c.expected(path, what, j);
   std::vector<std::string> names;
-  for (const ProceduralSpec& s : proceduralSpecs()) names.push_back(s.name);
+  for (const ProceduralSpec& s : proceduralSpecs()) names.push_back(nameOf(s.kind));
   const std::string name = peekChoice(c, j, path, what, "procedural", names);
   const ProceduralSpec& spec = *std::find_if(proceduralSpecs().begin(), proceduralSpecs().end(),
-                                             [&](const ProceduralSpec& s) { return name == s.name; });
+                                             [&](const ProceduralSpec& s) { return name == nameOf(s.kind); });
   std::vector<std::string> keys = {"procedural", "resolution", "seed", "a", "b"};
   keys.insert(keys.end(), spec.keys.begin(), spec.keys.end());
   Obj o(c, j, path, what, keys);
@@ -484,16 +511,16 @@ ObserverDesc readObserver(const Ctx& c, const json* j) {
 }
 
 LightDesc readLight(const Ctx& c, const json* j, const std::string& path) {
-  const std::string what = "a light {\"type\": \"directional\" | \"point\" | \"ambient\", ...}";
-  const std::string type = peekChoice(c, j, path, what, "type", {"directional", "point", "ambient"});
+  const std::string what = "a light {\"type\": " + alternatives<LightDesc::Type>() + ", ...}";
+  const LightDesc::Type type = peekChoice<LightDesc::Type>(c, j, path, what, "type");
   LightDesc l;
-  if (type == "directional") {
+  if (type == LightDesc::Type::Directional) {
     Obj o(c, j, path, what, {"type", "direction", "color", "intensity"});
     l.type = LightDesc::Type::Directional;
     l.direction = o.vec3("direction", VecKind::Direction);
     l.color = o.vec3("color", VecKind::ColourNonNegative, Vec3(1.0));
     l.intensity = o.number("intensity", kNonNegative, 1.0);
-  } else if (type == "point") {
+  } else if (type == LightDesc::Type::Point) {
     Obj o(c, j, path, what, {"type", "position", "color", "intensity"});
     l.type = LightDesc::Type::Point;
     l.position = o.point("position");
@@ -524,20 +551,21 @@ void planeAxes(const Obj& o, const std::string& hint_key, const Vec3& u_hint, bo
 }
 
 EnvObjectDesc readEnvObject(const Ctx& c, const json* j, const std::string& path, size_t index) {
-  const std::string what = "an environment object {\"type\": \"mesh\" | \"ground\" | \"box\" | \"sphere\" | \"quad\", ...}";
-  const std::string type = peekChoice(c, j, path, what, "type", {"mesh", "ground", "box", "sphere", "quad"});
+  const std::string what = "an environment object {\"type\": " + alternatives<EnvObjectDesc::Type>() + ", ...}";
+  using Type = EnvObjectDesc::Type;
+  const Type type = peekChoice<Type>(c, j, path, what, "type");
   std::vector<std::string> keys = {"type", "name", "material"};
-  if (type == "mesh") keys.insert(keys.end(), {"file", "transform"});
-  if (type == "ground") keys.insert(keys.end(), {"point", "normal", "size", "u_axis"});
-  if (type == "box") keys.insert(keys.end(), {"centre", "size", "rotation_deg", "axis_angle"});
-  if (type == "sphere") keys.insert(keys.end(), {"centre", "radius"});
-  if (type == "quad") keys.insert(keys.end(), {"centre", "normal", "up", "size"});
+  if (type == Type::Mesh) keys.insert(keys.end(), {"file", "transform"});
+  if (type == Type::Ground) keys.insert(keys.end(), {"point", "normal", "size", "u_axis"});
+  if (type == Type::Box) keys.insert(keys.end(), {"centre", "size", "rotation_deg", "axis_angle"});
+  if (type == Type::Sphere) keys.insert(keys.end(), {"centre", "radius"});
+  if (type == Type::Quad) keys.insert(keys.end(), {"centre", "normal", "up", "size"});
   Obj o(c, j, path, what, keys);
   EnvObjectDesc d;
-  d.name = o.string("name", type + std::to_string(index));
+  d.name = o.string("name", nameOf(type) + std::to_string(index));
   d.material = readMaterial(c, o.get("material"), o.at("material"));
-  if (type == "mesh") {
-    d.type = EnvObjectDesc::Type::Mesh;
+  d.type = type;
+  if (type == Type::Mesh) {
     d.file = o.file("file", {".obj", ".ply"}, "OBJ or PLY mesh");
     d.scale = Vec3(c.unit_m);
     if (o.has("transform")) {
@@ -551,25 +579,22 @@ EnvObjectDesc readEnvObject(const Ctx& c, const json* j, const std::string& path
         else d.scale = Vec3(t.number("scale", kPositive)) * c.unit_m;
       }
     }
-  } else if (type == "ground" || type == "quad") {
-    d.type = type == "ground" ? EnvObjectDesc::Type::Ground : EnvObjectDesc::Type::Quad;
-    d.position = o.point(type == "ground" ? "point" : "centre");
+  } else if (type == Type::Ground || type == Type::Quad) {
+    d.position = o.point(type == Type::Ground ? "point" : "centre");
     d.normal = o.vec3("normal", VecKind::Direction);
     d.size = Vec3(o.vec2("size", VecKind::Size) * c.unit_m, 0.0);
-    if (type == "ground") {
+    if (type == Type::Ground) {
       const Vec3 hint = o.has("u_axis") ? o.vec3("u_axis", VecKind::Direction)
                         : (std::abs(d.normal.x) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 0, -1));
       planeAxes(o, "u_axis", hint, false, d);
     } else {
       planeAxes(o, "up", o.vec3("up", VecKind::Direction, Vec3(0, 1, 0)), true, d);
     }
-  } else if (type == "box") {
-    d.type = EnvObjectDesc::Type::Box;
+  } else if (type == Type::Box) {
     d.position = o.point("centre");
     d.size = o.vec3("size", VecKind::Size) * c.unit_m;
     d.rotation = readRotation(o);
   } else {
-    d.type = EnvObjectDesc::Type::Sphere;
     d.position = o.point("centre");
     d.radius_m = o.length("radius", kPositive);
   }
@@ -578,9 +603,9 @@ EnvObjectDesc readEnvObject(const Ctx& c, const json* j, const std::string& path
 
 // --- elements ---
 
-const std::vector<std::string> kAllSurfaceTypes = {"plane", "sphere", "asphere", "toric", "cylinder", "cad", "subdivision"};
+bool anySurface(SurfaceDesc::Type) { return true; }
 // A lens surface: analytic, or a CAD face that is a graph over the lens plane (cad::makeNurbsSag).
-const std::vector<std::string> kLensSurfaceTypes = {"plane", "sphere", "asphere", "toric", "cylinder", "cad"};
+bool lensSurface(SurfaceDesc::Type t) { return t != SurfaceDesc::Type::Subdivision; }
 
 double nonZeroRadius(const Obj& o, const std::string& k) {
   const double r = o.number(k, kAny, "a length");
@@ -590,20 +615,20 @@ double nonZeroRadius(const Obj& o, const std::string& k) {
   return r * o.ctx().unit_m;
 }
 
-SurfaceDesc readSurface(const Ctx& c, const json* j, const std::string& path, const std::vector<std::string>& types) {
+// `allowed`: the surface types accepted here (anySurface, lensSurface).
+SurfaceDesc readSurface(const Ctx& c, const json* j, const std::string& path, bool (*allowed)(SurfaceDesc::Type)) {
+  using Type = SurfaceDesc::Type;
   const std::string what = "a surface {\"type\": ...}";
-  const std::string type = peekChoice(c, j, path, what, "type", types);
+  const Type type = peekChoice<Type>(c, j, path, what, "type", allowed);
   SurfaceDesc s;
-  if (type == "plane") {
+  s.type = type;
+  if (type == Type::Plane) {
     Obj o(c, j, path, what, {"type"});
-    s.type = SurfaceDesc::Type::Plane;
-  } else if (type == "sphere") {
+  } else if (type == Type::Sphere) {
     Obj o(c, j, path, what, {"type", "radius"});
-    s.type = SurfaceDesc::Type::Sphere;
     s.radius_m = nonZeroRadius(o, "radius");
-  } else if (type == "asphere") {
+  } else if (type == Type::Asphere) {
     Obj o(c, j, path, what, {"type", "radius", "conic", "coefficients"});
-    s.type = SurfaceDesc::Type::Asphere;
     s.radius_m = nonZeroRadius(o, "radius");
     s.conic = o.number("conic", kAny, 0.0);
     if (const json* a = o.get("coefficients")) {
@@ -615,25 +640,21 @@ SurfaceDesc readSurface(const Ctx& c, const json* j, const std::string& path, co
         s.coefficients.push_back(v * std::pow(c.unit_m, 1 - n));
       }
     }
-  } else if (type == "toric") {
+  } else if (type == Type::Toric) {
     Obj o(c, j, path, what, {"type", "radius_a", "radius_b", "axis_deg"});
-    s.type = SurfaceDesc::Type::Toric;
     s.radius_a_m = nonZeroRadius(o, "radius_a");
     s.radius_b_m = nonZeroRadius(o, "radius_b");
     s.axis_deg = o.number("axis_deg", closed(-360, 360), 0.0, "an angle (degrees)");
-  } else if (type == "cylinder") {
+  } else if (type == Type::Cylinder) {
     Obj o(c, j, path, what, {"type", "radius", "axis_deg"});
-    s.type = SurfaceDesc::Type::Cylinder;
     s.radius_m = nonZeroRadius(o, "radius");
     s.axis_deg = o.number("axis_deg", closed(-360, 360), 0.0, "an angle (degrees)");
-  } else if (type == "cad") {
+  } else if (type == Type::Cad) {
     Obj o(c, j, path, what, {"type", "file", "face"});
-    s.type = SurfaceDesc::Type::Cad;
     s.file = o.file("file", {".step", ".stp", ".igs", ".iges"}, "STEP or IGES file");
     s.face = o.integer("face", 0, INT_MAX, 0);
   } else {
     Obj o(c, j, path, what, {"type", "file"});
-    s.type = SurfaceDesc::Type::Subdivision;
     s.file = o.file("file", {".obj"}, "OBJ quad cage");
     s.file_unit_m = c.unit_m;
   }
@@ -683,21 +704,19 @@ void checkSagReach(const Ctx& c, const json& surface_json, const std::string& pa
 }
 
 OutlineDesc readOutline(const Ctx& c, const json* j, const std::string& path) {
-  const std::string what = "an outline {\"shape\": \"rectangle\" | \"ellipse\" | \"circle\", ...}";
-  const std::string shape = peekChoice(c, j, path, what, "shape", {"rectangle", "ellipse", "circle"});
+  const std::string what = "an outline {\"shape\": " + alternatives<OutlineDesc::Shape>() + ", ...}";
+  using Shape = OutlineDesc::Shape;
   OutlineDesc d;
-  if (shape == "circle") {
+  d.shape = peekChoice<Shape>(c, j, path, what, "shape");
+  if (d.shape == Shape::Circle) {
     Obj o(c, j, path, what, {"shape", "diameter"});
-    d.shape = OutlineDesc::Shape::Circle;
     d.width_m = d.height_m = o.length("diameter", kPositive);
-  } else if (shape == "ellipse") {
+  } else if (d.shape == Shape::Ellipse) {
     Obj o(c, j, path, what, {"shape", "width", "height"});
-    d.shape = OutlineDesc::Shape::Ellipse;
     d.width_m = o.length("width", kPositive);
     d.height_m = o.length("height", kPositive);
   } else {
     Obj o(c, j, path, what, {"shape", "width", "height", "corner_radius"});
-    d.shape = OutlineDesc::Shape::Rectangle;
     d.width_m = o.length("width", kPositive);
     d.height_m = o.length("height", kPositive);
     const double half_min = 0.5 * std::min(d.width_m, d.height_m) / c.unit_m;
@@ -796,15 +815,15 @@ LensMaterialDesc readLensMaterial(const Ctx& c, const json* j, const std::string
 }
 
 ElementDesc readElement(const Ctx& c, const json* j, const std::string& path, size_t index) {
-  const std::string what = "an element {\"type\": \"mirror\" | \"lens\", ...}";
-  const std::string type = peekChoice(c, j, path, what, "type", {"mirror", "lens"});
+  const std::string what = "an element {\"type\": " + alternatives<ElementDesc::Type>() + ", ...}";
+  const ElementDesc::Type type = peekChoice<ElementDesc::Type>(c, j, path, what, "type");
   std::vector<std::string> keys = {"name", "type", "pose", "attached_to_observer", "outline", "tessellation",
                                    "patches", "max_patch_fov_deg", "material"};
-  if (type == "mirror") keys.push_back("surface");
+  if (type == ElementDesc::Type::Mirror) keys.push_back("surface");
   else keys.insert(keys.end(), {"front", "back", "centre_thickness", "min_edge_thickness", "prescription"});
   Obj o(c, j, path, what, keys);
   ElementDesc e;
-  e.type = type == "mirror" ? ElementDesc::Type::Mirror : ElementDesc::Type::Lens;
+  e.type = type;
   e.name = o.string("name", "element" + std::to_string(index));
   e.attached_to_observer = o.boolean("attached_to_observer", false);
 
@@ -822,7 +841,7 @@ ElementDesc readElement(const Ctx& c, const json* j, const std::string& path, si
   // Surfaces first: whether an outline is required depends on them.
   bool analytic = true;
   if (e.type == ElementDesc::Type::Mirror) {
-    e.surface = readSurface(c, o.get("surface"), o.at("surface"), kAllSurfaceTypes);
+    e.surface = readSurface(c, o.get("surface"), o.at("surface"), anySurface);
     analytic = e.surface.isSag();
     e.mirror_material = readMirrorMaterial(c, o.get("material"), o.at("material"));
   } else {
@@ -839,8 +858,8 @@ ElementDesc readElement(const Ctx& c, const json* j, const std::string& path, si
       if (p.has("base_curve_d")) rx.base_curve_d = p.number("base_curve_d", leftOpen(0, 25), "a power in dioptres");
       e.prescription = rx;
     } else {
-      e.front = readSurface(c, o.get("front"), o.at("front"), kLensSurfaceTypes);
-      e.back = readSurface(c, o.get("back"), o.at("back"), kLensSurfaceTypes);
+      e.front = readSurface(c, o.get("front"), o.at("front"), lensSurface);
+      e.back = readSurface(c, o.get("back"), o.at("back"), lensSurface);
     }
     if (!o.has("centre_thickness") && !o.has("min_edge_thickness"))
       o.expected("centre_thickness", "a length > 0 (or \"min_edge_thickness\")");
@@ -858,7 +877,7 @@ ElementDesc readElement(const Ctx& c, const json* j, const std::string& path, si
       checkSagReach(c, *o.get("back"), o.at("back"), e.back, *e.outline);
     }
   } else if (o.has("outline")) {
-    o.expected("outline", std::string("no outline with a \"") + toString(e.surface.type) +
+    o.expected("outline", std::string("no outline with a \"") + nameOf(e.surface.type) +
                               "\" surface (its own boundary is the outline)");
   }
 
@@ -883,34 +902,26 @@ ElementDesc readElement(const Ctx& c, const json* j, const std::string& path, si
 }
 
 RenderDesc readRender(const Ctx& c, const json* j, const std::string& source) {
-  RenderDesc r;
+  RenderDesc r;  // its defaults are the format's
   r.output = (fs::path("out") / (fs::path(source).stem().string() + ".png")).string();
   if (!j) return r;
   Obj o(c, j, "render", "an object {\"mode\", \"map_size\", \"output\", ...}",
         {"mode", "map_size", "map_texels_per_pixel", "map_reuse_margin_deg", "impostor_iterations", "impostor_layers", "output",
          "max_depth", "dispersion", "spectral_samples",
          "background"});
-  const std::string mode = o.choice("mode", {"pvrr", "raster", "raytrace", "envmap", "impostor"}, "pvrr");
-  r.mode = mode == "pvrr"       ? RenderDesc::Mode::Pvrr
-           : mode == "raster"   ? RenderDesc::Mode::Raster
-           : mode == "raytrace" ? RenderDesc::Mode::Raytrace
-           : mode == "envmap"   ? RenderDesc::Mode::Envmap
-                                : RenderDesc::Mode::Impostor;
-  r.map_size = o.integer("map_size", 16, kMaxImageSize, 1024);
-  r.map_texels_per_pixel = o.number("map_texels_per_pixel", closed(0, 1e4), 4);
-  r.map_reuse_margin_deg = o.number("map_reuse_margin_deg", closed(0, 10), 2);
-  r.impostor_iterations = o.integer("impostor_iterations", 0, 64, 8);
-  r.impostor_layers = o.integer("impostor_layers", 1, 2, 2);
+  r.mode = o.choice<RenderMode>("mode", r.mode);
+  r.map_size = o.integer("map_size", 16, kMaxImageSize, r.map_size);
+  r.map_texels_per_pixel = o.number("map_texels_per_pixel", closed(0, 1e4), r.map_texels_per_pixel);
+  r.map_reuse_margin_deg = o.number("map_reuse_margin_deg", closed(0, 10), r.map_reuse_margin_deg);
+  r.impostor_iterations = o.integer("impostor_iterations", 0, 64, r.impostor_iterations);
+  r.impostor_layers = o.integer("impostor_layers", 1, 2, r.impostor_layers);
   if (o.has("output")) {
     r.output = o.string("output");
     if (!endsWithAny(r.output, {".png"})) o.expected("output", "a file name ending in \".png\"");
   }
-  r.max_depth = o.integer("max_depth", 1, 64, 4);
-  const std::string disp = o.choice("dispersion", {"off", "rgb", "spectral"}, "off");
-  r.dispersion = disp == "off" ? RenderDesc::Dispersion::Off
-                 : disp == "rgb" ? RenderDesc::Dispersion::Rgb
-                                 : RenderDesc::Dispersion::Spectral;
-  r.spectral_samples = o.integer("spectral_samples", 3, 256, 16);
+  r.max_depth = o.integer("max_depth", 1, 64, r.max_depth);
+  r.dispersion = o.choice<DispersionMode>("dispersion", r.dispersion);
+  r.spectral_samples = o.integer("spectral_samples", 3, 256, r.spectral_samples);
   r.background = o.vec3("background", VecKind::ColourNonNegative, r.background);
   return r;
 }
@@ -1178,78 +1189,6 @@ SceneDesc loadScene(const std::string& path, const std::vector<std::string>& set
   if (in.bad()) throw Error(path + ": cannot read the scene file");
   const std::string dir = fs::path(path).parent_path().string();
   return parseScene(ss.str(), path, dir, set_overrides);
-}
-
-const char* toString(TextureDesc::Kind k) {
-  switch (k) {
-    case TextureDesc::Kind::Image: return "image";
-    case TextureDesc::Kind::Checker: return "checker";
-    case TextureDesc::Kind::EyeChart: return "eye-chart";
-    case TextureDesc::Kind::Page: return "page";
-    case TextureDesc::Kind::Bricks: return "bricks";
-    case TextureDesc::Kind::Road: return "road";
-    case TextureDesc::Kind::Windows: return "windows";
-    case TextureDesc::Kind::Sky: return "sky";
-    case TextureDesc::Kind::Sign: return "sign";
-  }
-  return "?";
-}
-const char* toString(EnvObjectDesc::Type t) {
-  switch (t) {
-    case EnvObjectDesc::Type::Mesh: return "mesh";
-    case EnvObjectDesc::Type::Ground: return "ground";
-    case EnvObjectDesc::Type::Box: return "box";
-    case EnvObjectDesc::Type::Sphere: return "sphere";
-    case EnvObjectDesc::Type::Quad: return "quad";
-  }
-  return "?";
-}
-const char* toString(LightDesc::Type t) {
-  switch (t) {
-    case LightDesc::Type::Directional: return "directional";
-    case LightDesc::Type::Point: return "point";
-    case LightDesc::Type::Ambient: return "ambient";
-  }
-  return "?";
-}
-const char* toString(SurfaceDesc::Type t) {
-  switch (t) {
-    case SurfaceDesc::Type::Plane: return "plane";
-    case SurfaceDesc::Type::Sphere: return "sphere";
-    case SurfaceDesc::Type::Asphere: return "asphere";
-    case SurfaceDesc::Type::Toric: return "toric";
-    case SurfaceDesc::Type::Cylinder: return "cylinder";
-    case SurfaceDesc::Type::Cad: return "cad";
-    case SurfaceDesc::Type::Subdivision: return "subdivision";
-  }
-  return "?";
-}
-const char* toString(OutlineDesc::Shape s) {
-  switch (s) {
-    case OutlineDesc::Shape::Rectangle: return "rectangle";
-    case OutlineDesc::Shape::Ellipse: return "ellipse";
-    case OutlineDesc::Shape::Circle: return "circle";
-  }
-  return "?";
-}
-const char* toString(ElementDesc::Type t) { return t == ElementDesc::Type::Mirror ? "mirror" : "lens"; }
-const char* toString(RenderDesc::Mode m) {
-  switch (m) {
-    case RenderDesc::Mode::Pvrr: return "pvrr";
-    case RenderDesc::Mode::Raster: return "raster";
-    case RenderDesc::Mode::Raytrace: return "raytrace";
-    case RenderDesc::Mode::Envmap: return "envmap";
-    case RenderDesc::Mode::Impostor: return "impostor";
-  }
-  return "?";
-}
-const char* toString(RenderDesc::Dispersion d) {
-  switch (d) {
-    case RenderDesc::Dispersion::Off: return "off";
-    case RenderDesc::Dispersion::Rgb: return "rgb";
-    case RenderDesc::Dispersion::Spectral: return "spectral";
-  }
-  return "?";
 }
 
 }  // namespace pvrr

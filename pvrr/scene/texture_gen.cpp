@@ -361,10 +361,10 @@ TextureImage generateTexture(const TextureDesc& d) {
   if (d.kind == TextureDesc::Kind::Image)
     throw Error("texture \"" + d.image_path + "\": an image texture is read from its file, not generated");
   if (d.width < 8 || d.width > 1024 || d.height < 8 || d.height > 1024)
-    throw Error(std::string(toString(d.kind)) + " texture: size " + std::to_string(d.width) + " x " +
+    throw Error(std::string(nameOf(d.kind)) + " texture: size " + std::to_string(d.width) + " x " +
                 std::to_string(d.height) + " outside [8, 1024]");
   const auto positive = [&](int v, const char* what) {
-    if (v < 1) throw Error(std::string(toString(d.kind)) + " texture: " + what + " must be >= 1");
+    if (v < 1) throw Error(std::string(nameOf(d.kind)) + " texture: " + what + " must be >= 1");
   };
   switch (d.kind) {
     case TextureDesc::Kind::Checker:

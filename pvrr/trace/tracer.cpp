@@ -17,13 +17,6 @@
 
 namespace pvrr {
 
-DispersionMode parseDispersionMode(const std::string& s) {
-  if (s == "off") return DispersionMode::Off;
-  if (s == "rgb") return DispersionMode::Rgb;
-  if (s == "spectral") return DispersionMode::Spectral;
-  throw Error("dispersion: expected one of off, rgb, spectral; got \"" + s + "\"");
-}
-
 Tracer::Tracer(const RayScene& rays, TraceOptions options)
     : rays_(rays), scene_(rays.scene()), options_(options) {
   if (options_.dispersion == DispersionMode::Spectral) spectral_ = spectralSamples(options_.spectral_samples);

@@ -6,11 +6,12 @@
 // Total internal reflection inside a lens is followed (up to the depth limit). A mirror reflects with its
 // reflectance (or the conductor Fresnel reflectance of its metal, per channel); its back side is dark.
 //
-// Dispersion: "off" traces one ray with each lens's index at the d line; "rgb" traces one ray per channel at
-// that channel's wavelength (pvrr/optics/spectrum.h) and keeps that channel; "spectral" traces N wavelengths and
-// sums them with the colour-matching weights of pvrr/optics/spectrum.h. A metal mirror with a measured table
-// (MirrorMaterial::metal_table) reflects with its per-channel (n, k) in the off and rgb modes, and in the
-// spectral mode with its conductor Fresnel reflectance at each sample's wavelength, Metal::index(lambda).
+// Dispersion (DispersionMode, pvrr/scene/render_desc.h): "off" traces one ray with each lens's index at the d
+// line; "rgb" traces one ray per channel at that channel's wavelength (pvrr/optics/spectrum.h) and keeps that
+// channel; "spectral" traces N wavelengths and sums them with the colour-matching weights of
+// pvrr/optics/spectrum.h. A metal mirror with a measured table (MirrorMaterial::metal_table) reflects with its
+// per-channel (n, k) in the off and rgb modes, and in the spectral mode with its conductor Fresnel
+// reflectance at each sample's wavelength, Metal::index(lambda).
 //
 // Primary rays: render() intersects the primary rays of 4 x 4 pixel tiles as Embree packets
 // (RayScene::intersectPacket, the same exact hits as single rays); every secondary ray is a single ray.
@@ -22,11 +23,9 @@
 
 #include "pvrr/trace/ray_scene.h"
 #include "pvrr/optics/spectrum.h"
+#include "pvrr/scene/render_desc.h"
 
 namespace pvrr {
-
-enum class DispersionMode { Off, Rgb, Spectral };
-DispersionMode parseDispersionMode(const std::string& s);  // throws pvrr::Error
 
 // One segment of a traced path (pvrr trace prints these). The segment runs from `origin` along `direction`
 // to its event point.

@@ -153,6 +153,22 @@ TEST_F(Cli, RaytraceModeRenders) {
   EXPECT_TRUE(fs::exists(out));
 }
 
+// --mode and --modes parse through the render mode's name table (pvrr/scene/render_desc.h); the message lists
+// the raster modes, then raytrace, as it always has. Sweep and compare take raster modes only.
+TEST_F(Cli, UnknownModesGiveOneMessage) {
+  const std::string expected = "mode: expected one of pvrr, raster, envmap, impostor, raytrace; got ";
+  Result r = pvrr("render models/plane-mirror.json --mode bogus --size 8x6 --out '" + path("m.png") + "'");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(r.err, expected + "\"bogus\"\n");
+  EXPECT_FALSE(fs::exists(path("m.png")));
+  r = pvrr("sweep models/plane-mirror.json --modes pvrr,raytrace --out '" + dir_.string() + "'");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(r.err, expected + "\"raytrace\"\n");
+  r = pvrr("compare models/plane-mirror.json --modes pvrr,Envmap --out '" + dir_.string() + "'");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(r.err, expected + "\"Envmap\"\n");
+}
+
 TEST_F(Cli, SweepWritesCsvAndPlotsAndPlotRedraws) {
   Result r = pvrr("sweep models/plane-mirror.json --tessellation 3,5 --map-size 128 --modes pvrr --size 64x48 --frames 1 --out '" +
                dir_.string() + "'");

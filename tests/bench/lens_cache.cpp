@@ -75,12 +75,12 @@ void frameVsRaster(benchmark::State& state, const std::string& scene, const std:
   auto renderOnce = [&](Variant v) {
     gl::RasterFrame f;
     switch (v) {
-      case Variant::Raster: f = r.render(gl::RasterMode::Raster); break;
-      case Variant::Fresh: f = r.render(gl::RasterMode::Pvrr); break;
-      case Variant::CachedOrbit: turnHead(); f = r.render(gl::RasterMode::Pvrr, &cache); break;
+      case Variant::Raster: f = r.render(RenderMode::Raster); break;
+      case Variant::Fresh: f = r.render(RenderMode::Pvrr); break;
+      case Variant::CachedOrbit: turnHead(); f = r.render(RenderMode::Pvrr, &cache); break;
       case Variant::CachedStill:
         cache.environment_changed = false;
-        f = r.render(gl::RasterMode::Pvrr, &cache);
+        f = r.render(RenderMode::Pvrr, &cache);
         break;
     }
     for (const StageTiming& t : f.stages.stages) first_passes += t.name == "first-pass" && t.ran;

@@ -55,7 +55,7 @@ void BM_TangentClearance(benchmark::State& state) {
 BENCHMARK(BM_TangentClearance)->Unit(benchmark::kMillisecond);
 
 // A full raster frame at 1280 x 720 (GPU finished) on the backend named by PVRR_GL (default auto).
-void BM_RasterFrame(benchmark::State& state, const char* scene, gl::RasterMode mode) {
+void BM_RasterFrame(benchmark::State& state, const char* scene, RenderMode mode) {
   auto ctx = gl::GlContext::create(gl::glBackendFromEnvironment(gl::GlBackend::Auto));
   Scene s = loadDefault(scene, {"observer.image_size=[1280,720]"});
   RayScene rays(s);
@@ -67,18 +67,18 @@ void BM_RasterFrame(benchmark::State& state, const char* scene, gl::RasterMode m
   for (auto _ : state) benchmark::DoNotOptimize(r.render(mode).frame_ms);
   state.SetLabel(ctx->backendName() + " " + ctx->glRenderer());
 }
-BENCHMARK_CAPTURE(BM_RasterFrame, car_mirror_pvrr, "car-mirror", gl::RasterMode::Pvrr)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_RasterFrame, car_mirror_envmap, "car-mirror", gl::RasterMode::Envmap)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_RasterFrame, car_mirror_raster, "car-mirror", gl::RasterMode::Raster)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_RasterFrame, car_mirror_pvrr, "car-mirror", RenderMode::Pvrr)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_RasterFrame, car_mirror_envmap, "car-mirror", RenderMode::Envmap)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_RasterFrame, car_mirror_raster, "car-mirror", RenderMode::Raster)->Unit(benchmark::kMillisecond)->UseRealTime();
 // The distance-impostor glass mode: six cube faces at the scene's map size, then per-fragment searches (a
 // spectacle lens fills the image).
-BENCHMARK_CAPTURE(BM_RasterFrame, car_mirror_impostor, "car-mirror", gl::RasterMode::Impostor)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_RasterFrame, spectacle_lens_impostor, "spectacle-lens", gl::RasterMode::Impostor)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_RasterFrame, spectacle_lens_pvrr, "spectacle-lens", gl::RasterMode::Pvrr)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_RasterFrame, car_mirror_impostor, "car-mirror", RenderMode::Impostor)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_RasterFrame, spectacle_lens_impostor, "spectacle-lens", RenderMode::Impostor)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_RasterFrame, spectacle_lens_pvrr, "spectacle-lens", RenderMode::Pvrr)->Unit(benchmark::kMillisecond)->UseRealTime();
 // A mirror seen in a mirror: pvrr's nested first passes, and the impostor's two elements' cubes with the other
 // mirror drawn in each (a third cube of normals), followed per fragment.
-BENCHMARK_CAPTURE(BM_RasterFrame, mirror_pair_pvrr, "mirror-pair", gl::RasterMode::Pvrr)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_RasterFrame, mirror_pair_impostor, "mirror-pair", gl::RasterMode::Impostor)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_RasterFrame, mirror_pair_pvrr, "mirror-pair", RenderMode::Pvrr)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_RasterFrame, mirror_pair_impostor, "mirror-pair", RenderMode::Impostor)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 

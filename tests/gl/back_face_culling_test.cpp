@@ -66,7 +66,7 @@ TEST_P(BackFaceCullingTest, ThePictureIsUnchangedButForSilhouetteTies) {
     gl::RendererOptions off_opts;
     off_opts.cull_back_faces = false;
     gl::Renderer off(s, rays, off_opts), on(s, rays, gl::RendererOptions{});
-    for (gl::RasterMode mode : {gl::RasterMode::Pvrr, gl::RasterMode::Envmap, gl::RasterMode::Raster}) {
+    for (RenderMode mode : {RenderMode::Pvrr, RenderMode::Envmap, RenderMode::Raster}) {
       const gl::RasterFrame a = off.render(mode), b = on.render(mode);
       const Comparison c = compare(a, b, ref);
       // Ties happen only where a back face meets a front face on a silhouette: a few pixels in 19,200.
@@ -77,11 +77,11 @@ TEST_P(BackFaceCullingTest, ThePictureIsUnchangedButForSilhouetteTies) {
       const StageTiming* off_second = a.stages.find("second-pass");
       ASSERT_TRUE(off_second);
       EXPECT_NE(off_second->note.find("not culled"), std::string::npos);
-      if (mode != gl::RasterMode::Raster) {
+      if (mode != RenderMode::Raster) {
         const Culled first = culledIn(b, "first-pass");
         EXPECT_GT(first.drawn, 0) << scene << " mode " << int(mode);
         // A reversed (zooming) map draws every face; forward maps and cube faces cull.
-        bool forward = mode == gl::RasterMode::Envmap;
+        bool forward = mode == RenderMode::Envmap;
         int reversed = 0;  // reversed maps drawn: every closed mesh in each keeps its back faces
         for (const ElementFrame& f : b.elements)
           for (const PatchView& v : f.views) {
@@ -94,7 +94,7 @@ TEST_P(BackFaceCullingTest, ThePictureIsUnchangedButForSilhouetteTies) {
         int closed = 0;
         for (const EnvMesh& m : s.meshes) closed += m.closed_convex;
         EXPECT_GE(first.drawn - first.culled, reversed * closed) << scene << ": a reversed map culls nothing";
-        if (std::string(scene) == "concave-mirror" && mode == gl::RasterMode::Pvrr) {
+        if (std::string(scene) == "concave-mirror" && mode == RenderMode::Pvrr) {
           EXPECT_GT(reversed, 0);
         }
       }
@@ -133,7 +133,7 @@ TEST_P(BackFaceCullingTest, MeshesNearClippingCanOpenKeepEveryFace) {
   gl::RendererOptions off_opts;
   off_opts.cull_back_faces = false;
   gl::Renderer off(s, rays, off_opts), on(s, rays, gl::RendererOptions{});
-  const gl::RasterFrame a = off.render(gl::RasterMode::Pvrr), b = on.render(gl::RasterMode::Pvrr);
+  const gl::RasterFrame a = off.render(RenderMode::Pvrr), b = on.render(RenderMode::Pvrr);
   ASSERT_EQ(a.color.size(), b.color.size());
   size_t differ = 0, grazing_pixels = 0, above_pixels = 0;
   for (size_t i = 0; i < a.color.size(); ++i) {

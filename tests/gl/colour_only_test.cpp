@@ -49,8 +49,8 @@ TEST_P(ColourOnlyTest, SameColoursWithoutSeenPoints) {
     gl::Renderer a(s, rays, with), b(s, rays, without);
     // Impostor: its cube maps keep their seen points (the distances it searches) in the colour-only frame;
     // envmap after it recreates them without (the same renderer switching modes).
-    for (gl::RasterMode mode :
-         {gl::RasterMode::Pvrr, gl::RasterMode::Impostor, gl::RasterMode::Envmap, gl::RasterMode::Raster}) {
+    for (RenderMode mode :
+         {RenderMode::Pvrr, RenderMode::Impostor, RenderMode::Envmap, RenderMode::Raster}) {
       const gl::RasterFrame fa = a.render(mode), fb = b.render(mode);
       ASSERT_EQ(fa.color.size(), fb.color.size()) << scene;
       EXPECT_EQ(fa.seen.size(), fa.color.size());
@@ -61,14 +61,14 @@ TEST_P(ColourOnlyTest, SameColoursWithoutSeenPoints) {
       for (size_t i = 0; i < fa.color.size(); ++i)
         for (int c = 0; c < 3; ++c) {
           // The float target (spectral, pvrr mode) keeps the colours as they are; the 16-bit one clamps them.
-          const bool float_target = spectral && mode == gl::RasterMode::Pvrr;
+          const bool float_target = spectral && mode == RenderMode::Pvrr;
           const double expected = float_target ? fa.color[i][c] : std::clamp(fa.color[i][c], 0.0, 1.0);
           worst = std::max(worst, std::abs(expected - fb.color[i][c]));
           const int code = std::abs(int(linearToSrgb8(fa.color[i][c])) - int(linearToSrgb8(fb.color[i][c])));
           worst_code = std::max(worst_code, code);
           codes_differ += code != 0;
         }
-      EXPECT_LE(worst, spectral && mode == gl::RasterMode::Pvrr ? kColourTol : kUnorm16Tol) << scene << " mode " << int(mode);
+      EXPECT_LE(worst, spectral && mode == RenderMode::Pvrr ? kColourTol : kUnorm16Tol) << scene << " mode " << int(mode);
       EXPECT_LE(worst_code, 1) << scene << " mode " << int(mode);
       EXPECT_LE(codes_differ, fa.color.size() * 3 / 100) << scene << " mode " << int(mode);
       const StageTiming* on = fa.stages.find("seen-points");
@@ -85,10 +85,10 @@ TEST_P(ColourOnlyTest, SameColoursWithoutSeenPoints) {
 // elements where a later frame does: the same element pixels, the same colours.
 TEST_P(ColourOnlyTest, FirstFrameOfEachModeEqualsALaterOne) {
   // The reading lens in impostor mode: its first frame also builds the lens's height maps.
-  const std::vector<std::pair<std::string, gl::RasterMode>> cases = {
-      {"car-mirror", gl::RasterMode::Raster},   {"car-mirror", gl::RasterMode::Envmap},
-      {"car-mirror", gl::RasterMode::Impostor}, {"car-mirror", gl::RasterMode::Pvrr},
-      {"reading-lens", gl::RasterMode::Impostor}};
+  const std::vector<std::pair<std::string, RenderMode>> cases = {
+      {"car-mirror", RenderMode::Raster},   {"car-mirror", RenderMode::Envmap},
+      {"car-mirror", RenderMode::Impostor}, {"car-mirror", RenderMode::Pvrr},
+      {"reading-lens", RenderMode::Impostor}};
   for (const auto& [scene, mode] : cases) {
     Scene s = buildScene(loadScene(std::string(PVRR_SOURCE_DIR) + "/models/" + scene + ".json",
                                    {"observer.image_size=[96,72]", "render.map_size=256"}));
@@ -124,10 +124,10 @@ TEST_P(ColourOnlyTest, EveryPixelIsDrawnWithoutAColourClear) {
     Scene s = buildScene(loadScene(std::string(PVRR_SOURCE_DIR) + "/models/" + scene + ".json",
                                    {"observer.image_size=[96,72]", "render.map_size=256"}));
     RayScene rays(s);
-    for (gl::RasterMode mode : {gl::RasterMode::Pvrr, gl::RasterMode::Raster}) {
+    for (RenderMode mode : {RenderMode::Pvrr, RenderMode::Raster}) {
       for (const bool seen_points : {true, false}) {  // the float target, and the picture-only 16-bit one
         // In raster mode the spectacle lens is a uniform grey filling the view from any direction: nothing to see.
-        if (mode == gl::RasterMode::Raster && std::string(scene) == "spectacle-lens") continue;
+        if (mode == RenderMode::Raster && std::string(scene) == "spectacle-lens") continue;
         gl::RendererOptions o;
         o.seen_points = seen_points;
         const gl::RasterFrame fresh = gl::Renderer(s, rays, o).render(mode);
@@ -144,7 +144,7 @@ TEST_P(ColourOnlyTest, EveryPixelIsDrawnWithoutAColourClear) {
         s.observer.target = target;
         const gl::RasterFrame again = reused.render(mode);
         EXPECT_EQ(other_large.color.size(), 64 * fresh.color.size());
-        if (mode == gl::RasterMode::Pvrr) {  // the large view's maps were larger (the first-pass notes say so)
+        if (mode == RenderMode::Pvrr) {  // the large view's maps were larger (the first-pass notes say so)
           const StageTiming *large_fp = other_large.stages.find("first-pass"), *fp = again.stages.find("first-pass");
           ASSERT_TRUE(large_fp && fp);
           EXPECT_NE(large_fp->note, fp->note) << scene;
@@ -185,8 +185,8 @@ TEST_P(ColourOnlyTest, RgbLensPlanesEqualTheGeneralMap) {
     w[int((c + 1) % 3)] = 1e-30;
     general.vertex.channels[c].rgb_weight = w;
   }
-  const gl::RasterFrame a = gl::Renderer(s, rays, planes).render(gl::RasterMode::Pvrr);
-  const gl::RasterFrame b = gl::Renderer(s, rays, general).render(gl::RasterMode::Pvrr);
+  const gl::RasterFrame a = gl::Renderer(s, rays, planes).render(RenderMode::Pvrr);
+  const gl::RasterFrame b = gl::Renderer(s, rays, general).render(RenderMode::Pvrr);
   ASSERT_EQ(a.color.size(), b.color.size());
   const StageTiming *pa = a.stages.find("first-pass"), *pb = b.stages.find("first-pass");
   ASSERT_TRUE(pa && pb);
@@ -222,7 +222,7 @@ TEST_P(ColourOnlyTest, ElementsInsideAnRgbLensMap) {
     RayScene rays(s);
     gl::RendererOptions opt;
     opt.vertex.channels.clear();  // each element its own: the lens R, G, B; the mirror one
-    const gl::RasterFrame f = gl::Renderer(s, rays, opt).render(gl::RasterMode::Pvrr);
+    const gl::RasterFrame f = gl::Renderer(s, rays, opt).render(RenderMode::Pvrr);
     const StageTiming *fp = f.stages.find("first-pass"), *np = f.stages.find("nested-passes");
     ASSERT_TRUE(fp && np);
     EXPECT_NE(fp->note.find("RGB planes"), std::string::npos) << fp->note;

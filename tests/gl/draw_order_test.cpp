@@ -57,7 +57,7 @@ TEST_P(DrawOrderTest, ShippedScenesAreTheSameButForDepthTies) {
     const Scene s = test::shippedScene(name, {"observer.image_size=[160,120]"});
     RayScene rays(s);
     gl::Renderer in_scene_order(s, rays, sceneOrder()), sorted(s, rays, gl::RendererOptions{});
-    for (const gl::RasterMode mode : {gl::RasterMode::Pvrr, gl::RasterMode::Envmap, gl::RasterMode::Raster}) {
+    for (const RenderMode mode : {RenderMode::Pvrr, RenderMode::Envmap, RenderMode::Raster}) {
       const gl::RasterFrame a = in_scene_order.render(mode), b = sorted.render(mode);
       ASSERT_EQ(a.seen.size(), a.color.size());
       const Differences d = compare(a, b, s.observer.eye);
@@ -74,7 +74,7 @@ long long samplesPassed(gl::Renderer& r) {
   GLuint query = 0;
   glGenQueries(1, &query);
   glBeginQuery(GL_SAMPLES_PASSED, query);
-  r.render(gl::RasterMode::Pvrr);
+  r.render(RenderMode::Pvrr);
   glEndQuery(GL_SAMPLES_PASSED);
   GLuint64 n = 0;
   glGetQueryObjectui64v(query, GL_QUERY_RESULT, &n);

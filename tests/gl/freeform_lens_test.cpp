@@ -60,7 +60,7 @@ TEST_P(FreeformLensTest, ProgressiveLensMatchesTheReference) {
   RayScene rays(s);
   const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
   gl::Renderer r(s, rays, gl::RendererOptions{});
-  const gl::RasterFrame f = r.render(gl::RasterMode::Pvrr);
+  const gl::RasterFrame f = r.render(RenderMode::Pvrr);
   const Errors all = errors(ref, f, 0, ref.height);
   // The lens fills the view (its rim is just outside the corners).
   EXPECT_GT(all.pixels, size_t(0.99 * ref.width * ref.height));

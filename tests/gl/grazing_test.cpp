@@ -51,7 +51,7 @@ TEST_P(GrazingTest, MirrorSeenNearlyEdgeOnStaysFiniteAndExact) {
       std::sort(e.begin(), e.end());
       return e;
     };
-    const gl::RasterFrame f = r.render(gl::RasterMode::Pvrr);
+    const gl::RasterFrame f = r.render(RenderMode::Pvrr);
     const std::vector<double> err = errors(f);
     ASSERT_GT(err.size(), 20u) << incidence_deg << " deg";
     const PatchView& pv = f.elements[0].views[0];
@@ -63,7 +63,7 @@ TEST_P(GrazingTest, MirrorSeenNearlyEdgeOnStaysFiniteAndExact) {
     // 1 / cos(incidence)); a fit gone wrong is tens of arcmin off.
     EXPECT_LE(err[err.size() / 2], kMedianArcmin) << incidence_deg << " deg";
     // The impostor mode reflects each fragment's own ray, whatever the angle: finite, and closer.
-    const gl::RasterFrame imp = r.render(gl::RasterMode::Impostor);
+    const gl::RasterFrame imp = r.render(RenderMode::Impostor);
     const std::vector<double> imp_err = errors(imp);
     ASSERT_GT(imp_err.size(), 20u) << incidence_deg << " deg";
     // Mirror pixels of the reference that the impostor drops (a search that did not converge, or a view ray

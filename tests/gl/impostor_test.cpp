@@ -85,10 +85,10 @@ ImpostorRun runImpostor(const Scene& s, bool with_envmap = true) {
   gl::RendererOptions o;
   o.map_size = 512;
   gl::Renderer r(s, rays, o);
-  run.f = r.render(gl::RasterMode::Impostor);
+  run.f = r.render(RenderMode::Impostor);
   expectFinite(run.f);
   run.errors = elementErrors(run.ref, run.ref.seen, run.f);
-  if (with_envmap) run.envmap_median = medianArcmin(run.ref, r.render(gl::RasterMode::Envmap));
+  if (with_envmap) run.envmap_median = medianArcmin(run.ref, r.render(RenderMode::Envmap));
   return run;
 }
 
@@ -135,13 +135,13 @@ TEST_P(ImpostorTest, CarMirrorFarBelowTheCubeMap) {
   RayScene rays(s);
   const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
   gl::Renderer r(s, rays, gl::RendererOptions{});
-  const gl::RasterFrame f = r.render(gl::RasterMode::Impostor);
+  const gl::RasterFrame f = r.render(RenderMode::Impostor);
   expectFinite(f);
-  const double impostor = medianArcmin(ref, f), envmap = medianArcmin(ref, r.render(gl::RasterMode::Envmap));
+  const double impostor = medianArcmin(ref, f), envmap = medianArcmin(ref, r.render(RenderMode::Envmap));
   // The colour where the impostor sees the reference's point (under 0.1'): both raster modes sample the
   // street's minified textures where the one-ray reference samples them elsewhere (measured 8.0 % of the
   // colour for the impostor, 9.7 % for pvrr on the same pixels); the impostor is no worse than pvrr.
-  const gl::RasterFrame pf = r.render(gl::RasterMode::Pvrr);
+  const gl::RasterFrame pf = r.render(RenderMode::Pvrr);
   double cerr = 0, perr = 0, csum = 0;
   size_t agree = 0;
   for (size_t i = 0; i < ref.color.size(); ++i) {
@@ -251,7 +251,7 @@ TEST_P(ImpostorTest, SecondLayerSkippedWhereNoPixelNeedsIt) {
     RayScene rays(s);
     gl::RendererOptions o;
     o.map_size = 512;
-    frames.push_back(gl::Renderer(s, rays, o).render(gl::RasterMode::Impostor));
+    frames.push_back(gl::Renderer(s, rays, o).render(RenderMode::Impostor));
   }
   const StageTiming* sp = frames[1].stages.find("second-pass");
   ASSERT_NE(sp, nullptr);
@@ -317,7 +317,7 @@ gl::RasterFrame impostorFrame(const Scene& s) {
   RayScene rays(s);
   gl::RendererOptions o;
   o.map_size = 512;
-  const gl::RasterFrame f = gl::Renderer(s, rays, o).render(gl::RasterMode::Impostor);
+  const gl::RasterFrame f = gl::Renderer(s, rays, o).render(RenderMode::Impostor);
   expectFinite(f);
   return f;
 }
@@ -392,7 +392,7 @@ TEST_P(ImpostorTest, EachColourChannelRefractedWithItsOwnIndex) {
     o.map_size = 512;
     o.seen_channel = c;
     gl::Renderer r(s, rays, o);
-    const gl::RasterFrame f = r.render(gl::RasterMode::Impostor);
+    const gl::RasterFrame f = r.render(RenderMode::Impostor);
     expectFinite(f);
     e[size_t(c)] = elementErrors(ref, ref.channel_seen[size_t(c)], f);
     if (c == 1) green = f;
@@ -709,7 +709,7 @@ TEST_P(ImpostorTest, MirrorShowsALensColourFringes) {
   s.elements.push_back(plusTwoLens(test::pose(Vec3(0.05, 0.0, 2.2), Vec3(0, 0, -1))));
   s.elements.back().dispersion = Dispersion::fromAbbe(1.5, 20);
   s.elements.back().dispersion_on = true;
-  s.render.dispersion = "rgb";
+  s.render.dispersion = DispersionMode::Rgb;
   s.updateBounds();
   RayScene rays(s);
   const TracedFrame ref = rgbReference(rays, s.render.max_depth);
@@ -729,7 +729,7 @@ TEST_P(ImpostorTest, MirrorShowsALensColourFringes) {
     gl::RendererOptions o;
     o.map_size = 512;
     o.seen_channel = c;
-    const gl::RasterFrame f = gl::Renderer(s, rays, o).render(gl::RasterMode::Impostor);
+    const gl::RasterFrame f = gl::Renderer(s, rays, o).render(RenderMode::Impostor);
     expectFinite(f);
     const std::vector<double> e = errors(f, c);
     if (c == 0) red_against_blue = quantile(errors(f, 2), 0.5);

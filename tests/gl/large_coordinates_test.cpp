@@ -67,7 +67,7 @@ struct Result {
   double median_arcmin = 0;
 };
 
-Result run(const Vec3& offset, gl::RasterMode mode, Kind kind) {
+Result run(const Vec3& offset, RenderMode mode, Kind kind) {
   Scene s = kind == Kind::Lens         ? lensInARoom(offset)
             : kind == Kind::MirrorPair ? mirrorPair(offset)
                                        : mirrorInARoom(offset);
@@ -96,7 +96,7 @@ Result run(const Vec3& offset, gl::RasterMode mode, Kind kind) {
 class LargeCoordinatesTest : public ::testing::TestWithParam<gl::GlBackend> {};
 
 // The same frame at the origin and far away: the same element pixels (to 1 %), colours and seen points.
-void expectSameFarAway(gl::RasterMode mode, Kind kind) {
+void expectSameFarAway(RenderMode mode, Kind kind) {
   const Vec3 far_away(3.2e6, 1.5e3, -5.4e6);  // UTM-like easting/northing, metres
   const Result near = run(Vec3(0.0), mode, kind), far = run(far_away, mode, kind);
   ASSERT_EQ(near.color.size(), far.color.size());
@@ -117,14 +117,14 @@ void expectSameFarAway(gl::RasterMode mode, Kind kind) {
     if (near.element[i] >= 0) worst_seen = std::max(worst_seen, glm::length(near.seen_rel[i] - far.seen_rel[i]));
   }
   const char* name = kind == Kind::Lens ? "lens" : kind == Kind::MirrorPair ? "mirror pair" : "mirror";
-  std::cout << "[ measured ] " << name << ", mode " << gl::modeName(mode) << ": " << differ
+  std::cout << "[ measured ] " << name << ", mode " << nameOf(mode) << ": " << differ
             << " of " << near.color.size() << " pixels differ, seen points within " << worst_seen << " m, median "
             << near.median_arcmin << "' at the origin, " << far.median_arcmin << "' far away\n";
-  EXPECT_LE(differ, near.color.size() / 100) << gl::modeName(mode);
-  EXPECT_LT(worst_seen, 1e-3) << gl::modeName(mode);
-  if (mode == gl::RasterMode::Pvrr || mode == gl::RasterMode::Impostor) {
-    EXPECT_LT(far.median_arcmin, 1.0) << gl::modeName(mode);
-    EXPECT_NEAR(far.median_arcmin, near.median_arcmin, 0.01 + 0.05 * near.median_arcmin) << gl::modeName(mode);
+  EXPECT_LE(differ, near.color.size() / 100) << nameOf(mode);
+  EXPECT_LT(worst_seen, 1e-3) << nameOf(mode);
+  if (mode == RenderMode::Pvrr || mode == RenderMode::Impostor) {
+    EXPECT_LT(far.median_arcmin, 1.0) << nameOf(mode);
+    EXPECT_NEAR(far.median_arcmin, near.median_arcmin, 0.01 + 0.05 * near.median_arcmin) << nameOf(mode);
   }
   EXPECT_GT(pixels, 500u);  // element pixels compared
 }
@@ -132,8 +132,8 @@ void expectSameFarAway(gl::RasterMode mode, Kind kind) {
 TEST_P(LargeCoordinatesTest, SceneMillionsOfMetresAwayRendersAsAtTheOrigin) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
-  for (gl::RasterMode mode :
-       {gl::RasterMode::Pvrr, gl::RasterMode::Envmap, gl::RasterMode::Impostor, gl::RasterMode::Raster})
+  for (RenderMode mode :
+       {RenderMode::Pvrr, RenderMode::Envmap, RenderMode::Impostor, RenderMode::Raster})
     expectSameFarAway(mode, Kind::Mirror);
 }
 
@@ -141,7 +141,7 @@ TEST_P(LargeCoordinatesTest, SceneMillionsOfMetresAwayRendersAsAtTheOrigin) {
 TEST_P(LargeCoordinatesTest, LensMillionsOfMetresAwayRendersAsAtTheOrigin) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
-  for (gl::RasterMode mode : {gl::RasterMode::Pvrr, gl::RasterMode::Impostor}) expectSameFarAway(mode, Kind::Lens);
+  for (RenderMode mode : {RenderMode::Pvrr, RenderMode::Impostor}) expectSameFarAway(mode, Kind::Lens);
 }
 
 // A mirror seen in a mirror: pvrr's nested first passes from virtual viewpoints, the impostor's search
@@ -149,7 +149,7 @@ TEST_P(LargeCoordinatesTest, LensMillionsOfMetresAwayRendersAsAtTheOrigin) {
 TEST_P(LargeCoordinatesTest, MirrorPairMillionsOfMetresAwayRendersAsAtTheOrigin) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
-  for (gl::RasterMode mode : {gl::RasterMode::Pvrr, gl::RasterMode::Impostor})
+  for (RenderMode mode : {RenderMode::Pvrr, RenderMode::Impostor})
     expectSameFarAway(mode, Kind::MirrorPair);
 }
 

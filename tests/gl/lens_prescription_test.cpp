@@ -228,7 +228,7 @@ TEST_P(LensPrescriptionTest, ToricAndAsphericLensesMatchTheReference) {
     RayScene rays(s);
     const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
     gl::Renderer r(s, rays, gl::RendererOptions{});
-    const gl::RasterFrame f = r.render(gl::RasterMode::Pvrr);
+    const gl::RasterFrame f = r.render(RenderMode::Pvrr);
     ASSERT_EQ(f.seen.size(), ref.seen.size());
     size_t pixels = 0;
     const double median = medianArcmin(ref, f, &pixels);

@@ -57,7 +57,7 @@ TEST_P(LensTypesTest, InvertingPlusLensAndMinusLensMatchTheReference) {
     RayScene rays(s);
     const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
     gl::Renderer r(s, rays, gl::RendererOptions{});
-    const gl::RasterFrame f = r.render(gl::RasterMode::Pvrr);
+    const gl::RasterFrame f = r.render(RenderMode::Pvrr);
 
     std::vector<double> err;
     size_t off_axis = 0, oriented_ref = 0, oriented_pvrr = 0;
@@ -101,7 +101,7 @@ TEST_P(LensTypesTest, LensBeyondTheDepthLimitIsDarkLikeTheReference) {
   to.max_depth = 1;
   const TracedFrame ref = Tracer(rays, to).render();
   gl::Renderer r(s, rays, gl::RendererOptions{});
-  const gl::RasterFrame f = r.render(gl::RasterMode::Pvrr);
+  const gl::RasterFrame f = r.render(RenderMode::Pvrr);
   size_t lens = 0, dark_ref = 0, dark_pvrr = 0;
   for (size_t i = 0; i < ref.color.size(); ++i) {
     if (ref.element[i] < 0) continue;
@@ -137,7 +137,7 @@ TEST_P(LensTypesTest, TotalInternalReflectionShowsWhatTheReferenceShows) {
   to.max_depth = s.render.max_depth;
   const TracedFrame ref = Tracer(rays, to).render();
   gl::Renderer r(s, rays, gl::RendererOptions{});
-  const gl::RasterFrame f = r.render(gl::RasterMode::Pvrr);
+  const gl::RasterFrame f = r.render(RenderMode::Pvrr);
   ASSERT_EQ(f.elements.size(), 1u);
   size_t tir = 0, traced = 0;
   for (const VertexRay& v : f.elements[0].rays[0]) {

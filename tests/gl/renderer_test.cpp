@@ -83,7 +83,7 @@ TEST_P(RendererTest, RasterEnvironmentMatchesTheTracer) {
     RayScene rays(s);
     TracedFrame ref = Tracer(rays, TraceOptions{}).render();
     gl::Renderer r(s, rays, gl::RendererOptions{});
-    gl::RasterFrame f = r.render(gl::RasterMode::Raster);
+    gl::RasterFrame f = r.render(RenderMode::Raster);
     ASSERT_EQ(f.color.size(), ref.color.size());
     const std::vector<bool> smooth = awayFromDepthEdges(ref, s.observer.eye);
     double colour_sum = 0;
@@ -111,7 +111,7 @@ TEST_P(RendererTest, PlaneMirrorPvrrIsExactAwayFromDepthEdges) {
   gl::RendererOptions opt;
   opt.map_size = 512;
   gl::Renderer r(s, rays, opt);
-  gl::RasterFrame f = r.render(gl::RasterMode::Pvrr);
+  gl::RasterFrame f = r.render(RenderMode::Pvrr);
   const std::vector<bool> smooth = awayFromDepthEdges(ref, s.observer.eye);
   size_t mirror_pixels = 0;
   double worst = 0;
@@ -143,11 +143,11 @@ TEST_P(RendererTest, ConvexMirrorPvrrBeatsTheCubeMap) {
   gl::RendererOptions opt;
   opt.map_size = 512;
   gl::Renderer r(s, rays, opt);
-  const double pvrr = medianArcmin(ref, r.render(gl::RasterMode::Pvrr));
-  const double envmap = medianArcmin(ref, r.render(gl::RasterMode::Envmap));
+  const double pvrr = medianArcmin(ref, r.render(RenderMode::Pvrr));
+  const double envmap = medianArcmin(ref, r.render(RenderMode::Envmap));
   EXPECT_LT(pvrr, 1.0);
   EXPECT_LT(pvrr * 3, envmap) << "pvrr " << pvrr << "', envmap " << envmap << "'";
-  for (const Vec3& c : r.render(gl::RasterMode::Pvrr).color) ASSERT_TRUE(isFinite(c));
+  for (const Vec3& c : r.render(RenderMode::Pvrr).color) ASSERT_TRUE(isFinite(c));
 }
 
 // The car mirror (issue 5): median error <= 1 arcmin at the scene's default tessellation, at least 10x below
@@ -160,17 +160,17 @@ TEST_P(RendererTest, CarMirrorAccuracyAndConvergence) {
     if (tess > 0) sets.push_back("elements[0].tessellation=" + std::to_string(tess));
     return buildScene(loadScene(PVRR_SOURCE_DIR "/models/car-mirror.json", sets));
   };
-  auto errorAt = [&](int tess, gl::RasterMode mode) {
+  auto errorAt = [&](int tess, RenderMode mode) {
     Scene s = load(tess);
     RayScene rays(s);
     TracedFrame ref = Tracer(rays, TraceOptions{}).render();
     gl::Renderer r(s, rays, gl::RendererOptions{});
     return medianArcmin(ref, r.render(mode));
   };
-  const double def = errorAt(0, gl::RasterMode::Pvrr), envmap = errorAt(0, gl::RasterMode::Envmap);
+  const double def = errorAt(0, RenderMode::Pvrr), envmap = errorAt(0, RenderMode::Envmap);
   EXPECT_LE(def, 1.0);
   EXPECT_GE(envmap, 10.0 * def) << "pvrr " << def << "', envmap " << envmap << "'";
-  const double e7 = errorAt(7, gl::RasterMode::Pvrr), e33 = errorAt(33, gl::RasterMode::Pvrr);
+  const double e7 = errorAt(7, RenderMode::Pvrr), e33 = errorAt(33, RenderMode::Pvrr);
   // Vertex spacing scales as 1 / (n - 1).
   const double slope = std::log(e33 / e7) / std::log(6.0 / 32.0);
   EXPECT_GE(slope, 1.7) << "error " << e7 << "' at 7x7, " << e33 << "' at 33x33";
@@ -185,7 +185,7 @@ TEST_P(RendererTest, ConcaveMirrorZoomingRegion) {
   RayScene rays(s);
   TracedFrame ref = Tracer(rays, TraceOptions{}).render();
   gl::Renderer r(s, rays, gl::RendererOptions{});
-  gl::RasterFrame f = r.render(gl::RasterMode::Pvrr);
+  gl::RasterFrame f = r.render(RenderMode::Pvrr);
   ASSERT_FALSE(f.elements.empty());
   EXPECT_TRUE(f.elements[0].views[0].volume.backward);
   size_t mirror = 0, holes = 0;
@@ -214,16 +214,16 @@ TEST_P(RendererTest, EyeFixedCacheMatchesAFreshFrame) {
   RayScene rays(s);
   gl::Renderer cached(s, rays, gl::RendererOptions{});
   gl::FrameCache cache;
-  cached.render(gl::RasterMode::Pvrr, &cache);
+  cached.render(RenderMode::Pvrr, &cache);
   // Turn the head by 5 degrees about the vertical through the eye.
   const Vec3 e = s.observer.eye;
   s.observer.target = e + Vec3(glm::rotate(Mat4(1.0), radians(5.0), Vec3(0, 1, 0)) * Vec4(s.observer.target - e, 0.0));
   updateAttachedElements(s, desc);
   rays.updateElementPoses();
   cache.environment_changed = false;
-  gl::RasterFrame a = cached.render(gl::RasterMode::Pvrr, &cache);
+  gl::RasterFrame a = cached.render(RenderMode::Pvrr, &cache);
   gl::Renderer fresh_renderer(s, rays, gl::RendererOptions{});
-  gl::RasterFrame b = fresh_renderer.render(gl::RasterMode::Pvrr);
+  gl::RasterFrame b = fresh_renderer.render(RenderMode::Pvrr);
   for (const StageTiming& t : a.stages.stages) {
     if (t.name == "vertex-rays" || t.name == "refraction" || t.name == "viewpoint-fit") {
       EXPECT_FALSE(t.ran) << t.name;
@@ -273,7 +273,7 @@ struct MovingObserver {
     s.observer.eye = eye;
     s.observer.target = turnedTarget(eye0, target0, deg, eye);
     cache.environment_changed = false;
-    return renderer.render(gl::RasterMode::Pvrr, &cache);
+    return renderer.render(RenderMode::Pvrr, &cache);
   }
 };
 
@@ -304,22 +304,22 @@ TEST_P(RendererTest, MapReuseWithinTheMarginMatchesAFreshFrame) {
   };
   gl::Renderer cached(s, rays, gl::RendererOptions{});
   bool ran = false;
-  cached.render(gl::RasterMode::Pvrr, &cache);
+  cached.render(RenderMode::Pvrr, &cache);
   cache.environment_changed = false;
-  EXPECT_NE(firstPass(cached.render(gl::RasterMode::Pvrr, &cache), &ran).find("eye-fixed cache"), std::string::npos);
+  EXPECT_NE(firstPass(cached.render(RenderMode::Pvrr, &cache), &ran).find("eye-fixed cache"), std::string::npos);
   EXPECT_FALSE(ran) << "nothing moved: the first frame's maps stay";
   turnTo(0.5);
-  std::string note = firstPass(cached.render(gl::RasterMode::Pvrr, &cache), &ran);
+  std::string note = firstPass(cached.render(RenderMode::Pvrr, &cache), &ran);
   EXPECT_TRUE(ran);
   EXPECT_NE(note.find("widened up to 2 deg"), std::string::npos) << note;
   turnTo(2.0);  // 1.5 deg on: inside the margin
-  const gl::RasterFrame reused = cached.render(gl::RasterMode::Pvrr, &cache);
+  const gl::RasterFrame reused = cached.render(RenderMode::Pvrr, &cache);
   note = firstPass(reused, &ran);
   EXPECT_FALSE(ran);
   EXPECT_NE(note.find("map reuse"), std::string::npos) << note;
   for (const char* stage : {"vertex-rays", "viewpoint-fit"}) EXPECT_FALSE(reused.stages.find(stage)->ran) << stage;
   gl::Renderer fresh_renderer(s, rays, gl::RendererOptions{});
-  const gl::RasterFrame fresh = fresh_renderer.render(gl::RasterMode::Pvrr);
+  const gl::RasterFrame fresh = fresh_renderer.render(RenderMode::Pvrr);
   const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
   const double reused_err = medianArcmin(ref, reused), fresh_err = medianArcmin(ref, fresh);
   EXPECT_LE(reused_err, 1.0);
@@ -332,38 +332,38 @@ TEST_P(RendererTest, MapReuseWithinTheMarginMatchesAFreshFrame) {
               reused_err, fresh_err, reused_colour, fresh_colour, meanColourDifference(ref, reused.color, fresh.color));
   EXPECT_LE(reused_colour, 1.15 * fresh_colour);  // measured 1.05x at 320 x 240
   // A first pass drawn for another cache (or none) overwrites the maps: the cache's record of them is void.
-  cached.render(gl::RasterMode::Pvrr);
+  cached.render(RenderMode::Pvrr);
   turnTo(2.1);
-  note = firstPass(cached.render(gl::RasterMode::Pvrr, &cache), &ran);
+  note = firstPass(cached.render(RenderMode::Pvrr, &cache), &ran);
   EXPECT_TRUE(ran);
   EXPECT_NE(note.find("this renderer drew other maps since"), std::string::npos) << note;
   turnTo(4.5);  // 2.4 deg from the maps' view (drawn at 2.1 deg): past the margin
-  note = firstPass(cached.render(gl::RasterMode::Pvrr, &cache), &ran);
+  note = firstPass(cached.render(RenderMode::Pvrr, &cache), &ran);
   EXPECT_TRUE(ran);
   EXPECT_NE(note.find("left its map's margin"), std::string::npos) << note;
   turnTo(4.6);
-  note = firstPass(cached.render(gl::RasterMode::Pvrr, &cache), &ran);
+  note = firstPass(cached.render(RenderMode::Pvrr, &cache), &ran);
   EXPECT_FALSE(ran) << note;
   turnTo(4.7);
   cache.environment_changed = true;
-  note = firstPass(cached.render(gl::RasterMode::Pvrr, &cache), &ran);
+  note = firstPass(cached.render(RenderMode::Pvrr, &cache), &ran);
   EXPECT_TRUE(ran);
   EXPECT_NE(note.find("the environment changed"), std::string::npos) << note;
   // Nothing moved, but another first pass drew over the maps (a frame without this cache): drawn again.
-  cached.render(gl::RasterMode::Pvrr);
+  cached.render(RenderMode::Pvrr);
   cache.environment_changed = false;
-  firstPass(cached.render(gl::RasterMode::Pvrr, &cache), &ran);
+  firstPass(cached.render(RenderMode::Pvrr, &cache), &ran);
   EXPECT_TRUE(ran) << "the maps were overwritten by a frame drawn without this cache";
   // Margin 0: every frame that moved renders its maps, unwidened.
   gl::RendererOptions off;
   off.map_reuse_margin_deg = 0;
   gl::Renderer plain(s, rays, off);
   gl::FrameCache plain_cache;
-  plain.render(gl::RasterMode::Pvrr, &plain_cache);
+  plain.render(RenderMode::Pvrr, &plain_cache);
   for (const double deg : {4.8, 4.9}) {
     turnTo(deg);
     plain_cache.environment_changed = false;
-    note = firstPass(plain.render(gl::RasterMode::Pvrr, &plain_cache), &ran);
+    note = firstPass(plain.render(RenderMode::Pvrr, &plain_cache), &ran);
     EXPECT_TRUE(ran);
     EXPECT_EQ(note.find("widened"), std::string::npos) << note;
   }
@@ -425,14 +425,14 @@ TEST_P(RendererTest, LensAccuracyAndDispersion) {
     RayScene rays(s);
     const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
     gl::Renderer r(s, rays, gl::RendererOptions{});
-    EXPECT_LE(medianArcmin(ref, r.render(gl::RasterMode::Pvrr)), 1.0);
+    EXPECT_LE(medianArcmin(ref, r.render(RenderMode::Pvrr)), 1.0);
   }
   Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/reading-lens.json", {"observer.image_size=[200,150]"}));
   RayScene rays(s);
   gl::RendererOptions opt;
   opt.vertex.channels = {ChannelSpec{kRgbWavelengths_nm[0]}, ChannelSpec{kRgbWavelengths_nm[1]}, ChannelSpec{kRgbWavelengths_nm[2]}};
   gl::Renderer r(s, rays, opt);
-  gl::RasterFrame f = r.render(gl::RasterMode::Pvrr);
+  gl::RasterFrame f = r.render(RenderMode::Pvrr);
   ASSERT_EQ(f.elements.size(), 1u);
   EXPECT_EQ(f.elements[0].views.size(), 1u);        // one shared first pass
   EXPECT_EQ(f.elements[0].views[0].st.size(), 3u);  // three texture-coordinate sets
@@ -456,7 +456,7 @@ TEST_P(RendererTest, PatchesCoverTheMirrorAndKeepTheAccuracy) {
     RayScene rays(s);
     *reference = Tracer(rays, TraceOptions{}).render();
     gl::Renderer r(s, rays, gl::RendererOptions{});
-    *frame = r.render(gl::RasterMode::Pvrr);
+    *frame = r.render(RenderMode::Pvrr);
   };
   gl::RasterFrame one, four, automatic;
   TracedFrame ref;
@@ -493,7 +493,7 @@ TEST_P(RendererTest, AutomaticSplitStopsAtFourQuadsAPatchAndShrinksTheMaps) {
   gl::RendererOptions opt;
   opt.map_texels_per_pixel = 0;  // the patch budget alone (at 120 x 90 the image would need far fewer texels)
   gl::Renderer r(s, rays, opt);
-  const gl::RasterFrame f = r.render(gl::RasterMode::Pvrr);
+  const gl::RasterFrame f = r.render(RenderMode::Pvrr);
   const ElementFrame& e = f.elements[0];
   EXPECT_EQ(e.patches_u, 3);
   EXPECT_EQ(e.patches_v, 3);
@@ -536,7 +536,7 @@ TEST_P(RendererTest, SeenChannelGivesEachChannelsSeenPoint) {
     opt.vertex.channels = dispersionChannels(s, 0, "rgb", 0);
     opt.seen_channel = c;
     gl::Renderer r(s, rays, opt);
-    return r.render(gl::RasterMode::Pvrr);
+    return r.render(RenderMode::Pvrr);
   };
   const gl::RasterFrame red = renderChannel(0), green = renderChannel(-1), blue = renderChannel(2);
   const Dispersion& d = s.elements[0].dispersion;
@@ -591,7 +591,7 @@ TEST_P(RendererTest, MirrorSeenInAMirror) {
     s.render.max_depth = max_depth;
     gl::RendererOptions opt;
     opt.map_size = 512;
-    return gl::Renderer(s, rays, opt).render(gl::RasterMode::Pvrr);
+    return gl::Renderer(s, rays, opt).render(RenderMode::Pvrr);
   };
   const gl::RasterFrame f4 = render(4), f1 = render(1);
   // Median angular error over the reference's mirror pixels whose path has at least `min_bounces`.
@@ -644,7 +644,7 @@ TEST_P(RendererTest, OneMirrorHasNoNesting) {
   RayScene rays(s);
   gl::RendererOptions opt;
   opt.map_size = 64;
-  const gl::RasterFrame f = gl::Renderer(s, rays, opt).render(gl::RasterMode::Pvrr);
+  const gl::RasterFrame f = gl::Renderer(s, rays, opt).render(RenderMode::Pvrr);
   EXPECT_FALSE(stage(f, "nested-passes").ran);
   EXPECT_EQ(stage(f, "nested-passes").reason, "one mirror: no nesting");
 }
@@ -671,12 +671,12 @@ TEST_P(RendererTest, SpectralPvrrMatchesTheSpectralTracer) {
     opt.map_texels_per_pixel = 0;
     opt.vertex.channels = dispersionChannels(s, 0, dispersion, s.render.spectral_samples);
     gl::Renderer r(s, rays, opt);
-    return r.render(gl::RasterMode::Pvrr);
+    return r.render(RenderMode::Pvrr);
   };
   gl::RendererOptions per_element;  // empty channels: the renderer asks dispersionChannels() per element
   per_element.vertex.channels.clear();
   per_element.map_texels_per_pixel = 0;
-  const gl::RasterFrame spectral = gl::Renderer(s, rays, per_element).render(gl::RasterMode::Pvrr);
+  const gl::RasterFrame spectral = gl::Renderer(s, rays, per_element).render(RenderMode::Pvrr);
   const gl::RasterFrame rgb = render("rgb"), off = render("off");
   const StageTiming& cc = stage(spectral, "colour-channels");
   EXPECT_TRUE(cc.ran);
@@ -729,7 +729,7 @@ TEST_P(RendererTest, AdaptiveMapIsCloserToASupersampledReference) {
     auto render = [&](double texels_per_pixel, std::string* note) {
       gl::RendererOptions opt;
       opt.map_texels_per_pixel = texels_per_pixel;
-      const gl::RasterFrame f = gl::Renderer(s, rays, opt).render(gl::RasterMode::Pvrr);
+      const gl::RasterFrame f = gl::Renderer(s, rays, opt).render(RenderMode::Pvrr);
       *note = stage(f, "first-pass").note;
       return f;
     };

@@ -49,7 +49,7 @@ TEST_P(UnreadTexelsTest, ShippedScenesAreTheSameBitForBit) {
     gl::RendererOptions whole_opts;
     whole_opts.skip_unread_texels = false;
     gl::Renderer whole(s, rays, whole_opts), skipping(s, rays, gl::RendererOptions{});
-    const gl::RasterFrame a = whole.render(gl::RasterMode::Pvrr), b = skipping.render(gl::RasterMode::Pvrr);
+    const gl::RasterFrame a = whole.render(RenderMode::Pvrr), b = skipping.render(RenderMode::Pvrr);
     EXPECT_EQ(differingPixels(a, b), 0u) << name;
     EXPECT_EQ(unshadedPercent(a), -1) << name << ": whole maps";
     EXPECT_GE(unshadedPercent(b), least) << name << ": " << b.stages.find("first-pass")->note;
@@ -82,8 +82,8 @@ TEST_P(UnreadTexelsTest, MapReuseReadsWholeMaps) {
     updateAttachedElements(s, desc);
     rays.updateElementPoses();
     whole_cache.environment_changed = skipping_cache.environment_changed = false;
-    const gl::RasterFrame a = whole.render(gl::RasterMode::Pvrr, &whole_cache);
-    const gl::RasterFrame b = skipping.render(gl::RasterMode::Pvrr, &skipping_cache);
+    const gl::RasterFrame a = whole.render(RenderMode::Pvrr, &whole_cache);
+    const gl::RasterFrame b = skipping.render(RenderMode::Pvrr, &skipping_cache);
     EXPECT_EQ(differingPixels(a, b), 0u) << "turned " << deg << " deg";
     const StageTiming* first = b.stages.find("first-pass");
     ASSERT_TRUE(first);

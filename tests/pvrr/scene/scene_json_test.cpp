@@ -152,7 +152,7 @@ TEST(SceneJson, ReadingLensHasPlusTwoAndAHalfDioptres) {
   EXPECT_NEAR(n, 1.586, 1e-12);
   const double f1 = -(n - 1) / l.back.radius_m, f2 = (n - 1) / l.front.radius_m;
   EXPECT_NEAR(f1 + f2 - t / n * f1 * f2, 2.5, kPowerTol_D);  // thick-lens equivalent power
-  EXPECT_EQ(s.render.dispersion, RenderDesc::Dispersion::Rgb);
+  EXPECT_EQ(s.render.dispersion, DispersionMode::Rgb);
   // Held 25-30 cm above the page (the page's plane is y = 0.75 m).
   EXPECT_GT(l.pose.position.y - 0.75, 0.25 - 1e-9);
   EXPECT_LT(l.pose.position.y - 0.75, 0.30);
@@ -347,7 +347,7 @@ TEST(SceneJson, DefaultsAreFilledIn) {
   EXPECT_EQ(s.elements[0].patches_u, 1);
   ASSERT_EQ(s.lights.size(), 1u);  // no "lights": white ambient
   EXPECT_EQ(s.lights[0].type, LightDesc::Type::Ambient);
-  EXPECT_EQ(s.render.mode, RenderDesc::Mode::Pvrr);
+  EXPECT_EQ(s.render.mode, RenderMode::Pvrr);
   EXPECT_EQ(s.render.map_size, 1024);
   EXPECT_EQ(s.render.map_texels_per_pixel, 4.0);
   EXPECT_EQ(s.render.map_reuse_margin_deg, 2.0);
@@ -537,7 +537,7 @@ TEST(SceneJson, OverridesTakeEffect) {
                                     "render.map_size=256"});           // later overrides win
   EXPECT_EQ(s.render.map_size, 256);
   EXPECT_EQ(s.observer.eye, Vec3(0, 1.5, 0.5));
-  EXPECT_EQ(s.render.mode, RenderDesc::Mode::Raster);
+  EXPECT_EQ(s.render.mode, RenderMode::Raster);
   EXPECT_EQ(s.elements[0].pose.position, Vec3(0, 1.3, -1));
   EXPECT_EQ(s.elements[1].tessellation.n_u, 9);
   EXPECT_EQ(s.elements[0].tessellation.n_u, 7);

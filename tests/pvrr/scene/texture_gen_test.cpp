@@ -64,8 +64,8 @@ TEST(TextureGen, EveryKindIsDeterministicAndSized) {
     EXPECT_EQ(a.width, 320);
     EXPECT_EQ(a.height, 400);
     EXPECT_EQ(a.rgb.size(), 320u * 400u * 3u);
-    EXPECT_EQ(a.rgb, b.rgb) << toString(kind);
-    maybeWrite(a, toString(kind));
+    EXPECT_EQ(a.rgb, b.rgb) << nameOf(kind);
+    maybeWrite(a, nameOf(kind));
   }
 }
 

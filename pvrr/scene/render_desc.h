@@ -1,0 +1,54 @@
+// The "render" section of a scene file (docs/scene-format.md): the render mode, the dispersion mode and the
+// render settings, each written once. The parser (pvrr/scene/scene_json.h) starts from RenderDesc{} and the
+// runtime scene's RenderSettings (pvrr/scene/scene.h) derives from it; the CLI (--mode, --modes), the GL
+// renderer and the reference tracer take these enums, named by these tables.
+#pragma once
+#include <string>
+
+#include "pvrr/base/math.h"
+#include "pvrr/base/names.h"
+
+namespace pvrr {
+
+// pvrr: the method (per-vertex rays, virtual viewpoints, two passes; pvrr/gl/renderer.h); raster: elements
+// drawn as plain surfaces; raytrace: the exact reference tracer (CPU, pvrr/trace/tracer.h); envmap: a dynamic
+// cube map from each element's centre (the classic baseline); impostor: distance impostors (the glass mode).
+enum class RenderMode { Pvrr, Raster, Raytrace, Envmap, Impostor };
+inline constexpr NameTable<RenderMode, 5> kRenderModeNames = {{{RenderMode::Pvrr, "pvrr"},
+                                                               {RenderMode::Raster, "raster"},
+                                                               {RenderMode::Raytrace, "raytrace"},
+                                                               {RenderMode::Envmap, "envmap"},
+                                                               {RenderMode::Impostor, "impostor"}}};
+constexpr const NameTable<RenderMode, 5>& nameTable(RenderMode) { return kRenderModeNames; }
+static_assert(namesAreUnique(kRenderModeNames));
+
+// The modes the GL renderer draws: all but Raytrace, the reference tracer's.
+constexpr bool isRasterMode(RenderMode m) { return m != RenderMode::Raytrace; }
+
+// off: one ray (one draw) with each lens's index at the d line; rgb: one per colour channel at that channel's
+// wavelength (pvrr/optics/spectrum.h), keeping that channel; spectral: N wavelengths summed with the
+// colour-matching weights.
+enum class DispersionMode { Off, Rgb, Spectral };
+inline constexpr NameTable<DispersionMode, 3> kDispersionModeNames = {
+    {{DispersionMode::Off, "off"}, {DispersionMode::Rgb, "rgb"}, {DispersionMode::Spectral, "spectral"}}};
+constexpr const NameTable<DispersionMode, 3>& nameTable(DispersionMode) { return kDispersionModeNames; }
+static_assert(namesAreUnique(kDispersionModeNames));
+
+// The settings of the "render" section with their defaults: the defaults of the scene format.
+struct RenderDesc {
+  RenderMode mode = RenderMode::Pvrr;
+  int map_size = 1024;               // a map's longer side at most (texels)
+  double map_texels_per_pixel = 4;   // a top-level map's texels per image pixel of its patch; 0: map_size
+  double map_reuse_margin_deg = 2;   // maps widened this much for reuse by later frames; 0: no reuse
+  int impostor_iterations = 8;       // impostor mode: false-position steps of each fragment's search
+  int impostor_layers = 2;           // impostor mode: layers of each distance map (2: the second depth-peeled)
+  // Relative to the current directory, as written. The parser and the build fill in out/<scene name>.png
+  // when the file names none.
+  std::string output;
+  int max_depth = 4;
+  DispersionMode dispersion = DispersionMode::Off;
+  int spectral_samples = 16;
+  Vec3 background{0.55, 0.7, 0.9};  // linear RGB of escaping rays (the sky)
+};
+
+}  // namespace pvrr
