@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "pvrr/scene/render_desc.h"
 #include "pvrr/trace/ray_scene.h"
 #include "pvrr/scene/scene.h"
 #include "pvrr/method/vertex_stage.h"
@@ -18,17 +19,18 @@ namespace pvrr {
 
 // The settings of the planning; gl::RendererOptions derives from it, so its fields are set on a
 // RendererOptions by these names.
+// The defaults are the scene format's (RenderDesc, pvrr/scene/render_desc.h), written there once.
 struct PassPlanOptions {
-  int map_size = 1024;              // first-pass map's longer side at most (pvrr), cube face size (envmap, impostor)
+  int map_size = RenderDesc{}.map_size;  // first-pass map's longer side at most (pvrr), cube face size (envmap, impostor)
   // pvrr: each top-level map's texels per image pixel of its patch (Scene render.map_texels_per_pixel); the
   // map's longer side is lowered from map_size to that (topLevelMapSide). 0: always map_size.
-  double map_texels_per_pixel = 4;
+  double map_texels_per_pixel = RenderDesc{}.map_texels_per_pixel;
   // Map reuse across frames (Scene render.map_reuse_margin_deg), with a FrameCache only: once a frame
   // follows another, each top-level map is rendered this much wider on each side (at the same texel
   // density), and later frames whose views still lie inside it, from a viewpoint that moved by under a
   // quarter texel of parallax, draw from it without a first pass (stage "first-pass" says why, or why not).
   // 0: every frame that moved renders its maps.
-  double map_reuse_margin_deg = 2;
+  double map_reuse_margin_deg = RenderDesc{}.map_reuse_margin_deg;
 };
 
 // Reuse across frames (paper section 5, eye-fixed caching): when an element has not moved relative to the
