@@ -1,0 +1,90 @@
+#include "support/golden.h"
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <sstream>
+
+#include "cad/error.h"
+
+namespace fs = std::filesystem;
+
+namespace pvrr::test {
+namespace {
+
+// Set by tests/CMakeLists.txt: where the references live (in the source tree) and where failures write.
+const char* const kGoldenDir = PVRR_GOLDEN_DIR;
+const char* const kGoldenDiffDir = PVRR_GOLDEN_DIFF_DIR;
+
+bool validName(const std::string& name) {
+  return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' || c == '_';
+  });
+}
+
+}  // namespace
+
+bool updatingGoldens() {
+  const char* v = std::getenv("PVRR_UPDATE_GOLDEN");
+  return v && *v && std::string(v) != "0";
+}
+
+ImageRGB8 srgbPicture(int width, int height, const std::vector<Vec3>& linear) {
+  PVRR_CHECK(linear.size() == size_t(width) * size_t(height), << width << "x" << height << " holds " << linear.size());
+  ImageRGB8 img(width, height);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      Vec3 c = linear[size_t(y) * size_t(width) + size_t(x)];
+      if (!isFinite(c)) c = Vec3(0);
+      uint8_t* p = img.at(x, y);
+      for (int k = 0; k < 3; ++k) p[k] = linearToSrgb8(std::clamp(c[k], 0.0, 1.0));
+    }
+  return img;
+}
+
+::testing::AssertionResult matchesGolden(const std::string& name, const ImageRGB8& actual,
+                                         const GoldenTolerance& tolerance) {
+  if (!validName(name)) return ::testing::AssertionFailure() << "golden name \"" << name << "\": letters, digits, - and _ only";
+  const std::string reference_path = std::string(kGoldenDir) + "/" + name + ".png";
+  if (updatingGoldens()) {
+    fs::create_directories(kGoldenDir);
+    writePngAtomic(reference_path, actual);
+    return ::testing::AssertionSuccess() << "PVRR_UPDATE_GOLDEN: wrote " << reference_path;
+  }
+  const fs::path diff_dir(kGoldenDiffDir);
+  const std::string actual_path = (diff_dir / (name + "-actual.png")).string();
+  if (!fs::exists(reference_path)) {
+    fs::create_directories(diff_dir);
+    writePngAtomic(actual_path, actual);
+    return ::testing::AssertionFailure() << "no reference " << reference_path << " (the actual picture is "
+                                         << actual_path << "; PVRR_UPDATE_GOLDEN=1 writes the references)";
+  }
+  const ImageRGB8 reference = readPng(reference_path);
+  const bool same_size = reference.width == actual.width && reference.height == actual.height;
+  ImageDiff d;
+  if (same_size) {
+    d = compareImages(reference, actual, tolerance.pixel_delta);
+    if (d.mean_abs <= tolerance.mean_delta && d.failing_fraction <= tolerance.failing_fraction)
+      return ::testing::AssertionSuccess() << name << ": " << describe(d);
+  }
+  fs::create_directories(diff_dir);
+  const std::string reference_copy = (diff_dir / (name + "-reference.png")).string(),
+                    diff_path = (diff_dir / (name + "-diff.png")).string();
+  writePngAtomic(actual_path, actual);
+  writePngAtomic(reference_copy, reference);
+  ::testing::AssertionResult r = ::testing::AssertionFailure();
+  r << name << " differs from " << reference_path << ": ";
+  if (!same_size) {
+    r << "size " << actual.width << "x" << actual.height << ", the reference's " << reference.width << "x"
+      << reference.height;
+  } else {
+    writeDiffImage(reference, actual, diff_path);
+    r << describe(d) << " (thresholds: a pixel fails over " << tolerance.pixel_delta << " codes; mean at most "
+      << tolerance.mean_delta << "; at most " << 100 * tolerance.failing_fraction << "% failing)";
+  }
+  r << "\n  actual:    " << actual_path << "\n  reference: " << reference_copy;
+  if (same_size) r << "\n  diff:      " << diff_path;
+  return r;
+}
+
+}  // namespace pvrr::test
