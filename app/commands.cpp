@@ -83,8 +83,6 @@ size_t writeLinearPng(const std::string& path, int width, int height, const std:
   return bad;
 }
 
-double seenAngle(const Vec3& p, const Vec3& a, const Vec3& b) { return angleBetween(a - p, b - p); }
-
 namespace {
 
 gl::GlBackend backendArg(const Args& a) {
@@ -93,12 +91,6 @@ gl::GlBackend backendArg(const Args& a) {
 }
 
 json vec(const Vec3& v) { return json::array({v.x, v.y, v.z}); }
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
 
 }  // namespace
 
@@ -171,20 +163,6 @@ int cmdGlInfo(const std::vector<std::string>& argv) {
   return 0;
 }
 
-namespace {
-// The per-pixel buffers every frame type carries (TracedFrame, gl::RasterFrame).
-template <class Frame>
-void takePixels(RenderedFrame& out, Frame& f) {
-  out.width = f.width;
-  out.height = f.height;
-  out.color = std::move(f.color);
-  out.seen = std::move(f.seen);
-  out.element = std::move(f.element);
-  out.element_point = std::move(f.element_point);
-  out.frame_ms = f.frame_ms;
-}
-}  // namespace
-
 RenderedFrame timedFrame(LoadedScene& ls, const std::string& mode, const std::string& gl_backend_name, int frames,
                          double* median_ms) {
   // Timed as pvrr render draws for viewing (colour only, no seen-point attachments): one warm-up frame
@@ -231,7 +209,7 @@ RenderedFrame renderFrame(LoadedScene& ls, const std::string& mode, const std::s
     Tracer tracer(rays, to);
     const auto t0 = std::chrono::steady_clock::now();
     bool shown = false;
-    TracedFrame f = tracer.render([&](double frac) {
+    Frame f = tracer.render([&](double frac) {
       const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       if (s > 1.0 && isatty(2)) {
         std::fprintf(stderr, "\rray tracing: %3d%%", int(100 * frac));
@@ -239,10 +217,7 @@ RenderedFrame renderFrame(LoadedScene& ls, const std::string& mode, const std::s
       }
     });
     if (shown) std::fprintf(stderr, "\rray tracing: done \n");
-    out.channel_seen = std::move(f.channel_seen);
-    out.bounces = std::move(f.bounces);
-    takePixels(out, f);
-    out.stages.ran("ray-trace", f.frame_ms);
+    static_cast<Frame&>(out) = std::move(f);  // with its stage "ray-trace"
     out.gl_backend = "none (CPU, Embree)";
     return out;
   }
@@ -266,9 +241,8 @@ RenderedFrame renderFrame(LoadedScene& ls, const std::string& mode, const std::s
   }
   session->renderer->setReadBack(session->read_back);
   gl::RasterFrame f = session->renderer->render(rm, &session->cache);
-  takePixels(out, f);
-  out.stages = std::move(f.stages);
   out.elements = elementsJson(scene, f.elements);
+  static_cast<Frame&>(out) = std::move(static_cast<Frame&>(f));
   out.gl_backend = session->context->backendName() + " (" + session->context->glRenderer() + ")";
   return out;
 }

@@ -40,15 +40,6 @@ int rssBaselineFrame(int frames) { return frames < 100 ? 1 : 100; }
 
 namespace {
 
-double quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const double pos = q * double(v.size() - 1);
-  const size_t i = size_t(pos);
-  const double f = pos - double(i);
-  return i + 1 < v.size() ? v[i] * (1 - f) + v[i + 1] * f : v[i];
-}
-
 // A perceptually ordered colour map (black-body-like: black, red, yellow, white) for heat maps.
 Vec3 heat(double x) {
   x = std::clamp(x, 0.0, 1.0);
@@ -123,69 +114,9 @@ void writeHeatMap(const std::string& path, int w, int h, const std::vector<doubl
   writePngAtomic(path, img);
 }
 
-// Squared difference of two linear colours, sRGB-encoded and clamped to [0, 1], summed over R, G and B.
-double srgbSquaredError(const Vec3& a, const Vec3& b) {
-  double se = 0;
-  for (int k = 0; k < 3; ++k) {
-    const double d = linearToSrgb(std::clamp(a[k], 0.0, 1.0)) - linearToSrgb(std::clamp(b[k], 0.0, 1.0));
-    se += d * d;
-  }
-  return se;
-}
-
-// The RMSE of srgbSquaredError summed over `pixels` pixels, and its PSNR (99 dB for no error).
-double colourRmse(double se, size_t pixels) { return pixels ? std::sqrt(se / (3.0 * double(pixels))) : 0.0; }
-double psnrDb(double rmse) { return rmse > 0 ? 20.0 * std::log10(1.0 / rmse) : 99.0; }
-
 }  // namespace
 
-ErrorStats compareToReference(const RenderedFrame& ref, const RenderedFrame& mode, std::vector<double>* errors,
-                              int only_element) {
-  std::vector<double> local;
-  std::vector<double>& e = errors ? *errors : local;
-  e.assign(ref.color.size(), std::nan(""));
-  double se = 0;
-  for (size_t i = 0; i < e.size(); ++i) {
-    if (ref.element[i] < 0 || (only_element >= 0 && ref.element[i] != only_element)) continue;
-    const double a = arcminutes(seenAngle(ref.element_point[i], ref.seen[i], mode.seen[i]));
-    if (!std::isfinite(a)) continue;
-    e[i] = a;
-    se += srgbSquaredError(ref.color[i], mode.color[i]);
-  }
-  ErrorStats s = summarizeErrors(e);
-  if (s.pixels == 0) return s;
-  s.rmse = colourRmse(se, s.pixels);
-  s.psnr_db = psnrDb(s.rmse);
-  return s;
-}
-
-std::vector<double> angularErrors(const RenderedFrame& ref, const std::vector<Vec3>& ref_seen,
-                                  const std::vector<Vec3>& mode_seen) {
-  const size_t n = ref.element.size();
-  std::vector<double> e(n, std::nan(""));
-  if (ref_seen.size() != n || mode_seen.size() != n || ref.element_point.size() != n) return e;
-  for (size_t i = 0; i < n; ++i) {
-    if (ref.element[i] < 0) continue;
-    const double a = arcminutes(seenAngle(ref.element_point[i], ref_seen[i], mode_seen[i]));
-    if (std::isfinite(a)) e[i] = a;
-  }
-  return e;
-}
-
-ErrorStats summarizeErrors(const std::vector<double>& errors_arcmin, const std::vector<int8_t>* region, int8_t value) {
-  std::vector<double> e;
-  for (size_t i = 0; i < errors_arcmin.size(); ++i)
-    if (std::isfinite(errors_arcmin[i]) && (!region || (i < region->size() && (*region)[i] == value))) e.push_back(errors_arcmin[i]);
-  ErrorStats s;
-  s.pixels = e.size();
-  if (e.empty()) return s;
-  s.median_arcmin = quantile(e, 0.5);
-  s.p95_arcmin = quantile(e, 0.95);
-  s.max_arcmin = *std::max_element(e.begin(), e.end());
-  return s;
-}
-
-std::vector<int8_t> zoomingRegion(const RenderedFrame& ref, const std::vector<ElementFrame>& frames, const Scene* scene) {
+std::vector<int8_t> zoomingRegion(const Frame& ref, const std::vector<ElementFrame>& frames, const Scene* scene) {
   const size_t n = ref.element.size();
   std::vector<int8_t> region(n, -1);
   for (const ElementFrame& f : frames) {
@@ -329,18 +260,6 @@ std::vector<Vec3> supersampledReference(const LoadedScene& ls, const std::string
         for (int dx = 0; dx < 2; ++dx)
           out[size_t(y) * size_t(w) + size_t(x)] += 0.25 * f.color[size_t(2 * y + dy) * size_t(2 * w) + size_t(2 * x + dx)];
   return out;
-}
-
-// Colour PSNR (sRGB-encoded, clamped) of `colour` against `truth` over the pixels where `ref` sees an element.
-double elementPsnr(const RenderedFrame& ref, const std::vector<Vec3>& truth, const std::vector<Vec3>& colour) {
-  double se = 0;
-  size_t n = 0;
-  for (size_t i = 0; i < ref.element.size() && i < truth.size() && i < colour.size(); ++i) {
-    if (ref.element[i] < 0) continue;
-    se += srgbSquaredError(truth[i], colour[i]);
-    ++n;
-  }
-  return n == 0 ? 0.0 : psnrDb(colourRmse(se, n));
 }
 
 }  // namespace

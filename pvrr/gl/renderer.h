@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "pvrr/frame.h"
 #include "pvrr/ray_scene.h"
 #include "pvrr/stats.h"
 #include "pvrr/vertex_stage.h"
@@ -27,16 +28,9 @@ enum class RasterMode { Raster, Pvrr, Envmap, Impostor };
 RasterMode parseRasterMode(const std::string& mode);  // throws pvrr::Error
 std::string modeName(RasterMode mode);                 // the name parseRasterMode takes
 
-// What one frame produced, read back from the GPU. Rows top-down. `seen` and `surface` are world points
-// (double, reconstructed from camera-relative floats).
-struct RasterFrame {
-  int width = 0, height = 0;
-  std::vector<Vec3> color;          // linear RGB
-  std::vector<Vec3> seen;           // the pixel's seen point
-  std::vector<int> element;         // element index under the pixel, -1 for none
-  std::vector<Vec3> element_point;  // the element surface point under the pixel
-  FrameStages stages;
-  double frame_ms = 0;              // CPU + GPU (finished) time of the frame
+// What one frame produced, read back from the GPU (pvrr/frame.h: color, and with seen points on seen, element
+// and element_point; bounces and channel_seen stay empty), and the pvrr mode's per-element state.
+struct RasterFrame : Frame {
   std::vector<ElementFrame> elements;  // PVRR per-element state of this frame (pvrr mode)
 };
 

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <ostream>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -19,6 +20,11 @@
 #include "support/scenes.h"
 
 namespace pvrr {
+namespace gl {
+// The backend's name in test names and messages (gtest prints a parameter's bytes otherwise).
+void PrintTo(GlBackend b, std::ostream* os) { *os << glBackendName(b); }
+}  // namespace gl
+
 namespace {
 
 // Small enough that the 64 pictures of one backend take about 15 s on llvmpipe, large enough that each
@@ -57,7 +63,7 @@ TEST_P(GoldenTest, EveryRasterModeMatchesItsReference) {
     ASSERT_EQ(f.width, kWidth);
     ASSERT_EQ(f.height, kHeight);
     const ::testing::AssertionResult match =
-        test::matchesGolden(name + "-" + gl::modeName(mode), test::srgbPicture(f.width, f.height, f.color));
+        test::matchesGolden(name + "-" + gl::modeName(mode), test::srgbPicture(f));
     EXPECT_TRUE(match);
     if (match) std::printf("%s\n", match.message());  // the differences within the thresholds, for the log
   }
