@@ -7,6 +7,9 @@
 // reflected or refracted ray's direction where the eye's ray meets the element, not an angle at the eye.
 // Summaries over the finite errors: median, p95 (quantile), max.
 //
+// Known-hard regions are reported separately, never left out: the zooming region of a pvrr patch
+// (zoomingRegion) and, with rgb dispersion, the colour fringes (fringeStats).
+//
 // Colour error: each channel clamped to [0, 1] and sRGB-encoded (IEC 61966-2-1, as the 8-bit pictures are),
 // then the RMSE over the three channels of the counted pixels and its PSNR = 20 log10(1 / RMSE) dB (peak 1).
 #pragma once
@@ -16,6 +19,8 @@
 
 #include "cad/math.h"
 #include "pvrr/frame.h"
+#include "pvrr/scene.h"
+#include "pvrr/vertex_stage.h"
 
 namespace pvrr {
 
@@ -63,5 +68,29 @@ double colourRmse(double squared_error_sum, size_t pixels);
 double psnrDb(double rmse);
 // The colour PSNR of `colour` against `truth` over the pixels where `ref` sees an element; 0 for none.
 double elementPsnr(const Frame& ref, const std::vector<Vec3>& truth, const std::vector<Vec3>& colour);
+
+// The zooming region (issue 5; docs/accuracy.md): a pixel is in it when the reference's seen point lies
+// behind the fitted viewpoint of the patch under the pixel, along that patch's forward direction:
+// (seen - fit.eye) . forward <= 0, where forward is the forward volume's (pvrr/view_volume.h: the normalised
+// mean of the patch's outgoing ray directions; recomputed from the rays when the patch's volume is the
+// reversed one). The patch under a pixel is the patch of the element vertex nearest the reference's element
+// point. Per pixel: 1 zooming, 0 not, -1 no element pixel or an element missing from `frames`, 2 not
+// classified: the reference path (ref.bounces, when given) has more specular events than the element's own
+// (mirror 1, lens 2), so its seen point lies beyond a second element (a mirror seen in a mirror) or a TIR.
+std::vector<int8_t> zoomingRegion(const Frame& ref, const std::vector<ElementFrame>& frames,
+                                  const Scene* scene = nullptr);
+
+// Colour fringes (issue 6): the deviation of a channel at a pixel is the angle between the eye ray (eye to
+// the element point) and the line from the element point to that channel's seen point. Blue bends more than
+// red where deviation(B) > deviation(R). Over the pixels in `mask` (non-zero) whose |deviation(B) -
+// deviation(R)| is at least min_difference_arcmin (pixels with no dispersion are left out).
+struct FringeStats {
+  size_t pixels = 0;                       // pixels counted
+  double median_blue_minus_red_arcmin = 0;  // median of deviation(B) - deviation(R)
+  double fraction_blue_bends_more = 0;      // fraction of the counted pixels with deviation(B) > deviation(R)
+};
+FringeStats fringeStats(const Vec3& eye, const std::vector<Vec3>& element_point, const std::vector<Vec3>& red_seen,
+                        const std::vector<Vec3>& blue_seen, const std::vector<int8_t>& mask,
+                        double min_difference_arcmin = 0.01);
 
 }  // namespace pvrr
