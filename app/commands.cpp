@@ -19,6 +19,7 @@
 #include "pvrr/gl/context.h"
 #include "pvrr/gl/gl.h"
 #include "pvrr/format.h"
+#include "pvrr/frame.h"
 #include "pvrr/image.h"
 #include "pvrr/scene_json.h"
 #include "pvrr/spectrum.h"
@@ -64,18 +65,8 @@ void writeFileAtomic(const std::string& path, const std::string& content) {
 }
 
 size_t writeLinearPng(const std::string& path, int width, int height, const std::vector<Vec3>& linear) {
-  ImageRGB8 img(width, height);
   size_t bad = 0;
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      Vec3 c = linear[size_t(y) * size_t(width) + size_t(x)];
-      if (!isFinite(c)) {
-        ++bad;
-        c = Vec3(0);
-      }
-      uint8_t* p = img.at(x, y);
-      for (int k = 0; k < 3; ++k) p[k] = linearToSrgb8(std::clamp(c[k], 0.0, 1.0));
-    }
+  const ImageRGB8 img = srgbPicture(width, height, linear, &bad);
   const fs::path target(path);
   std::error_code ec;
   if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);

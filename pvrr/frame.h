@@ -7,9 +7,11 @@
 // frame). Points are world coordinates in the scene's units (metres or millimetres, as the scene says).
 #pragma once
 #include <array>
+#include <cstddef>
 #include <vector>
 
 #include "cad/math.h"
+#include "pvrr/image.h"
 #include "pvrr/stats.h"
 
 namespace pvrr {
@@ -38,5 +40,13 @@ struct Frame {
   // What each stage did and took (pvrr/stats.h); the tracer reports one stage, "ray-trace".
   FrameStages stages;
 };
+
+// The 8-bit sRGB picture of linear RGB colours (row-major, rows top-down): each channel clamped to [0, 1] and
+// encoded with linearToSrgb8 (pvrr/image.h); a non-finite colour is written black and counted in
+// `non_finite` (optional). What `pvrr render` and `pvrr compare` write and the golden-image tests compare.
+ImageRGB8 srgbPicture(int width, int height, const std::vector<Vec3>& linear, size_t* non_finite = nullptr);
+inline ImageRGB8 srgbPicture(const Frame& f, size_t* non_finite = nullptr) {
+  return srgbPicture(f.width, f.height, f.color, non_finite);
+}
 
 }  // namespace pvrr

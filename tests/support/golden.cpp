@@ -56,19 +56,6 @@ bool updatingGoldens() {
   return v && *v && std::string(v) != "0";
 }
 
-ImageRGB8 srgbPicture(int width, int height, const std::vector<Vec3>& linear) {
-  PVRR_CHECK(linear.size() == size_t(width) * size_t(height), << width << "x" << height << " holds " << linear.size());
-  ImageRGB8 img(width, height);
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      Vec3 c = linear[size_t(y) * size_t(width) + size_t(x)];
-      if (!isFinite(c)) c = Vec3(0);
-      uint8_t* p = img.at(x, y);
-      for (int k = 0; k < 3; ++k) p[k] = linearToSrgb8(std::clamp(c[k], 0.0, 1.0));
-    }
-  return img;
-}
-
 ::testing::AssertionResult matchesGolden(const std::string& name, const ImageRGB8& actual,
                                          const GoldenTolerance& tolerance) {
   if (!validName(name)) return ::testing::AssertionFailure() << "golden name \"" << name << "\": letters, digits, - and _ only";

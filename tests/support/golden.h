@@ -42,11 +42,6 @@ struct GoldenTolerance {
 //   codes that stays under pixel_delta everywhere (the reflectance and light changes above).
 constexpr GoldenTolerance kGoldenTolerance{8, 0.3, 0.005};
 
-// The 8-bit sRGB picture of linear RGB colours (row-major, top row first): each channel clamped to [0, 1] and
-// encoded with linearToSrgb8, non-finite colours black; as `pvrr render` writes its PNG.
-ImageRGB8 srgbPicture(int width, int height, const std::vector<Vec3>& linear);
-inline ImageRGB8 srgbPicture(const Frame& f) { return srgbPicture(f.width, f.height, f.color); }
-
 // Compares `actual` with the reference tests/golden/images/NAME.png (NAME: letters, digits, '-', '_').
 // Success: the reference exists, has the same size and the differences are within `tolerance`. Failure: the
 // message gives the differences and the paths of NAME-actual.png, NAME-reference.png and NAME-diff.png
