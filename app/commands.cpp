@@ -22,6 +22,7 @@
 #include "pvrr/base/image.h"
 #include "pvrr/scene/scene_json.h"
 #include "pvrr/optics/spectrum.h"
+#include "pvrr/base/frame.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -40,23 +41,11 @@ LoadedScene loadScene(const std::string& path, const std::vector<std::string>& o
 }
 
 size_t writeLinearPng(const std::string& path, int width, int height, const std::vector<Vec3>& linear) {
-  ImageRGB8 img(width, height);
   size_t bad = 0;
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      Vec3 c = linear[size_t(y) * size_t(width) + size_t(x)];
-      if (!isFinite(c)) {
-        ++bad;
-        c = Vec3(0);
-      }
-      uint8_t* p = img.at(x, y);
-      for (int k = 0; k < 3; ++k) p[k] = linearToSrgb8(std::clamp(c[k], 0.0, 1.0));
-    }
+  const ImageRGB8 img = srgbPicture(width, height, linear, &bad);
   writePngAtomic(path, img, MissingFolder::Create);
   return bad;
 }
-
-double seenAngle(const Vec3& p, const Vec3& a, const Vec3& b) { return angleBetween(a - p, b - p); }
 
 namespace {
 
@@ -66,12 +55,6 @@ gl::GlBackend backendArg(const Args& a) {
 }
 
 json vec(const Vec3& v) { return json::array({v.x, v.y, v.z}); }
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
 
 }  // namespace
 
@@ -144,20 +127,6 @@ int cmdGlInfo(const std::vector<std::string>& argv) {
   return 0;
 }
 
-namespace {
-// The per-pixel buffers every frame type carries (TracedFrame, gl::RasterFrame).
-template <class Frame>
-void takePixels(RenderedFrame& out, Frame& f) {
-  out.width = f.width;
-  out.height = f.height;
-  out.color = std::move(f.color);
-  out.seen = std::move(f.seen);
-  out.element = std::move(f.element);
-  out.element_point = std::move(f.element_point);
-  out.frame_ms = f.frame_ms;
-}
-}  // namespace
-
 RenderMode parseModeOption(const std::string& text, bool raytrace_ok) {
   const std::optional<RenderMode> mode = parseName<RenderMode>(text);
   if (!mode || (!raytrace_ok && !isRasterMode(*mode)))
@@ -211,7 +180,7 @@ RenderedFrame renderFrame(LoadedScene& ls, RenderMode mode, const std::string& g
     Tracer tracer(rays, to);
     const auto t0 = std::chrono::steady_clock::now();
     bool shown = false;
-    TracedFrame f = tracer.render([&](double frac) {
+    Frame f = tracer.render([&](double frac) {
       const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       if (s > 1.0 && isatty(2)) {
         std::fprintf(stderr, "\rray tracing: %3d%%", int(100 * frac));
@@ -219,10 +188,7 @@ RenderedFrame renderFrame(LoadedScene& ls, RenderMode mode, const std::string& g
       }
     });
     if (shown) std::fprintf(stderr, "\rray tracing: done \n");
-    out.channel_seen = std::move(f.channel_seen);
-    out.bounces = std::move(f.bounces);
-    takePixels(out, f);
-    out.stages.ran("ray-trace", f.frame_ms);
+    static_cast<Frame&>(out) = std::move(f);  // with its stage "ray-trace"
     out.gl_backend = "none (CPU, Embree)";
     return out;
   }
@@ -234,20 +200,15 @@ RenderedFrame renderFrame(LoadedScene& ls, RenderMode mode, const std::string& g
     session->rays = std::make_unique<RayScene>(scene, o);
   }
   if (!session->renderer) {
-    gl::RendererOptions ro;
-    ro.map_size = scene.render.map_size;
-    ro.map_texels_per_pixel = scene.render.map_texels_per_pixel;
-    ro.map_reuse_margin_deg = scene.render.map_reuse_margin_deg;
+    gl::RendererOptions ro = gl::rendererOptionsFor(scene);
     ro.seen_channel = session->seen_channel;
     ro.seen_points = session->seen_points;
-    ro.vertex.channels.clear();  // per element: dispersionChannels(scene, e), rgb or spectral as the scene says
     session->renderer = std::make_unique<gl::Renderer>(scene, *session->rays, ro);
   }
   session->renderer->setReadBack(session->read_back);
   gl::RasterFrame f = session->renderer->render(mode, &session->cache);
-  takePixels(out, f);
-  out.stages = std::move(f.stages);
   out.elements = elementsJson(scene, f.elements);
+  static_cast<Frame&>(out) = std::move(static_cast<Frame&>(f));
   out.gl_backend = session->context->backendName() + " (" + session->context->glRenderer() + ")";
   return out;
 }

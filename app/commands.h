@@ -36,7 +36,4 @@ MeshData readMeshFile(const std::string& path);
 // Linear RGB -> sRGB8 PNG, atomically. Non-finite values are written as black and counted (returned).
 size_t writeLinearPng(const std::string& path, int width, int height, const std::vector<Vec3>& linear);
 
-// Angular error (radians) at `surface_point` between the directions to two seen points.
-double seenAngle(const Vec3& surface_point, const Vec3& seen_a, const Vec3& seen_b);
-
 }  // namespace pvrr::app

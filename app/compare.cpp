@@ -40,15 +40,6 @@ int rssBaselineFrame(int frames) { return frames < 100 ? 1 : 100; }
 
 namespace {
 
-double quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const double pos = q * double(v.size() - 1);
-  const size_t i = size_t(pos);
-  const double f = pos - double(i);
-  return i + 1 < v.size() ? v[i] * (1 - f) + v[i + 1] * f : v[i];
-}
-
 // A perceptually ordered colour map (black-body-like: black, red, yellow, white) for heat maps.
 Vec3 heat(double x) {
   x = std::clamp(x, 0.0, 1.0);
@@ -123,139 +114,7 @@ void writeHeatMap(const std::string& path, int w, int h, const std::vector<doubl
   writePngAtomic(path, img);
 }
 
-// Squared difference of two linear colours, sRGB-encoded and clamped to [0, 1], summed over R, G and B.
-double srgbSquaredError(const Vec3& a, const Vec3& b) {
-  double se = 0;
-  for (int k = 0; k < 3; ++k) {
-    const double d = linearToSrgb(std::clamp(a[k], 0.0, 1.0)) - linearToSrgb(std::clamp(b[k], 0.0, 1.0));
-    se += d * d;
-  }
-  return se;
-}
-
-// The RMSE of srgbSquaredError summed over `pixels` pixels, and its PSNR (99 dB for no error).
-double colourRmse(double se, size_t pixels) { return pixels ? std::sqrt(se / (3.0 * double(pixels))) : 0.0; }
-double psnrDb(double rmse) { return rmse > 0 ? 20.0 * std::log10(1.0 / rmse) : 99.0; }
-
 }  // namespace
-
-ErrorStats compareToReference(const RenderedFrame& ref, const RenderedFrame& mode, std::vector<double>* errors,
-                              int only_element) {
-  std::vector<double> local;
-  std::vector<double>& e = errors ? *errors : local;
-  e.assign(ref.color.size(), std::nan(""));
-  double se = 0;
-  for (size_t i = 0; i < e.size(); ++i) {
-    if (ref.element[i] < 0 || (only_element >= 0 && ref.element[i] != only_element)) continue;
-    const double a = arcminutes(seenAngle(ref.element_point[i], ref.seen[i], mode.seen[i]));
-    if (!std::isfinite(a)) continue;
-    e[i] = a;
-    se += srgbSquaredError(ref.color[i], mode.color[i]);
-  }
-  ErrorStats s = summarizeErrors(e);
-  if (s.pixels == 0) return s;
-  s.rmse = colourRmse(se, s.pixels);
-  s.psnr_db = psnrDb(s.rmse);
-  return s;
-}
-
-std::vector<double> angularErrors(const RenderedFrame& ref, const std::vector<Vec3>& ref_seen,
-                                  const std::vector<Vec3>& mode_seen) {
-  const size_t n = ref.element.size();
-  std::vector<double> e(n, std::nan(""));
-  if (ref_seen.size() != n || mode_seen.size() != n || ref.element_point.size() != n) return e;
-  for (size_t i = 0; i < n; ++i) {
-    if (ref.element[i] < 0) continue;
-    const double a = arcminutes(seenAngle(ref.element_point[i], ref_seen[i], mode_seen[i]));
-    if (std::isfinite(a)) e[i] = a;
-  }
-  return e;
-}
-
-ErrorStats summarizeErrors(const std::vector<double>& errors_arcmin, const std::vector<int8_t>* region, int8_t value) {
-  std::vector<double> e;
-  for (size_t i = 0; i < errors_arcmin.size(); ++i)
-    if (std::isfinite(errors_arcmin[i]) && (!region || (i < region->size() && (*region)[i] == value))) e.push_back(errors_arcmin[i]);
-  ErrorStats s;
-  s.pixels = e.size();
-  if (e.empty()) return s;
-  s.median_arcmin = quantile(e, 0.5);
-  s.p95_arcmin = quantile(e, 0.95);
-  s.max_arcmin = *std::max_element(e.begin(), e.end());
-  return s;
-}
-
-std::vector<int8_t> zoomingRegion(const RenderedFrame& ref, const std::vector<ElementFrame>& frames, const Scene* scene) {
-  const size_t n = ref.element.size();
-  std::vector<int8_t> region(n, -1);
-  for (const ElementFrame& f : frames) {
-    if (f.views.empty()) continue;
-    // The patch of each vertex (the first patch listing it: shared boundary vertices belong to either).
-    std::vector<int> vertex_view(f.world_pos.size(), -1);
-    for (size_t v = 0; v < f.views.size(); ++v)
-      for (uint32_t vi : f.grid_patches[size_t(f.views[v].patch)].vertices)
-        if (vi < vertex_view.size() && vertex_view[vi] < 0) vertex_view[vi] = int(v);
-    // The forward direction of each patch's forward volume: the normalised mean of its outgoing ray directions
-    // (pvrr/method/view_volume.h; a patch rendered with the reversed volume keeps only forward' in its volume).
-    const size_t fit_channel = f.rays.size() / 2;
-    std::vector<Vec3> forward(f.views.size());
-    for (size_t v = 0; v < f.views.size(); ++v) {
-      const ViewVolume& vv = f.views[v].volume;
-      if (!vv.backward || f.rays.empty()) {
-        forward[v] = vv.forward;
-        continue;
-      }
-      Vec3 sum(0);
-      for (uint32_t vi : f.grid_patches[size_t(f.views[v].patch)].vertices)
-        if (vi < f.rays[fit_channel].size() && f.rays[fit_channel][vi].status != VertexStatus::Tir) sum += f.rays[fit_channel][vi].dir;
-      forward[v] = glm::length(sum) > 0 ? glm::normalize(sum) : -vv.forward;
-    }
-    // Specular events of a path that meets this element only: a mirror reflects once, a lens refracts twice.
-    const int own_events = scene && scene->elements[size_t(f.element)].type == ElementType::Lens ? 2 : 1;
-    for (size_t i = 0; i < n; ++i) {
-      if (ref.element[i] != f.element) continue;
-      if (ref.bounces.size() == n && ref.bounces[i] > own_events) {
-        region[i] = 2;
-        continue;
-      }
-      size_t view = 0;
-      if (f.views.size() > 1) {
-        double best = std::numeric_limits<double>::infinity();
-        for (size_t vi = 0; vi < f.world_pos.size(); ++vi) {
-          const Vec3 d = f.world_pos[vi] - ref.element_point[i];
-          const double d2 = glm::dot(d, d);
-          if (d2 < best && vertex_view[vi] >= 0) best = d2, view = size_t(vertex_view[vi]);
-        }
-      }
-      const double depth = glm::dot(ref.seen[i] - f.views[view].fit.eye, forward[view]);
-      if (std::isfinite(depth)) region[i] = depth <= 0 ? 1 : 0;
-    }
-  }
-  return region;
-}
-
-FringeStats fringeStats(const Vec3& eye, const std::vector<Vec3>& element_point, const std::vector<Vec3>& red_seen,
-                        const std::vector<Vec3>& blue_seen, const std::vector<int8_t>& mask, double min_difference_arcmin) {
-  FringeStats s;
-  const size_t n = element_point.size();
-  if (red_seen.size() != n || blue_seen.size() != n || mask.size() != n) return s;
-  std::vector<double> diff;
-  size_t more = 0;
-  for (size_t i = 0; i < n; ++i) {
-    if (!mask[i]) continue;
-    const Vec3 p = element_point[i], in = p - eye;
-    const double dev_r = arcminutes(angleBetween(in, red_seen[i] - p)), dev_b = arcminutes(angleBetween(in, blue_seen[i] - p));
-    const double d = dev_b - dev_r;
-    if (!std::isfinite(d) || std::abs(d) < min_difference_arcmin) continue;
-    diff.push_back(d);
-    more += d > 0;
-  }
-  s.pixels = diff.size();
-  if (diff.empty()) return s;
-  s.median_blue_minus_red_arcmin = quantile(diff, 0.5);
-  s.fraction_blue_bends_more = double(more) / double(diff.size());
-  return s;
-}
 
 namespace {
 
@@ -329,18 +188,6 @@ std::vector<Vec3> supersampledReference(const LoadedScene& ls, const std::string
         for (int dx = 0; dx < 2; ++dx)
           out[size_t(y) * size_t(w) + size_t(x)] += 0.25 * f.color[size_t(2 * y + dy) * size_t(2 * w) + size_t(2 * x + dx)];
   return out;
-}
-
-// Colour PSNR (sRGB-encoded, clamped) of `colour` against `truth` over the pixels where `ref` sees an element.
-double elementPsnr(const RenderedFrame& ref, const std::vector<Vec3>& truth, const std::vector<Vec3>& colour) {
-  double se = 0;
-  size_t n = 0;
-  for (size_t i = 0; i < ref.element.size() && i < truth.size() && i < colour.size(); ++i) {
-    if (ref.element[i] < 0) continue;
-    se += srgbSquaredError(truth[i], colour[i]);
-    ++n;
-  }
-  return n == 0 ? 0.0 : psnrDb(colourRmse(se, n));
 }
 
 }  // namespace
@@ -525,10 +372,7 @@ int cmdVertices(const std::vector<std::string>& argv) {
   for (const ElementFrame& f : frames) {
     const Element& el = scene.elements[size_t(f.element)];
     json patches = json::array();
-    gl::RendererOptions ro;
-    ro.map_size = scene.render.map_size;
-    ro.map_texels_per_pixel = scene.render.map_texels_per_pixel;
-    ro.map_reuse_margin_deg = scene.render.map_reuse_margin_deg;
+    const gl::RendererOptions ro = gl::rendererOptionsFor(scene);
     for (const PatchView& pv : f.views) {
       const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
       const std::array<int, 2> texels = mapTexels(pv.volume, gl::topLevelMapSide(scene, f, pv, ro));

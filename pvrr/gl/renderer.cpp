@@ -106,6 +106,15 @@ Renderer::Renderer(const Scene& scene, const RayScene& rays, RendererOptions opt
     : impl_(std::make_unique<Impl>(scene, rays, std::move(options))) {}
 Renderer::~Renderer() = default;
 
+RendererOptions rendererOptionsFor(const Scene& scene) {
+  RendererOptions o;
+  o.map_size = scene.render.map_size;
+  o.map_texels_per_pixel = scene.render.map_texels_per_pixel;
+  o.map_reuse_margin_deg = scene.render.map_reuse_margin_deg;
+  o.vertex.channels.clear();  // per element: dispersionChannels(scene, e), rgb or spectral as the scene says
+  return o;
+}
+
 RasterFrame Renderer::render(RenderMode mode, FrameCache* cache) {
   PVRR_CHECK(isRasterMode(mode), "(raytrace is the reference tracer's mode)");
   return impl_->render(mode, cache);

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "pvrr/base/frame.h"
 #include "pvrr/method/pass_plan.h"
 #include "pvrr/trace/ray_scene.h"
 #include "pvrr/base/stats.h"
@@ -24,16 +25,9 @@
 
 namespace pvrr::gl {
 
-// What one frame produced, read back from the GPU. Rows top-down. `seen` and `surface` are world points
-// (double, reconstructed from camera-relative floats).
-struct RasterFrame {
-  int width = 0, height = 0;
-  std::vector<Vec3> color;          // linear RGB
-  std::vector<Vec3> seen;           // the pixel's seen point
-  std::vector<int> element;         // element index under the pixel, -1 for none
-  std::vector<Vec3> element_point;  // the element surface point under the pixel
-  FrameStages stages;
-  double frame_ms = 0;              // CPU + GPU (finished) time of the frame
+// What one frame produced, read back from the GPU (pvrr/base/frame.h: color, and with seen points on seen, element
+// and element_point; bounces and channel_seen stay empty), and the pvrr mode's per-element state.
+struct RasterFrame : Frame {
   std::vector<ElementFrame> elements;  // PVRR per-element state of this frame (pvrr mode)
 };
 
@@ -81,6 +75,10 @@ struct RendererOptions : PassPlanOptions {
   // compare.
   bool sort_environment = true;
 };
+
+// The options a scene asks for: its render section's planning settings (map_size, map_texels_per_pixel,
+// map_reuse_margin_deg), each element's channels from its dispersion (vertex.channels empty), the rest default.
+RendererOptions rendererOptionsFor(const Scene& scene);
 
 // The frame cache and the map sizes belong to the planning (pvrr/method/pass_plan.h); these names keep them where the
 // renderer's users look for them.

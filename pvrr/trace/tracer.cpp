@@ -202,9 +202,9 @@ static_assert(kTile * kTile == RayScene::kPacketSize, "one packet per tile");
 
 }  // namespace
 
-TracedFrame Tracer::render(const std::function<void(double)>& progress) const {
+Frame Tracer::render(const std::function<void(double)>& progress) const {
   const int w = scene_.observer.width, h = scene_.observer.height;
-  TracedFrame f;
+  Frame f;
   f.width = w;
   f.height = h;
   const size_t n = size_t(w) * size_t(h);
@@ -269,6 +269,7 @@ TracedFrame Tracer::render(const std::function<void(double)>& progress) const {
     }
   });
   f.frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  f.stages.ran("ray-trace", f.frame_ms);
   return f;
 }
 

@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "pvrr/base/frame.h"
 #include "pvrr/trace/ray_scene.h"
 #include "pvrr/optics/spectrum.h"
 #include "pvrr/scene/render_desc.h"
@@ -57,19 +58,6 @@ struct TraceOptions {
   bool primary_packets = true;  // render(): primary rays of 4 x 4 tiles as packets (false: one ray each)
 };
 
-struct TracedFrame {
-  int width = 0, height = 0;
-  std::vector<Vec3> color;          // linear RGB, row-major, top row first
-  std::vector<Vec3> seen;           // world seen point per pixel
-  std::vector<int> element;         // first element per pixel, -1 for none
-  std::vector<Vec3> element_point;  // first element hit per pixel
-  std::vector<int> bounces;
-  // DispersionMode::Rgb only (empty otherwise): the seen point of each channel's own ray (R = C line,
-  // G = d line, B = F line) per pixel. Equal to `seen` for all three where the path crosses no lens.
-  std::array<std::vector<Vec3>, 3> channel_seen;
-  double frame_ms = 0;
-};
-
 class Tracer {
  public:
   Tracer(const RayScene& rays, TraceOptions options);
@@ -78,9 +66,10 @@ class Tracer {
   TraceResult trace(const Vec3& o, const Vec3& d, double wavelength_nm, std::vector<PathSegment>* path = nullptr) const;
   // A full pixel (pixel coordinates with centres at +0.5, origin top-left) honouring the dispersion mode.
   TraceResult tracePixel(double px, double py) const;
-  // The whole image, multithreaded (TBB) with FTZ/DAZ per thread. `progress` (fraction done) is called from
+  // The whole image, multithreaded (TBB) with FTZ/DAZ per thread: every buffer of the Frame (channel_seen in
+  // the rgb dispersion mode only), and its one stage "ray-trace". `progress` (fraction done) is called from
   // one thread at a time, at most every few rows.
-  TracedFrame render(const std::function<void(double)>& progress = {}) const;
+  Frame render(const std::function<void(double)>& progress = {}) const;
 
  private:
   // `first`: the hit of the ray (o, d) for t > 0 when already known (a packet's lane), else null.

@@ -1,4 +1,4 @@
-// The accuracy metric and the sweep CSV on constructed cases.
+// The sweep CSV, mesh files and sweep plots on constructed cases (the accuracy metric: tests/pvrr/accuracy_test.cpp).
 #include <gtest/gtest.h>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -13,53 +13,6 @@
 
 namespace pvrr::app {
 namespace {
-
-// Seen points rotated about the surface point by a known angle give exactly that angle.
-TEST(ErrorMetric, RotatedSeenPointsGiveTheRotationAngle) {
-  RenderedFrame ref, mode;
-  const int n = 101;
-  ref.width = mode.width = n;
-  ref.height = mode.height = 1;
-  const Vec3 p(0.3, 1.2, -0.4);
-  for (int i = 0; i < n; ++i) {
-    const double angle_arcmin = 0.05 * i;  // 0 .. 5 arcmin
-    const Vec3 axis = glm::normalize(Vec3(std::sin(i), std::cos(i), 0.3));
-    const Vec3 to = glm::normalize(Vec3(1, 0.2 * i / n, -0.5)) * (2.0 + i);
-    const Vec3 offset = Vec3(glm::rotate(Mat4(1.0), radians(angle_arcmin / 60.0), axis) * Vec4(to, 0));
-    // Rotating about an axis not perpendicular to `to` turns it by less: compute the true angle independently.
-    const double expected = arcminutes(std::acos(std::clamp(glm::dot(glm::normalize(to), glm::normalize(offset)), -1.0, 1.0)));
-    ref.element.push_back(0);
-    ref.element_point.push_back(p);
-    ref.seen.push_back(p + to);
-    ref.color.push_back(Vec3(0.5));
-    mode.element.push_back(0);
-    mode.element_point.push_back(p);
-    mode.seen.push_back(p + offset);
-    mode.color.push_back(Vec3(0.5));
-    EXPECT_NEAR(arcminutes(seenAngle(p, p + to, p + offset)), expected, 1e-6);
-  }
-  std::vector<double> per_pixel;
-  const ErrorStats s = compareToReference(ref, mode, &per_pixel);
-  EXPECT_EQ(s.pixels, size_t(n));
-  EXPECT_GT(s.max_arcmin, 0);
-  EXPECT_LE(s.max_arcmin, 5.0 + 1e-9);
-  EXPECT_LE(s.median_arcmin, s.p95_arcmin);
-  EXPECT_GE(s.psnr_db, 98.0);  // identical colours
-}
-
-TEST(ErrorMetric, PureRotationAboutAPerpendicularAxisIsExact) {
-  RenderedFrame ref, mode;
-  ref.width = mode.width = 1;
-  ref.height = mode.height = 1;
-  const Vec3 p(1, 2, 3), to(0, 0, -5);
-  const double a = radians(1.5 / 60.0);  // 1.5 arcmin about +x, perpendicular to `to`
-  ref.element = mode.element = {0};
-  ref.element_point = mode.element_point = {p};
-  ref.seen = {p + to};
-  mode.seen = {p + Vec3(glm::rotate(Mat4(1.0), a, Vec3(1, 0, 0)) * Vec4(to, 0))};
-  ref.color = mode.color = {Vec3(0.2)};
-  EXPECT_NEAR(compareToReference(ref, mode, nullptr).median_arcmin, 1.5, 1e-9);
-}
 
 TEST(SweepCsv, RoundTripsAndNamesBadLines) {
   SweepRow r;
@@ -225,106 +178,6 @@ TEST(SweepPlot, PaddedRangeIgnoresBadValuesAndRejectsNone) {
   EXPECT_NEAR(lg.second, 8 * 1.6, 1e-12);
   EXPECT_THROW(paddedRange({0, -2}, true), Error);
   EXPECT_THROW(paddedRange({}, false), Error);
-}
-
-// A constructed two-patch mirror: patch 0 (vertices at x < 0) has a forward volume looking down -z from a
-// viewpoint at z = 1; patch 1 (x > 0) was rendered with the reversed volume, whose forward' is the opposite
-// of its rays' mean direction (+z here, rays going -z); its viewpoint is at z = 2. A pixel is zooming when
-// its reference seen point lies behind its patch's viewpoint along the rays' mean direction.
-TEST(ZoomingRegion, PixelsBehindTheirPatchViewpointAreZooming) {
-  ElementFrame f;
-  f.element = 0;
-  f.world_pos = {Vec3(-1, 0, 0), Vec3(-0.5, 0, 0), Vec3(0.5, 0, 0), Vec3(1, 0, 0)};
-  f.rays.assign(1, std::vector<VertexRay>(4));
-  for (VertexRay& r : f.rays[0]) r.dir = Vec3(0, 0, -1), r.status = VertexStatus::Hit;
-  f.grid_patches.resize(2);
-  f.grid_patches[0].vertices = {0, 1};
-  f.grid_patches[1].vertices = {2, 3};
-  f.views.resize(2);
-  f.views[0].patch = 0;
-  f.views[0].fit.eye = Vec3(0, 0, 1);
-  f.views[0].volume.eye = Vec3(0, 0, 1);
-  f.views[0].volume.forward = Vec3(0, 0, -1);
-  f.views[1].patch = 1;
-  f.views[1].fit.eye = Vec3(0, 0, 2);
-  f.views[1].volume.eye = Vec3(0, 0, 2);
-  f.views[1].volume.forward = Vec3(0, 0, 1);  // reversed: looks back towards the mirror
-  f.views[1].volume.backward = true;
-
-  RenderedFrame ref;
-  // pixel: element point, seen point -> expected region
-  struct Px {
-    int element;
-    Vec3 p, seen;
-    int8_t expected;
-  };
-  const std::vector<Px> px = {
-      {0, Vec3(-0.9, 0, 0), Vec3(-0.9, 0, -3), 0},   // patch 0, seen beyond the mirror side: in front of z = 1 along -z
-      {0, Vec3(-0.6, 0, 0), Vec3(-0.6, 0, 1.5), 1},  // patch 0, seen at z = 1.5: behind its viewpoint (z = 1)
-      {0, Vec3(0.6, 0, 0), Vec3(0.6, 0, 1.5), 0},    // patch 1 (viewpoint z = 2): z = 1.5 is in front
-      {0, Vec3(0.9, 0, 0), Vec3(0.9, 0, 2.5), 1},    // patch 1: z = 2.5 is behind
-      {-1, Vec3(0), Vec3(0, 0, 5), -1},               // no element
-      {1, Vec3(0), Vec3(0, 0, 5), -1},                // an element without frames
-  };
-  for (const Px& p : px) {
-    ref.element.push_back(p.element);
-    ref.element_point.push_back(p.p);
-    ref.seen.push_back(p.seen);
-  }
-  ref.width = int(px.size());
-  ref.height = 1;
-  const std::vector<int8_t> region = zoomingRegion(ref, {f});
-  ASSERT_EQ(region.size(), px.size());
-  for (size_t i = 0; i < px.size(); ++i) EXPECT_EQ(region[i], px[i].expected) << "pixel " << i;
-  // A path that reflects again after this mirror (its seen point lies beyond a second element) is left
-  // unclassified.
-  ref.bounces = {1, 2, 1, 1, 0, 0};
-  const std::vector<int8_t> nested = zoomingRegion(ref, {f});
-  EXPECT_EQ(nested[0], 0);
-  EXPECT_EQ(nested[1], 2);
-  ref.bounces.clear();
-
-  // The region splits the error statistics.
-  const std::vector<double> err = {1, 10, 2, 20, std::nan(""), std::nan("")};
-  const ErrorStats z = summarizeErrors(err, &region, 1), o = summarizeErrors(err, &region, 0), all = summarizeErrors(err);
-  EXPECT_EQ(z.pixels, 2u);
-  EXPECT_DOUBLE_EQ(z.median_arcmin, 15);
-  EXPECT_DOUBLE_EQ(z.max_arcmin, 20);
-  EXPECT_EQ(o.pixels, 2u);
-  EXPECT_DOUBLE_EQ(o.median_arcmin, 1.5);
-  EXPECT_EQ(all.pixels, 4u);
-}
-
-// Fringes: an eye ray along -z; the red seen point deviates by 1 degree, the blue one by 1.5 degrees (blue
-// bends more by 30 arcmin) at three pixels, the other way round at one, equal at one (left out).
-TEST(Fringe, BlueBendingMoreIsMeasuredFromTheSeenPoints) {
-  const Vec3 eye(0, 0, 1);
-  auto seenAt = [](const Vec3& p, double deg) { return p + 5.0 * Vec3(std::sin(radians(deg)), 0, -std::cos(radians(deg))); };
-  std::vector<Vec3> pts, red, blue;
-  std::vector<int8_t> mask;
-  const double r_deg[] = {1, 1, 1, 2, 1, 3}, b_deg[] = {1.5, 1.5, 1.5, 1.9, 1, 9};
-  for (int i = 0; i < 6; ++i) {
-    const Vec3 p(0, 0, 0);
-    pts.push_back(p);
-    red.push_back(seenAt(p, r_deg[i]));
-    blue.push_back(seenAt(p, b_deg[i]));
-    mask.push_back(i < 5);  // the last pixel is not a lens pixel
-  }
-  const FringeStats s = fringeStats(eye, pts, red, blue, mask);
-  EXPECT_EQ(s.pixels, 4u);
-  EXPECT_NEAR(s.fraction_blue_bends_more, 0.75, 1e-12);
-  EXPECT_NEAR(s.median_blue_minus_red_arcmin, 30, 1e-6);
-
-  // Per-channel angular errors: the mode's channel seen point compared with the reference's same channel.
-  RenderedFrame ref;
-  ref.element = {0, 0, -1};
-  ref.element_point = {Vec3(0), Vec3(0), Vec3(0)};
-  const std::vector<Vec3> ref_b = {seenAt(Vec3(0), 1.5), seenAt(Vec3(0), 1.5), seenAt(Vec3(0), 1)};
-  const std::vector<Vec3> mode_b = {seenAt(Vec3(0), 1.5), seenAt(Vec3(0), 1.0), seenAt(Vec3(0), 9)};
-  const std::vector<double> e = angularErrors(ref, ref_b, mode_b);
-  EXPECT_NEAR(e[0], 0, 1e-6);
-  EXPECT_NEAR(e[1], 30, 1e-6);
-  EXPECT_TRUE(std::isnan(e[2]));  // not an element pixel
 }
 
 }  // namespace

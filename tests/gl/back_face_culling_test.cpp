@@ -42,7 +42,7 @@ struct Comparison {
   size_t pixels = 0, differ = 0, culled_closer = 0;
 };
 // Pixels whose colour differs with culling, and of those, how many are at least as close to the tracer's.
-Comparison compare(const gl::RasterFrame& off, const gl::RasterFrame& on, const TracedFrame& ref) {
+Comparison compare(const gl::RasterFrame& off, const gl::RasterFrame& on, const Frame& ref) {
   Comparison c;
   c.pixels = on.color.size();
   for (size_t i = 0; i < on.color.size(); ++i) {
@@ -62,7 +62,7 @@ TEST_P(BackFaceCullingTest, ThePictureIsUnchangedButForSilhouetteTies) {
     Scene s = buildScene(loadScene(std::string(PVRR_SOURCE_DIR) + "/models/" + scene + ".json",
                                    {"observer.image_size=[160,120]", "render.map_size=512"}));
     RayScene rays(s);
-    const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
+    const Frame ref = Tracer(rays, TraceOptions{}).render();
     gl::RendererOptions off_opts;
     off_opts.cull_back_faces = false;
     gl::Renderer off(s, rays, off_opts), on(s, rays, gl::RendererOptions{});

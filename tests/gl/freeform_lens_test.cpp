@@ -32,7 +32,7 @@ struct Errors {
 };
 
 // Angular error (docs/method.md) over the pixels where the reference sees the lens, in rows [y0, y1).
-Errors errors(const TracedFrame& ref, const gl::RasterFrame& f, int y0, int y1) {
+Errors errors(const Frame& ref, const gl::RasterFrame& f, int y0, int y1) {
   std::vector<double> e;
   for (int y = y0; y < y1; ++y)
     for (int x = 0; x < ref.width; ++x) {
@@ -58,7 +58,7 @@ TEST_P(FreeformLensTest, ProgressiveLensMatchesTheReference) {
   if (!ctx) return;
   Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/progressive-lens.json", {"observer.image_size=[160,120]"}));
   RayScene rays(s);
-  const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
+  const Frame ref = Tracer(rays, TraceOptions{}).render();
   gl::Renderer r(s, rays, gl::RendererOptions{});
   const gl::RasterFrame f = r.render(RenderMode::Pvrr);
   const Errors all = errors(ref, f, 0, ref.height);

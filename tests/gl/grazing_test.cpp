@@ -36,7 +36,7 @@ TEST_P(GrazingTest, MirrorSeenNearlyEdgeOnStaysFiniteAndExact) {
     test::addMirror(s, cad::makeSphere(1.5, outline), outline, test::pose(centre, normal), 25, 0.9);
     s.updateBounds();
     RayScene rays(s);
-    const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
+    const Frame ref = Tracer(rays, TraceOptions{}).render();
     gl::Renderer r(s, rays, gl::RendererOptions{});
     // A frame's errors at the pixels where both it and the reference see the mirror, sorted; every pixel finite.
     auto errors = [&](const gl::RasterFrame& f) {

@@ -30,14 +30,14 @@ using test::medianArcmin;
 
 // Pixels where the reference sees an element but the frame does not (the impostor drops mirror fragments whose
 // view ray misses the surface, or whose search does not converge).
-size_t holes(const TracedFrame& ref, const gl::RasterFrame& f) {
+size_t holes(const Frame& ref, const gl::RasterFrame& f) {
   size_t n = 0;
   for (size_t i = 0; i < ref.color.size(); ++i) n += ref.element[i] >= 0 && f.element[i] != ref.element[i];
   return n;
 }
 
 // Per-pixel angular errors (arcmin) where both the reference and the frame see element `element`.
-std::vector<double> elementErrors(const TracedFrame& ref, const std::vector<Vec3>& ref_seen, const gl::RasterFrame& f) {
+std::vector<double> elementErrors(const Frame& ref, const std::vector<Vec3>& ref_seen, const gl::RasterFrame& f) {
   std::vector<double> e;
   for (size_t i = 0; i < ref.color.size(); ++i)
     if (ref.element[i] >= 0 && f.element[i] == ref.element[i])
@@ -56,7 +56,7 @@ void expectFinite(const gl::RasterFrame& f) {
 }
 
 // Mean absolute colour difference over the pixels where both see element 0, and the reference's mean colour.
-std::pair<double, double> colourError(const TracedFrame& ref, const gl::RasterFrame& f) {
+std::pair<double, double> colourError(const Frame& ref, const gl::RasterFrame& f) {
   double err = 0, sum = 0;
   size_t n = 0;
   for (size_t i = 0; i < ref.color.size(); ++i) {
@@ -71,7 +71,7 @@ std::pair<double, double> colourError(const TracedFrame& ref, const gl::RasterFr
 
 // The reference frame, an impostor frame (finite everywhere) and its errors, and envmap's median (when asked).
 struct ImpostorRun {
-  TracedFrame ref;
+  Frame ref;
   gl::RasterFrame f;
   std::vector<double> errors;  // sorted, arcmin
   double envmap_median = 0;
@@ -133,7 +133,7 @@ TEST_P(ImpostorTest, CarMirrorFarBelowTheCubeMap) {
   if (!ctx) return;
   Scene s = test::shippedScene("car-mirror", {"observer.image_size=[320,240]"});
   RayScene rays(s);
-  const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
+  const Frame ref = Tracer(rays, TraceOptions{}).render();
   gl::Renderer r(s, rays, gl::RendererOptions{});
   const gl::RasterFrame f = r.render(RenderMode::Impostor);
   expectFinite(f);
@@ -298,18 +298,18 @@ Scene planoConvex(int max_depth = 4) {
   s.render.max_depth = max_depth;
   return s;
 }
-TracedFrame reference(const Scene& s) {
+Frame reference(const Scene& s) {
   RayScene rays(s);
   TraceOptions to;
   to.max_depth = s.render.max_depth;
   return Tracer(rays, to).render();
 }
-// The reference with R, G and B each traced with its own index (TracedFrame::channel_seen).
-TracedFrame rgbReference(const RayScene& rays, int max_depth) {
+// The reference with R, G and B each traced with its own index (Frame::channel_seen).
+Frame rgbReference(const RayScene& rays, int max_depth) {
   TraceOptions to;
   to.dispersion = DispersionMode::Rgb;
   to.max_depth = max_depth;
-  TracedFrame ref = Tracer(rays, to).render();
+  Frame ref = Tracer(rays, to).render();
   EXPECT_FALSE(ref.channel_seen[0].empty());
   return ref;
 }
@@ -363,7 +363,7 @@ TEST_P(ImpostorTest, LensSeenFromBehindEntersThroughItsBack) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
   const Scene s = plusLens(Vec3(0.01, 0.005, 1.4), Vec3(0, 0, 3));
-  const TracedFrame ref = reference(s);
+  const Frame ref = reference(s);
   const gl::RasterFrame f = impostorFrame(s);
   const std::vector<double> e = elementErrors(ref, ref.seen, f);
   const auto [cerr, cmean] = colourError(ref, f);
@@ -383,7 +383,7 @@ TEST_P(ImpostorTest, EachColourChannelRefractedWithItsOwnIndex) {
   if (!ctx) return;
   Scene s = test::shippedScene("reading-lens", {"observer.image_size=[160,120]", "render.dispersion=\"rgb\""});
   RayScene rays(s);
-  const TracedFrame ref = rgbReference(rays, s.render.max_depth);
+  const Frame ref = rgbReference(rays, s.render.max_depth);
   std::array<std::vector<double>, 3> e;
   gl::RasterFrame green;
   double red_against_blue = 0;
@@ -422,7 +422,7 @@ TEST_P(ImpostorTest, TotalInternalReflectionFollowedInsideTheGlass) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
   const Scene s = planoConvex();
-  const TracedFrame ref = reference(s);
+  const Frame ref = reference(s);
   const gl::RasterFrame f = impostorFrame(s);
   const Vec3 axis_point(0, 0, 2.0);
   std::vector<double> angles;
@@ -470,7 +470,7 @@ TEST_P(ImpostorTest, DepthLimitAbsorbsInsideTheGlassAsTheTracerDoes) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
   const Scene s = planoConvex(2);
-  const TracedFrame ref = reference(s);
+  const Frame ref = reference(s);
   const gl::RasterFrame f = impostorFrame(s);
   const Vec3 axis_point(0, 0, 2.0);
   size_t ring = 0, both_dark = 0, near = 0;
@@ -497,7 +497,7 @@ struct PathErrors {
   std::vector<double> arcmin;
   double colour = 0;
 };
-PathErrors pathErrors(const TracedFrame& ref, const gl::RasterFrame& f, const std::function<bool(size_t)>& keep) {
+PathErrors pathErrors(const Frame& ref, const gl::RasterFrame& f, const std::function<bool(size_t)>& keep) {
   PathErrors out;
   double cerr = 0, csum = 0;
   for (size_t i = 0; i < ref.color.size(); ++i) {
@@ -587,7 +587,7 @@ TEST_P(ImpostorTest, MirrorsFollowedThroughEachOthersCubes) {
     }
     const std::string label = lens_first ? "mirror pair after a lens" : "mirror pair";
     const ImpostorRun run = runImpostor(s, false);
-    const TracedFrame& ref4 = run.ref;
+    const Frame& ref4 = run.ref;
     // Over the pixels whose reference path meets `bounces` mirrors (0: two or more).
     auto errors = [&](int bounces) {
       return pathErrors(ref4, run.f,
@@ -612,7 +612,7 @@ TEST_P(ImpostorTest, MirrorsFollowedThroughEachOthersCubes) {
     // Depth 2: where the reference path at depth 4 meets three mirrors or more, the tracer at depth 2 absorbs
     // at the third: black, its seen point on that mirror's surface.
     s.render.max_depth = 2;
-    const TracedFrame ref2 = reference(s);
+    const Frame ref2 = reference(s);
     const gl::RasterFrame f2 = impostorFrame(s);
     size_t deep = 0, dark = 0, same_point = 0;
     for (size_t i = 0; i < ref4.color.size(); ++i) {
@@ -712,7 +712,7 @@ TEST_P(ImpostorTest, MirrorShowsALensColourFringes) {
   s.render.dispersion = DispersionMode::Rgb;
   s.updateBounds();
   RayScene rays(s);
-  const TracedFrame ref = rgbReference(rays, s.render.max_depth);
+  const Frame ref = rgbReference(rays, s.render.max_depth);
   auto through = [&](size_t i) { return ref.element[i] == 0 && ref.bounces[i] == 3; };
   // Angular errors (sorted) of frame f's seen points against the tracer's of channel c, over `through`.
   auto errors = [&](const gl::RasterFrame& f, int c) {

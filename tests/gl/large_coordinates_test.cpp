@@ -74,7 +74,7 @@ Result run(const Vec3& offset, RenderMode mode, Kind kind) {
   RayScene rays(s);
   TraceOptions to;
   to.max_depth = s.render.max_depth;
-  const TracedFrame ref = Tracer(rays, to).render();
+  const Frame ref = Tracer(rays, to).render();
   gl::RendererOptions opt;
   opt.map_size = 512;
   gl::Renderer r(s, rays, opt);

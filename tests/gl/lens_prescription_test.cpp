@@ -226,7 +226,7 @@ TEST_P(LensPrescriptionTest, ToricAndAsphericLensesMatchTheReference) {
     SCOPED_TRACE(c.name);
     Scene s = buildScene(spectacleWith(c.surfaces));
     RayScene rays(s);
-    const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
+    const Frame ref = Tracer(rays, TraceOptions{}).render();
     gl::Renderer r(s, rays, gl::RendererOptions{});
     const gl::RasterFrame f = r.render(RenderMode::Pvrr);
     ASSERT_EQ(f.seen.size(), ref.seen.size());

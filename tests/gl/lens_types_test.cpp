@@ -55,7 +55,7 @@ TEST_P(LensTypesTest, InvertingPlusLensAndMinusLensMatchTheReference) {
   for (const LensCase& c : {LensCase{"plus 10 D", 0.1, -0.1, 0.005, true}, LensCase{"minus 10 D", -0.1, 0.1, 0.0015, false}}) {
     Scene s = lensScene(c);
     RayScene rays(s);
-    const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
+    const Frame ref = Tracer(rays, TraceOptions{}).render();
     gl::Renderer r(s, rays, gl::RendererOptions{});
     const gl::RasterFrame f = r.render(RenderMode::Pvrr);
 
@@ -99,7 +99,7 @@ TEST_P(LensTypesTest, LensBeyondTheDepthLimitIsDarkLikeTheReference) {
   RayScene rays(s);
   TraceOptions to;
   to.max_depth = 1;
-  const TracedFrame ref = Tracer(rays, to).render();
+  const Frame ref = Tracer(rays, to).render();
   gl::Renderer r(s, rays, gl::RendererOptions{});
   const gl::RasterFrame f = r.render(RenderMode::Pvrr);
   size_t lens = 0, dark_ref = 0, dark_pvrr = 0;
@@ -135,7 +135,7 @@ TEST_P(LensTypesTest, TotalInternalReflectionShowsWhatTheReferenceShows) {
   RayScene rays(s);
   TraceOptions to;
   to.max_depth = s.render.max_depth;
-  const TracedFrame ref = Tracer(rays, to).render();
+  const Frame ref = Tracer(rays, to).render();
   gl::Renderer r(s, rays, gl::RendererOptions{});
   const gl::RasterFrame f = r.render(RenderMode::Pvrr);
   ASSERT_EQ(f.elements.size(), 1u);

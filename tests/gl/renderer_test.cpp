@@ -33,7 +33,7 @@ constexpr double kSeenPointTol_m = 1e-4;
 constexpr double kMeanColourTol = 2e-3;
 
 // Pixels whose reference seen point is close to all of its 8 neighbours' (no depth edge nearby).
-std::vector<bool> awayFromDepthEdges(const TracedFrame& ref, const Vec3& eye) {
+std::vector<bool> awayFromDepthEdges(const Frame& ref, const Vec3& eye) {
   std::vector<bool> ok(ref.seen.size(), false);
   for (int y = 1; y + 1 < ref.height; ++y)
     for (int x = 1; x + 1 < ref.width; ++x) {
@@ -81,7 +81,7 @@ TEST_P(RendererTest, RasterEnvironmentMatchesTheTracer) {
       s.lights.push_back(lamp);
     }
     RayScene rays(s);
-    TracedFrame ref = Tracer(rays, TraceOptions{}).render();
+    Frame ref = Tracer(rays, TraceOptions{}).render();
     gl::Renderer r(s, rays, gl::RendererOptions{});
     gl::RasterFrame f = r.render(RenderMode::Raster);
     ASSERT_EQ(f.color.size(), ref.color.size());
@@ -107,7 +107,7 @@ TEST_P(RendererTest, PlaneMirrorPvrrIsExactAwayFromDepthEdges) {
   test::addMirror(s, cad::makePlane(outline), outline, test::pose(Vec3(0, 0, -0.5), Vec3(0, 0, 1)), 7, 0.9);
   s.updateBounds();
   RayScene rays(s);
-  TracedFrame ref = Tracer(rays, TraceOptions{}).render();
+  Frame ref = Tracer(rays, TraceOptions{}).render();
   gl::RendererOptions opt;
   opt.map_size = 512;
   gl::Renderer r(s, rays, opt);
@@ -139,7 +139,7 @@ TEST_P(RendererTest, ConvexMirrorPvrrBeatsTheCubeMap) {
   test::addMirror(s, cad::makeSphere(1.0, outline), outline, test::pose(Vec3(0, 0, -0.3), Vec3(0, 0, 1)), 25, 0.9);
   s.updateBounds();
   RayScene rays(s);
-  TracedFrame ref = Tracer(rays, TraceOptions{}).render();
+  Frame ref = Tracer(rays, TraceOptions{}).render();
   gl::RendererOptions opt;
   opt.map_size = 512;
   gl::Renderer r(s, rays, opt);
@@ -163,7 +163,7 @@ TEST_P(RendererTest, CarMirrorAccuracyAndConvergence) {
   auto errorAt = [&](int tess, RenderMode mode) {
     Scene s = load(tess);
     RayScene rays(s);
-    TracedFrame ref = Tracer(rays, TraceOptions{}).render();
+    Frame ref = Tracer(rays, TraceOptions{}).render();
     gl::Renderer r(s, rays, gl::RendererOptions{});
     return medianArcmin(ref, r.render(mode));
   };
@@ -183,7 +183,7 @@ TEST_P(RendererTest, ConcaveMirrorZoomingRegion) {
   if (!ctx) return;
   Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/concave-mirror.json", {"observer.image_size=[240,180]"}));
   RayScene rays(s);
-  TracedFrame ref = Tracer(rays, TraceOptions{}).render();
+  Frame ref = Tracer(rays, TraceOptions{}).render();
   gl::Renderer r(s, rays, gl::RendererOptions{});
   gl::RasterFrame f = r.render(RenderMode::Pvrr);
   ASSERT_FALSE(f.elements.empty());
@@ -229,7 +229,7 @@ TEST_P(RendererTest, EyeFixedCacheMatchesAFreshFrame) {
       EXPECT_FALSE(t.ran) << t.name;
     }
   }
-  const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
+  const Frame ref = Tracer(rays, TraceOptions{}).render();
   const double cached_err = medianArcmin(ref, a), fresh_err = medianArcmin(ref, b);
   EXPECT_LE(cached_err, 1.0);
   EXPECT_LE(cached_err, 1.1 * fresh_err + 0.02) << "cached " << cached_err << "', fresh " << fresh_err << "'";
@@ -237,7 +237,7 @@ TEST_P(RendererTest, EyeFixedCacheMatchesAFreshFrame) {
 
 // Mean absolute colour difference (linear, averaged over RGB) between two images over the pixels where
 // `ref` sees an element.
-double meanColourDifference(const TracedFrame& ref, const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+double meanColourDifference(const Frame& ref, const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
   double sum = 0;
   size_t n = 0;
   for (size_t i = 0; i < ref.element.size(); ++i)
@@ -320,7 +320,7 @@ TEST_P(RendererTest, MapReuseWithinTheMarginMatchesAFreshFrame) {
   for (const char* stage : {"vertex-rays", "viewpoint-fit"}) EXPECT_FALSE(reused.stages.find(stage)->ran) << stage;
   gl::Renderer fresh_renderer(s, rays, gl::RendererOptions{});
   const gl::RasterFrame fresh = fresh_renderer.render(RenderMode::Pvrr);
-  const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
+  const Frame ref = Tracer(rays, TraceOptions{}).render();
   const double reused_err = medianArcmin(ref, reused), fresh_err = medianArcmin(ref, fresh);
   EXPECT_LE(reused_err, 1.0);
   EXPECT_LE(reused_err, 1.1 * fresh_err + 0.02) << "reused " << reused_err << "', fresh " << fresh_err << "'";
@@ -423,7 +423,7 @@ TEST_P(RendererTest, LensAccuracyAndDispersion) {
   {
     Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/spectacle-lens.json", {"observer.image_size=[200,150]"}));
     RayScene rays(s);
-    const TracedFrame ref = Tracer(rays, TraceOptions{}).render();
+    const Frame ref = Tracer(rays, TraceOptions{}).render();
     gl::Renderer r(s, rays, gl::RendererOptions{});
     EXPECT_LE(medianArcmin(ref, r.render(RenderMode::Pvrr)), 1.0);
   }
@@ -442,7 +442,7 @@ TEST_P(RendererTest, LensAccuracyAndDispersion) {
   EXPECT_TRUE(it->ran);
   TraceOptions to;
   to.dispersion = DispersionMode::Rgb;
-  const TracedFrame ref = Tracer(rays, to).render();
+  const Frame ref = Tracer(rays, to).render();
   EXPECT_LE(medianArcmin(ref, f), 1.0);
 }
 
@@ -451,7 +451,7 @@ TEST_P(RendererTest, LensAccuracyAndDispersion) {
 TEST_P(RendererTest, PatchesCoverTheMirrorAndKeepTheAccuracy) {
   auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
-  auto run = [&](const std::string& set, gl::RasterFrame* frame, TracedFrame* reference) {
+  auto run = [&](const std::string& set, gl::RasterFrame* frame, Frame* reference) {
     Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/car-mirror.json", {"observer.image_size=[240,180]", set}));
     RayScene rays(s);
     *reference = Tracer(rays, TraceOptions{}).render();
@@ -459,7 +459,7 @@ TEST_P(RendererTest, PatchesCoverTheMirrorAndKeepTheAccuracy) {
     *frame = r.render(RenderMode::Pvrr);
   };
   gl::RasterFrame one, four, automatic;
-  TracedFrame ref;
+  Frame ref;
   run("elements[0].patches=[1,1]", &one, &ref);
   run("elements[0].patches=[2,2]", &four, &ref);
   run("elements[0].max_patch_fov_deg=20", &automatic, &ref);
@@ -586,7 +586,7 @@ TEST_P(RendererTest, MirrorSeenInAMirror) {
     to.max_depth = max_depth;
     return Tracer(rays, to).render();
   };
-  const TracedFrame ref4 = reference(4), ref1 = reference(1);
+  const Frame ref4 = reference(4), ref1 = reference(1);
   auto render = [&](int max_depth) {
     s.render.max_depth = max_depth;
     gl::RendererOptions opt;
@@ -595,7 +595,7 @@ TEST_P(RendererTest, MirrorSeenInAMirror) {
   };
   const gl::RasterFrame f4 = render(4), f1 = render(1);
   // Median angular error over the reference's mirror pixels whose path has at least `min_bounces`.
-  auto median = [&](const TracedFrame& ref, const gl::RasterFrame& f, int min_bounces, int max_bounces = 99) {
+  auto median = [&](const Frame& ref, const gl::RasterFrame& f, int min_bounces, int max_bounces = 99) {
     std::vector<double> e;
     for (size_t i = 0; i < ref.color.size(); ++i) {
       if (ref4.element[i] < 0 || ref4.bounces[i] < min_bounces || ref4.bounces[i] > max_bounces) continue;
@@ -662,7 +662,7 @@ TEST_P(RendererTest, SpectralPvrrMatchesTheSpectralTracer) {
   to.max_depth = s.render.max_depth;
   to.dispersion = DispersionMode::Spectral;
   to.spectral_samples = s.render.spectral_samples;
-  const TracedFrame ref = Tracer(rays, to).render();
+  const Frame ref = Tracer(rays, to).render();
   // The full 1024^2 map (map_texels_per_pixel 0): the tracer point-samples the page's fine text, and so does a
   // map of many texels per pixel; a map sized to the lens's pixels filters it (closer to the true picture,
   // see AdaptiveMapIsCloserToASupersampledReference, but not to point samples).
@@ -725,7 +725,7 @@ TEST_P(RendererTest, AdaptiveMapIsCloserToASupersampledReference) {
     RayScene rays(s), rays2(s2);
     TraceOptions to;
     to.max_depth = s.render.max_depth;
-    const TracedFrame ref = Tracer(rays, to).render(), fine = Tracer(rays2, to).render();
+    const Frame ref = Tracer(rays, to).render(), fine = Tracer(rays2, to).render();
     auto render = [&](double texels_per_pixel, std::string* note) {
       gl::RendererOptions opt;
       opt.map_texels_per_pixel = texels_per_pixel;

@@ -1,30 +1,34 @@
-// Accuracy metrics shared by the GL tests: a raster frame's seen points against the reference tracer's.
+// Accuracy for the GL tests: a raster frame's seen points against the reference tracer's, with the metric of
+// pvrr compare (pvrr/analysis/accuracy.h).
 #pragma once
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cmath>
 #include <vector>
 
 #include "pvrr/gl/renderer.h"
 #include "pvrr/trace/tracer.h"
+#include "pvrr/analysis/accuracy.h"
+#include "pvrr/base/frame.h"
 
 namespace pvrr::test {
 
-// Median angular error (arcmin) over the pixels where the reference sees an element: at the reference's
-// surface point, the angle between the directions to the frame's seen point and to the reference's (the
-// metric of pvrr compare). 1e9 when there are no such pixels; `pixels` (optional) gets their count.
-inline double medianArcmin(const TracedFrame& ref, const gl::RasterFrame& f, size_t* pixels = nullptr) {
-  std::vector<double> e;
-  for (size_t i = 0; i < ref.color.size(); ++i)
-    if (ref.element[i] >= 0) {
-      const double a = arcminutes(angleBetween(ref.seen[i] - ref.element_point[i], f.seen[i] - ref.element_point[i]));
-      EXPECT_TRUE(std::isfinite(a)) << "pixel " << i;
-      e.push_back(a);
-    }
-  if (pixels) *pixels = e.size();
-  std::sort(e.begin(), e.end());
-  return e.empty() ? 1e9 : e[e.size() / 2];
+// The median angular error (arcmin; pvrr/analysis/accuracy.h: for an even count the mean of the two middle errors) over
+// the pixels where the reference sees an element. Every such pixel must have a finite error (a test failure
+// names each that does not). 1e9 when no pixel has one or the frame has no seen points (a failure); `pixels` (optional) gets the count of finite errors.
+inline double medianArcmin(const Frame& ref, const Frame& f, size_t* pixels = nullptr) {
+  if (f.seen.size() != ref.seen.size()) {
+    ADD_FAILURE() << "the frame has " << f.seen.size() << " seen points, the reference " << ref.seen.size();
+    return 1e9;
+  }
+  const std::vector<double> e = angularErrors(ref, ref.seen, f.seen);
+  for (size_t i = 0; i < e.size(); ++i) {
+    if (ref.element[i] < 0) continue;
+    EXPECT_TRUE(std::isfinite(e[i])) << "pixel " << i;
+  }
+  const ErrorStats s = summarizeErrors(e);
+  if (pixels) *pixels = s.pixels;
+  return s.pixels == 0 ? 1e9 : s.median_arcmin;
 }
 
 }  // namespace pvrr::test

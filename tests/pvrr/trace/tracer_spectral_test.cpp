@@ -55,7 +55,7 @@ Scene lensScene(int width = 32, int height = 24) {
   return s;
 }
 
-size_t pixels(const TracedFrame& f) { return size_t(f.width) * size_t(f.height); }
+size_t pixels(const Frame& f) { return size_t(f.width) * size_t(f.height); }
 
 TEST(SpectralMode, WithoutLensesMatchesOffAndRgbModes) {
   // The weights integrate white to white (the normalisation of spectrum.h).
@@ -65,9 +65,9 @@ TEST(SpectralMode, WithoutLensesMatchesOffAndRgbModes) {
 
   Scene s = mirrorScene();
   RayScene rays(s);
-  const TracedFrame off = Tracer(rays, mode(DispersionMode::Off)).render();
-  const TracedFrame rgb = Tracer(rays, mode(DispersionMode::Rgb)).render();
-  const TracedFrame spec = Tracer(rays, mode(DispersionMode::Spectral)).render();
+  const Frame off = Tracer(rays, mode(DispersionMode::Off)).render();
+  const Frame rgb = Tracer(rays, mode(DispersionMode::Rgb)).render();
+  const Frame spec = Tracer(rays, mode(DispersionMode::Spectral)).render();
   int on_mirror = 0;
   for (size_t i = 0; i < pixels(off); ++i) {
     on_mirror += off.element[i] == 0;
@@ -89,8 +89,8 @@ TEST(SpectralMode, GreyMetalIntegratesToItsOwnReflectance) {
   m.mirror.metal_table = std::make_shared<const Metal>(
       Metal("grey", "test", {{380.0, 1.2, 3.1}, {560.0, 1.2, 3.1}, {780.0, 1.2, 3.1}}));
   RayScene rays(s);
-  const TracedFrame off = Tracer(rays, mode(DispersionMode::Off)).render();
-  const TracedFrame spec = Tracer(rays, mode(DispersionMode::Spectral, 24)).render();
+  const Frame off = Tracer(rays, mode(DispersionMode::Off)).render();
+  const Frame spec = Tracer(rays, mode(DispersionMode::Spectral, 24)).render();
   int on_mirror = 0;
   for (size_t i = 0; i < pixels(off); ++i) {
     on_mirror += off.element[i] == 0;
@@ -206,8 +206,8 @@ TEST(SpectralMode, DispersiveLensSpreadsSeenPointsBetweenTheCAndFLines) {
 TEST(SpectralMode, LensPixelColourIsCloseToTheRgbModes) {
   Scene s = lensScene(40, 30);
   RayScene rays(s);
-  const TracedFrame rgb = Tracer(rays, mode(DispersionMode::Rgb)).render();
-  const TracedFrame spec = Tracer(rays, mode(DispersionMode::Spectral)).render();
+  const Frame rgb = Tracer(rays, mode(DispersionMode::Rgb)).render();
+  const Frame spec = Tracer(rays, mode(DispersionMode::Spectral)).render();
   // The walls are flat colours under parallel light, so away from colour edges both modes see the same
   // colour times the lens's transmittance; the modes differ only in how T(lambda) = (1 - R)^2 is weighted,
   // a few 1e-3 at most for n = 1.57..1.61. Pixels whose fringes straddle an edge differ by more.

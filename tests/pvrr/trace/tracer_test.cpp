@@ -329,7 +329,7 @@ TEST(RayScenePackets, PacketAndSingleRayFramesAgree) {
     TraceOptions po, so;
     po.dispersion = so.dispersion = mode;
     so.primary_packets = false;
-    const TracedFrame a = Tracer(rays, po).render(), b = Tracer(rays, so).render();
+    const Frame a = Tracer(rays, po).render(), b = Tracer(rays, so).render();
     ASSERT_EQ(a.color.size(), b.color.size());
     for (size_t i = 0; i < a.color.size(); ++i) {
       EXPECT_EQ(a.element[i], b.element[i]) << i;
@@ -358,7 +358,7 @@ TEST(RayScene, MovingElementsAfterAPoseUpdateMatchAFreshScene) {
     updateAttachedElements(s, desc);
     refitted.updateElementPoses();
     RayScene fresh(s);
-    const TracedFrame a = Tracer(refitted, TraceOptions{}).render(), b = Tracer(fresh, TraceOptions{}).render();
+    const Frame a = Tracer(refitted, TraceOptions{}).render(), b = Tracer(fresh, TraceOptions{}).render();
     for (size_t i = 0; i < a.seen.size(); ++i) {
       ASSERT_EQ(a.element[i], b.element[i]) << deg << " deg, pixel " << i;
       EXPECT_LT(glm::length(a.seen[i] - b.seen[i]), 1e-9) << deg << " deg, pixel " << i;
@@ -374,7 +374,7 @@ TEST(Tracer, RgbModeRecordsEachChannelsSeenPoint) {
   TraceOptions rgb;
   rgb.dispersion = DispersionMode::Rgb;
   Tracer tracer(rays, rgb);
-  const TracedFrame f = tracer.render();
+  const Frame f = tracer.render();
   const size_t n = size_t(f.width) * size_t(f.height);
   for (const auto& c : f.channel_seen) ASSERT_EQ(c.size(), n);
   const Tracer mono(rays, TraceOptions{});
@@ -400,7 +400,7 @@ TEST(Tracer, RgbModeRecordsEachChannelsSeenPoint) {
   EXPECT_GT(lens_pixels, 20);
   EXPECT_GT(fringes, lens_pixels / 2);  // polycarbonate (V_d = 30) separates C and F
   // Other modes leave the channels empty.
-  const TracedFrame off = mono.render();
+  const Frame off = mono.render();
   for (const auto& c : off.channel_seen) EXPECT_TRUE(c.empty());
 }
 
