@@ -38,8 +38,9 @@
 //    path.
 //  - Distortion: the object's direction seen from the rotation centre (the object-side chief ray's direction
 //    for an object at infinity, the object point for a near one) as tangents t_obj in the lens frame, against
-//    the gaze's tangents t_gaze = (gx_t, gy_t) = (g.x, g.y) / (-g.z): distortion_pct = 100 (|t_obj - t_obj0| /
-//    |J0 t_gaze| - 1), J0 the derivative of t_obj by t_gaze at the straight-ahead gaze (its paraxial angular
+//    the gaze's tangents t_gaze = (g.x, g.y) / (-g.z) = (tan gx, tan gy / cos gx) (the image the eye sees):
+//    distortion_pct = 100 (|t_gaze| / |J0^-1 (t_obj - t_obj0)| - 1), the image against its paraxial position,
+//    with J0 the derivative of t_obj by t_gaze straight ahead (the inverse of the paraxial angular
 //    magnification) and t_obj0 the straight-ahead object direction. Negative: barrel (a minus lens),
 //    positive: pincushion (a plus lens).
 //  - Lateral colour: the angle (arcmin, >= 0) between the object-side chief ray directions at the F and C
@@ -113,8 +114,27 @@ struct LensmapResult {
     int iterations = 0;
     double residual_prism = 0;
   } focimeter;
+  // A progressive lens (the mean power along the vertical meridian gaze_x = 0 rises by at least
+  // kProgressiveMinAdd_d below the straight-ahead gaze): its reference points and corridor, searched along that
+  // meridian (a corridor without inset) in steps of kProgressiveStep_deg.
+  struct Progressive {
+    bool detected = false;
+    double add_d = 0;                 // highest mean power along the meridian minus the far point's
+    // Far point: the straight-ahead gaze (the prescription). Near point: the first gaze down the meridian
+    // where the power reaches 95 % of the add.
+    double far_gaze_y_deg = 0, far_lens_y_mm = 0, far_mean_d = 0;
+    double near_gaze_y_deg = 0, near_lens_y_mm = 0, near_mean_d = 0;
+    // Corridor length: from the far point down to where the power reaches 85 % of the add (lens mm on the
+    // eye-side surface). Width: where the power reaches 50 % of the add, the horizontal extent (lens mm) of
+    // the gazes whose unwanted cylinder stays below 0.5 D.
+    double corridor_length_mm = 0;
+    double corridor_mid_gaze_y_deg = 0, corridor_width_mm = 0;
+  } progressive;
   double elapsed_ms = 0;
 };
+constexpr double kProgressiveMinAdd_d = 0.5;
+constexpr double kProgressiveStep_deg = 0.25;
+constexpr double kCorridorCylinder_d = 0.5;
 
 class Lensmap {
  public:
@@ -126,6 +146,17 @@ class Lensmap {
   // The whole map (multithreaded over gazes), its centre and the focimeter reading.
   LensmapResult run() const;
   LensmapResult::Focimeter focimeter() const;
+  // The progressive lens's reference points and corridor against the prescription `rx` (run() calls it).
+  LensmapResult::Progressive progressive(const LensmapPoint& rx) const;
+  // The object's tangents (x, y) / (-z) seen from the rotation centre at gaze tangents t_gaze =
+  // (tan gx, tan gy / cos gx), lens frame; false where the chief ray fails.
+  bool objectTangents(const Vec2& t_gaze, Vec2& t_obj) const;
+  // The inverse: the gaze tangents that see the object at tangents t_obj, by Newton iterations from the
+  // paraxial guess (converged to 1e-12 in tangent, or nothing). Straight lines in object space through this
+  // are the distortion map's curves.
+  std::optional<Vec2> gazeForObject(const Vec2& t_obj) const;
+  // The paraxial mapping: the object tangents t_obj0 + J0 t_gaze (NaN when J0 could not be measured).
+  Vec2 paraxialObject(const Vec2& t_gaze) const;
 
   // The exact chief ray from the rotation centre along gaze g at `wavelength_nm` (lens frame). False with a
   // reason when it misses a surface or is totally reflected.
@@ -150,6 +181,9 @@ class Lensmap {
   LensmapOptions options_;
   double n_d_;
   Vec3 centre_local_;
+  // Distortion's reference (straight ahead): the object's tangents and their derivatives by the gaze's.
+  bool have_j0_ = false;
+  Vec2 t_obj0_{0}, j0x_{0}, j0y_{0};
 };
 
 }  // namespace pvrr
