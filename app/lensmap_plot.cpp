@@ -303,6 +303,8 @@ Sketch sketchField(const LensmapResult& r, const FieldMap& m, const std::string&
     if (std::isfinite(v)) vmin = std::min(vmin, v), vmax = std::max(vmax, v);
   const std::vector<double> levels = isoLevels(vmin - step, vmax + step, step, 1000);
   for (double level : levels) {
+    // A signed map's zero is its white; its line would trace rounding noise across a flat zone.
+    if (m.diverging && std::abs(level) < 1e-12) continue;
     const auto segs = isoSegments(m.values, n, level);
     const bool major = std::abs(level) < 1e-12;
     for (const auto& s : segs) k.lines.push_back({{gridPx(s.first), gridPx(s.second)}, major ? kBlack : kDark, major ? 1.6 : 0.9});
@@ -364,7 +366,7 @@ Sketch sketchField(const LensmapResult& r, const FieldMap& m, const std::string&
     k.texts.push_back({bx + bw + 8, y + 4, fmt("%g", ticks[i]), 11, 0, kBlack});
   }
   k.texts.push_back({bx + bw / 2, f.top - 8, m.unit, 12, 1, kBlack});
-  if (clipped) k.texts.push_back({bx + bw / 2, f.top - 24, "(top: and above)", 10, 1, kDark});
+  if (clipped) k.texts.push_back({bx + bw / 2, f.top - 24, m.diverging ? "(ends: and beyond)" : "(top: and above)", 10, 1, kDark});
   k.texts.push_back({f.left + f.size / 2, f.top + f.size + 58,
                      "iso-lines every " + fmt("%g", step) + " " + m.unit + " (labelled); grey: no ray passes", 11, 1,
                      kDark});
