@@ -42,10 +42,9 @@ std::string csv(const LensmapResult& r) {
   for (const LensmapPoint& p : r.points) {
     s += full(p.gaze_x_deg) + "," + full(p.gaze_y_deg);
     if (p.valid) {
-      for (double v : {p.lens_x_mm, p.lens_y_mm, p.sphere_d, p.cylinder_d, p.axis_deg, p.mean_power_d,
-                       p.power_error_d, p.unwanted_cylinder_d, p.prism_h, p.prism_v, p.distortion_pct,
-                       p.lateral_colour_arcmin, p.tangential_d, p.sagittal_d, p.prentice_h, p.prentice_v,
-                       p.object_x_deg, p.object_y_deg})
+      for (double v : {p.lens_x_mm, p.lens_y_mm, p.sphere_d, p.cylinder_d, p.axis_deg, p.mean_power_d, p.power_error_d,
+                       p.unwanted_cylinder_d, p.prism_h, p.prism_v, p.distortion_pct, p.lateral_colour_arcmin,
+                       p.tangential_d, p.sagittal_d, p.prentice_h, p.prentice_v, p.object_x_deg, p.object_y_deg})
         s += "," + full(v);
     } else {
       s += std::string(18, ',');
@@ -56,12 +55,18 @@ std::string csv(const LensmapResult& r) {
 }
 
 json pointJson(const LensmapPoint& p) {
-  return {{"gaze_x_deg", num(p.gaze_x_deg)},     {"gaze_y_deg", num(p.gaze_y_deg)},
-          {"lens_x_mm", num(p.lens_x_mm)},       {"lens_y_mm", num(p.lens_y_mm)},
-          {"sphere_d", num(p.sphere_d)},         {"cylinder_d", num(p.cylinder_d)},
-          {"axis_deg", num(p.axis_deg)},         {"mean_power_d", num(p.mean_power_d)},
-          {"tangential_d", num(p.tangential_d)}, {"sagittal_d", num(p.sagittal_d)},
-          {"prism_h", num(p.prism_h)},           {"prism_v", num(p.prism_v)},
+  return {{"gaze_x_deg", num(p.gaze_x_deg)},
+          {"gaze_y_deg", num(p.gaze_y_deg)},
+          {"lens_x_mm", num(p.lens_x_mm)},
+          {"lens_y_mm", num(p.lens_y_mm)},
+          {"sphere_d", num(p.sphere_d)},
+          {"cylinder_d", num(p.cylinder_d)},
+          {"axis_deg", num(p.axis_deg)},
+          {"mean_power_d", num(p.mean_power_d)},
+          {"tangential_d", num(p.tangential_d)},
+          {"sagittal_d", num(p.sagittal_d)},
+          {"prism_h", num(p.prism_h)},
+          {"prism_v", num(p.prism_v)},
           {"lateral_colour_arcmin", num(p.lateral_colour_arcmin)}};
 }
 
@@ -70,27 +75,34 @@ json resultJson(const LensmapResult& r, const std::string& scene_path) {
   j["scene"] = scene_path;
   j["element"] = r.element;
   j["material"] = {{"n_d", num(r.n_d)}, {"abbe_v_d", num(r.abbe)}};
-  j["conventions"] = {
-      {"frame", "lens frame: +x the wearer's right, +y up, +z towards the eye; lens_x_mm, lens_y_mm: the chief "
-                "ray on the eye-side surface"},
-      {"rotation_centre", "on the lens axis, rotation_centre_mm behind the eye-side vertex; powers are taken on "
-                          "the vertex sphere (about the rotation centre, through the eye-side vertex)"},
-      {"gaze", "Fick angles: gaze_x_deg turns the eye towards the wearer's right about the vertical axis, then "
-               "gaze_y_deg turns it up"},
-      {"power", "dioptres, positive converging; wavefront vergence on the vertex sphere minus the object's own "
-                "vergence there (0 at infinity); sphere/cylinder in minus-cylinder form"},
-      {"axis", "TABO: 0-180 deg, counter-clockwise as seen facing the wearer, 0 at the wearer's left"},
-      {"prism", "prism dioptres = 100 tan(deviation) in the eye's own horizontal/vertical frame; base right "
-                "(prism_h > 0) and base up (prism_v > 0) positive"},
-      {"prentice", "Prentice's rule beside it: -100 x (centre power matrix) x (decentration on the eye-side "
-                   "surface, m); an approximation (ignores form, thickness, obliquity)"},
-      {"power_error", "mean power minus the prescription's (the straight-ahead reading)"},
-      {"unwanted_cylinder", "|cylinder| (>= 0) of the power matrix minus the prescription's"},
-      {"distortion", "100 (|t_gaze| / |J0^-1 (t_obj - t_obj0)| - 1): the gaze's tangents (the image) against the "
-                     "paraxial image of the object's tangents seen from the rotation centre; < 0 barrel, > 0 "
-                     "pincushion"},
-      {"lateral_colour", "angle between the object-side chief rays at the F (486.13 nm) and C (656.27 nm) lines, "
-                         "arcmin"}};
+  j["conventions"] = {{"frame",
+                       "lens frame: +x the wearer's right, +y up, +z towards the eye; lens_x_mm, lens_y_mm: the chief "
+                       "ray on the eye-side surface"},
+                      {"rotation_centre",
+                       "on the lens axis, rotation_centre_mm behind the eye-side vertex; powers are taken on "
+                       "the vertex sphere (about the rotation centre, through the eye-side vertex)"},
+                      {"gaze",
+                       "Fick angles: gaze_x_deg turns the eye towards the wearer's right about the vertical axis, then "
+                       "gaze_y_deg turns it up"},
+                      {"power",
+                       "dioptres, positive converging; wavefront vergence on the vertex sphere minus the object's own "
+                       "vergence there (0 at infinity); sphere/cylinder in minus-cylinder form"},
+                      {"axis", "TABO: 0-180 deg, counter-clockwise as seen facing the wearer, 0 at the wearer's left"},
+                      {"prism",
+                       "prism dioptres = 100 tan(deviation) in the eye's own horizontal/vertical frame; base right "
+                       "(prism_h > 0) and base up (prism_v > 0) positive"},
+                      {"prentice",
+                       "Prentice's rule beside it: -100 x (centre power matrix) x (decentration on the eye-side "
+                       "surface, m); an approximation (ignores form, thickness, obliquity)"},
+                      {"power_error", "mean power minus the prescription's (the straight-ahead reading)"},
+                      {"unwanted_cylinder", "|cylinder| (>= 0) of the power matrix minus the prescription's"},
+                      {"distortion",
+                       "100 (|t_gaze| / |J0^-1 (t_obj - t_obj0)| - 1): the gaze's tangents (the image) against the "
+                       "paraxial image of the object's tangents seen from the rotation centre; < 0 barrel, > 0 "
+                       "pincushion"},
+                      {"lateral_colour",
+                       "angle between the object-side chief rays at the F (486.13 nm) and C (656.27 nm) lines, "
+                       "arcmin"}};
   j["rotation_centre_mm"] = 1e3 * r.options.rotation_centre_m;
   j["object_distance_m"] = num(r.options.object_distance_m);
   j["grid"] = r.options.grid;
@@ -128,8 +140,9 @@ json resultJson(const LensmapResult& r, const std::string& scene_path) {
   j["empty"] = {{"count", r.empty},
                 {"miss", r.empty_miss},
                 {"tir", r.empty_tir},
-                {"meaning", "gazes whose chief ray or bundle misses a surface inside the outline (miss) or is "
-                            "totally reflected (tir): their CSV cells are empty"}};
+                {"meaning",
+                 "gazes whose chief ray or bundle misses a surface inside the outline (miss) or is "
+                 "totally reflected (tir): their CSV cells are empty"}};
   const LensmapResult::Focimeter& f = r.focimeter;
   j["focimeter"] = f.found ? json{{"found", true},
                                   {"optical_centre_lens_mm", {num(f.lens_x_mm), num(f.lens_y_mm)}},
@@ -139,15 +152,22 @@ json resultJson(const LensmapResult& r, const std::string& scene_path) {
                                   {"axis_deg", num(f.axis_deg)},
                                   {"newton_iterations", f.iterations},
                                   {"residual_prism", num(f.residual_prism)},
-                                  {"meaning", "back vertex power at the optical centre (zero prism) with a "
-                                              "parallel beam, measured on the eye-side surface"}}
+                                  {"meaning",
+                                   "back vertex power at the optical centre (zero prism) with a "
+                                   "parallel beam, measured on the eye-side surface"}}
                            : json{{"found", false}, {"reason", f.reason}};
   const LensmapResult::Progressive& pr = r.progressive;
   if (pr.detected)
     j["progressive"] = {
         {"add_d", num(pr.add_d)},
-        {"far_point", {{"gaze_y_deg", num(pr.far_gaze_y_deg)}, {"lens_y_mm", num(pr.far_lens_y_mm)}, {"mean_power_d", num(pr.far_mean_d)}}},
-        {"near_point", {{"gaze_y_deg", num(pr.near_gaze_y_deg)}, {"lens_y_mm", num(pr.near_lens_y_mm)}, {"mean_power_d", num(pr.near_mean_d)}}},
+        {"far_point",
+         {{"gaze_y_deg", num(pr.far_gaze_y_deg)},
+          {"lens_y_mm", num(pr.far_lens_y_mm)},
+          {"mean_power_d", num(pr.far_mean_d)}}},
+        {"near_point",
+         {{"gaze_y_deg", num(pr.near_gaze_y_deg)},
+          {"lens_y_mm", num(pr.near_lens_y_mm)},
+          {"mean_power_d", num(pr.near_mean_d)}}},
         {"corridor_length_mm", num(pr.corridor_length_mm)},
         {"corridor_width_mm", num(pr.corridor_width_mm)},
         {"corridor_width_gaze_y_deg", num(pr.corridor_mid_gaze_y_deg)},

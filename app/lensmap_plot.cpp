@@ -66,10 +66,10 @@ constexpr double kColourQuantile = 0.98;
 constexpr double kMaxIsoLines = 24;
 
 // Cool-warm (diverging, for signed errors) and yellow-orange-red (sequential, for magnitudes).
-const std::vector<Rgb> kDiverging = {{0.23, 0.30, 0.75}, {0.55, 0.69, 0.99}, {0.97, 0.97, 0.97},
-                                     {0.96, 0.60, 0.48}, {0.71, 0.02, 0.15}};
-const std::vector<Rgb> kSequential = {{1.0, 1.0, 0.90}, {1.0, 0.85, 0.46}, {0.99, 0.55, 0.24},
-                                      {0.89, 0.10, 0.11}, {0.50, 0.0, 0.15}};
+const std::vector<Rgb> kDiverging = {
+    {0.23, 0.30, 0.75}, {0.55, 0.69, 0.99}, {0.97, 0.97, 0.97}, {0.96, 0.60, 0.48}, {0.71, 0.02, 0.15}};
+const std::vector<Rgb> kSequential = {
+    {1.0, 1.0, 0.90}, {1.0, 0.85, 0.46}, {0.99, 0.55, 0.24}, {0.89, 0.10, 0.11}, {0.50, 0.0, 0.15}};
 
 std::string hex(const Rgb& c) {
   char buf[8];
@@ -80,10 +80,14 @@ std::string hex(const Rgb& c) {
 std::string esc(const std::string& s) {
   std::string o;
   for (char ch : s) {
-    if (ch == '<') o += "&lt;";
-    else if (ch == '>') o += "&gt;";
-    else if (ch == '&') o += "&amp;";
-    else o += ch;
+    if (ch == '<')
+      o += "&lt;";
+    else if (ch == '>')
+      o += "&gt;";
+    else if (ch == '&')
+      o += "&amp;";
+    else
+      o += ch;
   }
   return o;
 }
@@ -109,8 +113,11 @@ std::string svg(const Sketch& k) {
         << t.size * 1.25 << "\" fill=\"white\" fill-opacity=\"0.8\"/>\n";
     }
     o << "<text x=\"" << t.x << "\" y=\"" << t.y << "\" font-size=\"" << t.size << "\" fill=\"" << hex(t.c)
-      << "\" text-anchor=\"" << (t.anchor == 0 ? "start" : t.anchor == 1 ? "middle" : "end") << "\">" << esc(t.s)
-      << "</text>\n";
+      << "\" text-anchor=\""
+      << (t.anchor == 0   ? "start"
+          : t.anchor == 1 ? "middle"
+                          : "end")
+      << "\">" << esc(t.s) << "</text>\n";
   }
   o << "</svg>\n";
   return o.str();
@@ -133,7 +140,8 @@ struct Raster {
     for (int y = int(std::floor(y0)); y < int(std::ceil(y1)); ++y)
       for (int x = int(std::floor(x0)); x < int(std::ceil(x1)); ++x) {
         // Coverage of the pixel by the rectangle (edges antialiased).
-        const double cx = std::min(x1, x + 1.0) - std::max(x0, double(x)), cy = std::min(y1, y + 1.0) - std::max(y0, double(y));
+        const double cx = std::min(x1, x + 1.0) - std::max(x0, double(x)),
+                     cy = std::min(y1, y + 1.0) - std::max(y0, double(y));
         if (cx > 0 && cy > 0) blend(x, y, c, a * cx * cy);
       }
   }
@@ -178,8 +186,7 @@ struct Raster {
 void writePng(const std::string& path, const Sketch& k) {
   Raster r(k.width, k.height);
   // Filled areas snapped to whole pixels: abutting cells leave no seams.
-  for (const Rect& q : k.rects)
-    r.rect(std::round(q.x0), std::round(q.y0), std::round(q.x1), std::round(q.y1), q.c);
+  for (const Rect& q : k.rects) r.rect(std::round(q.x0), std::round(q.y0), std::round(q.x1), std::round(q.y1), q.c);
   for (const Line& l : k.lines) {
     double run = 0;
     for (size_t i = 1; i < l.pts.size(); ++i) {
@@ -204,7 +211,8 @@ void writePng(const std::string& path, const Sketch& k) {
   for (int y = 0; y < k.height; ++y)
     for (int x = 0; x < k.width; ++x)
       for (int c = 0; c < 3; ++c)
-        img.at(x, y)[c] = uint8_t(std::lround(255 * std::clamp(r.px[(size_t(y) * size_t(k.width) + size_t(x)) * 3 + size_t(c)], 0.0, 1.0)));
+        img.at(x, y)[c] = uint8_t(
+            std::lround(255 * std::clamp(r.px[(size_t(y) * size_t(k.width) + size_t(x)) * 3 + size_t(c)], 0.0, 1.0)));
   writePngAtomic(path, img, MissingFolder::Create);
 }
 
@@ -224,7 +232,8 @@ void axes(Sketch& k, const Frame& f, const std::string& title, const std::string
   const double b = f.top + f.size;
   k.lines.push_back({{Vec2(f.left, f.top), Vec2(f.left + f.size, f.top), Vec2(f.left + f.size, b), Vec2(f.left, b),
                       Vec2(f.left, f.top)},
-                     kBlack, 1});
+                     kBlack,
+                     1});
   for (double v = std::ceil(f.lo / tick) * tick; v <= f.hi + 1e-9; v += tick) {
     const Vec2 px = f.toPx(v, v);
     k.lines.push_back({{Vec2(px.x, b), Vec2(px.x, b + 5)}, kBlack, 1});
@@ -249,8 +258,8 @@ struct FieldMap {
   std::string file, title, unit;
   std::vector<double> values;  // n x n, NaN where empty
   bool diverging = false;
-  double step = 0.25;          // iso-line spacing
-  bool arrows = false;         // prism: base directions
+  double step = 0.25;   // iso-line spacing
+  bool arrows = false;  // prism: base directions
 };
 
 Sketch sketchField(const LensmapResult& r, const FieldMap& m, const std::string& empty_note) {
@@ -307,7 +316,8 @@ Sketch sketchField(const LensmapResult& r, const FieldMap& m, const std::string&
     if (m.diverging && std::abs(level) < 1e-12) continue;
     const auto segs = isoSegments(m.values, n, level);
     const bool major = std::abs(level) < 1e-12;
-    for (const auto& s : segs) k.lines.push_back({{gridPx(s.first), gridPx(s.second)}, major ? kBlack : kDark, major ? 1.6 : 0.9});
+    for (const auto& s : segs)
+      k.lines.push_back({{gridPx(s.first), gridPx(s.second)}, major ? kBlack : kDark, major ? 1.6 : 0.9});
     // Label the segment nearest to each of two anchors, unless another label is near.
     for (const Vec2 anchor : {Vec2(0.75, 0.7), Vec2(0.25, 0.3)}) {
       double best = kInf;
@@ -346,18 +356,20 @@ Sketch sketchField(const LensmapResult& r, const FieldMap& m, const std::string&
         k.lines.push_back({{b - 5.0 * u + 3.0 * v, b, b - 5.0 * u - 3.0 * v}, kBlack, 1.2});
       }
   }
-  axes(k, f, m.title, empty_note, "gaze_x (deg): towards the wearer's right", "gaze_y (deg): up", niceStep(2 * f.hi, 8));
+  axes(k, f, m.title, empty_note, "gaze_x (deg): towards the wearer's right", "gaze_y (deg): up",
+       niceStep(2 * f.hi, 8));
   // Colour bar.
   const double bx = f.left + f.size + 40, bw = 22;
   const int steps = 240;
   for (int i = 0; i < steps; ++i) {
     const double t0 = double(i) / steps, t1 = double(i + 1) / steps;
-    k.rects.push_back({bx, f.top + f.size * (1 - t1), bx + bw, f.top + f.size * (1 - t0) + 0.5,
-                       ramp(stops, (t0 + t1) / 2)});
+    k.rects.push_back(
+        {bx, f.top + f.size * (1 - t1), bx + bw, f.top + f.size * (1 - t0) + 0.5, ramp(stops, (t0 + t1) / 2)});
   }
   k.lines.push_back({{Vec2(bx, f.top), Vec2(bx + bw, f.top), Vec2(bx + bw, f.top + f.size), Vec2(bx, f.top + f.size),
                       Vec2(bx, f.top)},
-                     kBlack, 1});
+                     kBlack,
+                     1});
   std::vector<double> ticks = isoLevels(cmin - m.step / 2, cmax + m.step / 2, m.step, 1000);
   const size_t every = std::max<size_t>(1, (ticks.size() + 11) / 12);
   for (size_t i = 0; i < ticks.size(); i += every) {
@@ -366,7 +378,8 @@ Sketch sketchField(const LensmapResult& r, const FieldMap& m, const std::string&
     k.texts.push_back({bx + bw + 8, y + 4, fmt("%g", ticks[i]), 11, 0, kBlack});
   }
   k.texts.push_back({bx + bw / 2, f.top - 8, m.unit, 12, 1, kBlack});
-  if (clipped) k.texts.push_back({bx + bw / 2, f.top - 24, m.diverging ? "(ends: and beyond)" : "(top: and above)", 10, 1, kDark});
+  if (clipped)
+    k.texts.push_back({bx + bw / 2, f.top - 24, m.diverging ? "(ends: and beyond)" : "(top: and above)", 10, 1, kDark});
   k.texts.push_back({f.left + f.size / 2, f.top + f.size + 58,
                      "iso-lines every " + fmt("%g", step) + " " + m.unit + " (labelled); grey: no ray passes", 11, 1,
                      kDark});
@@ -407,7 +420,8 @@ Sketch sketchDistortion(const LensmapResult& r, const DistortionGrid& g) {
   add(g.seen, Rgb{0.1, 0.2, 0.7}, 1.4, false);
   double worst = 0;
   for (const LensmapPoint& p : r.points)
-    if (p.valid && std::isfinite(p.distortion_pct) && std::abs(p.distortion_pct) > std::abs(worst)) worst = p.distortion_pct;
+    if (p.valid && std::isfinite(p.distortion_pct) && std::abs(p.distortion_pct) > std::abs(worst))
+      worst = p.distortion_pct;
   axes(k, f, "Distortion: straight object lines as seen through the lens",
        "solid: as seen; dashed: without distortion (paraxial); largest " + fmt("%+.2f", worst) +
            " % (< 0 barrel, > 0 pincushion)",
@@ -433,9 +447,15 @@ std::vector<std::string> writeLensmapPlots(const std::string& dir, const Lensmap
   std::vector<std::string> out;
   auto put = [&](const std::vector<std::string>& v) { out.insert(out.end(), v.begin(), v.end()); };
   put(writeSketch(dir, "power_error",
-                  sketchField(r, {"power_error", "Mean power error as worn: " + r.element, "D", field(&LensmapPoint::power_error_d), true, 0.25, false}, rx)));
+                  sketchField(r,
+                              {"power_error", "Mean power error as worn: " + r.element, "D",
+                               field(&LensmapPoint::power_error_d), true, 0.25, false},
+                              rx)));
   put(writeSketch(dir, "cylinder",
-                  sketchField(r, {"cylinder", "Unwanted cylinder as worn: " + r.element, "D", field(&LensmapPoint::unwanted_cylinder_d), false, 0.25, false}, rx)));
+                  sketchField(r,
+                              {"cylinder", "Unwanted cylinder as worn: " + r.element, "D",
+                               field(&LensmapPoint::unwanted_cylinder_d), false, 0.25, false},
+                              rx)));
   std::vector<double> prism(count, std::nan(""));
   std::vector<double> colour = field(&LensmapPoint::lateral_colour_arcmin);
   double pmax = 0, cmax = 0;
@@ -446,11 +466,15 @@ std::vector<std::string> writeLensmapPlots(const std::string& dir, const Lensmap
       cmax = std::max(cmax, colour[i]);
     }
   put(writeSketch(dir, "prism",
-                  sketchField(r, {"prism", "Prism as worn (arrows: base direction): " + r.element, "prism D", prism, false,
-                                  niceStep(std::max(pmax, 1e-3), 10), true}, rx)));
+                  sketchField(r,
+                              {"prism", "Prism as worn (arrows: base direction): " + r.element, "prism D", prism, false,
+                               niceStep(std::max(pmax, 1e-3), 10), true},
+                              rx)));
   put(writeSketch(dir, "lateral_colour",
-                  sketchField(r, {"lateral_colour", "Lateral colour (F' - C'): " + r.element, "arcmin", colour, false,
-                                  niceStep(std::max(cmax, 1e-3), 10), false}, rx)));
+                  sketchField(r,
+                              {"lateral_colour", "Lateral colour (F' - C'): " + r.element, "arcmin", colour, false,
+                               niceStep(std::max(cmax, 1e-3), 10), false},
+                              rx)));
   put(writeSketch(dir, "distortion", sketchDistortion(r, distortion)));
   return out;
 }

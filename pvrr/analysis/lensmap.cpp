@@ -18,8 +18,8 @@ namespace {
 constexpr double kBundleStart_m = 0.05;
 // The focimeter's search for zero prism: Newton steps on the gaze with a central-difference Jacobian.
 constexpr int kFocimeterIterations = 20;
-constexpr double kFocimeterStep_rad = 1e-4;      // the Jacobian's half step
-constexpr double kFocimeterTolerance = 1e-9;     // prism dioptres: far below any reading's 0.01
+constexpr double kFocimeterStep_rad = 1e-4;   // the Jacobian's half step
+constexpr double kFocimeterTolerance = 1e-9;  // prism dioptres: far below any reading's 0.01
 // Half step (in tangent) of the straight-ahead derivative J0 of the object's tangent by the gaze's: its
 // truncation error (~1e-6 relative) is far below the 0.01 % distortion is printed to.
 constexpr double kDistortionStep = 1e-3;
@@ -58,9 +58,9 @@ SphCylAxis sphCylAxis(double vxx, double vxy, double vyy) {
 
 Lensmap::Lensmap(const RayScene& rays, int element, LensmapOptions options)
     : rays_(rays),
-      el_(element >= 0 && size_t(element) < rays.scene().elements.size() ? rays.scene().elements[size_t(element)]
-                                                                          : throw Error("lensmap: no element " +
-                                                                                        std::to_string(element))),
+      el_(element >= 0 && size_t(element) < rays.scene().elements.size()
+              ? rays.scene().elements[size_t(element)]
+              : throw Error("lensmap: no element " + std::to_string(element))),
       element_(element),
       options_(options) {
   if (el_.type != ElementType::Lens) throw Error("lensmap: element \"" + el_.name + "\" is not a lens");
@@ -160,8 +160,7 @@ bool Lensmap::bundle(const Chief& c, const Vec3& g, const Vec3& ex, const Vec3& 
   if (near) {
     const Vec3 w = c.back - centre_local_;
     const double b = glm::dot(w, c.out);
-    const double s =
-        -b + std::sqrt(b * b - (glm::dot(w, w) - options_.object_distance_m * options_.object_distance_m));
+    const double s = -b + std::sqrt(b * b - (glm::dot(w, w) - options_.object_distance_m * options_.object_distance_m));
     q = c.back + s * c.out;
   }
   // h (position on the plane through `at` normal to g) and s (slope) of each of the 4 rays.
@@ -236,8 +235,9 @@ LensmapPoint Lensmap::evaluate(double gaze_x_deg, double gaze_y_deg, const Lensm
   p.valid = true;
   p.lens_x_mm = 1e3 * c.front.x;
   p.lens_y_mm = 1e3 * c.front.y;
-  const double v_object =
-      std::isfinite(options_.object_distance_m) ? -1.0 / (options_.object_distance_m - options_.rotation_centre_m) : 0.0;
+  const double v_object = std::isfinite(options_.object_distance_m)
+                              ? -1.0 / (options_.object_distance_m - options_.rotation_centre_m)
+                              : 0.0;
   p.asymmetry_d = std::abs(v[1] - v[2]);
   p.vxx = v[0] - v_object;
   p.vxy = 0.5 * (v[1] + v[2]);
@@ -273,8 +273,8 @@ LensmapPoint Lensmap::evaluate(double gaze_x_deg, double gaze_y_deg, const Lensm
   const double det = j0x_.x * j0y_.y - j0y_.x * j0x_.y;
   const Vec2 paraxial = Vec2(j0y_.y * r.x - j0y_.x * r.y, -j0x_.y * r.x + j0x_.x * r.y) / det;
   p.distortion_pct = !have_j0_ || !(std::abs(det) > 0) ? std::nan("")
-                     : glm::length(tg) < 1e-12          ? 0.0
-                                                        : 100 * (glm::length(tg) / glm::length(paraxial) - 1);
+                     : glm::length(tg) < 1e-12         ? 0.0
+                                                       : 100 * (glm::length(tg) / glm::length(paraxial) - 1);
   return p;
 }
 
@@ -409,8 +409,9 @@ LensmapResult Lensmap::run() const {
   r.n_d = n_d_;
   r.abbe = el_.dispersion.abbe();
   r.centre = evaluate(0, 0);
-  if (!r.centre.valid) throw Error("lensmap: element \"" + el_.name + "\": the straight-ahead gaze does not pass the lens (" +
-                                   r.centre.reason + ")");
+  if (!r.centre.valid)
+    throw Error("lensmap: element \"" + el_.name + "\": the straight-ahead gaze does not pass the lens (" +
+                r.centre.reason + ")");
   const int n = options_.grid;
   r.points.resize(size_t(n) * size_t(n));
   tbb::parallel_for(0, n * n, [&](int i) {

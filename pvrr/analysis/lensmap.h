@@ -34,8 +34,8 @@
 //    axis onto the eye's frame; e_x at the centre) and across it.
 //  - Prentice's rule beside it: prism = decentration (cm) x power, with the decentration of the chief ray's
 //    point on the eye-side surface from the lens axis d (lens frame, m) and the centre's power matrix V0:
-//    (prentice_h, prentice_v) = -100 V0 d, signed like the traced prism. An approximation: it ignores the lens form, thickness and the oblique
-//    path.
+//    (prentice_h, prentice_v) = -100 V0 d, signed like the traced prism. An approximation: it ignores the lens form,
+//    thickness and the oblique path.
 //  - Distortion: the object's direction seen from the rotation centre (the object-side chief ray's direction
 //    for an object at infinity, the object point for a near one) as tangents t_obj in the lens frame, against
 //    the gaze's tangents t_gaze = (g.x, g.y) / (-g.z) = (tan gx, tan gy / cos gx) (the image the eye sees):
@@ -56,9 +56,9 @@
 namespace pvrr {
 
 struct LensmapOptions {
-  double rotation_centre_m = 0.0255;   // from the eye-side vertex (12 mm vertex distance + 13.5 mm)
-  double object_distance_m = kInf;     // from the rotation centre; infinity: a distant object
-  int grid = 41;                       // grid x grid gazes, each angle from -gaze_max_deg to +gaze_max_deg
+  double rotation_centre_m = 0.0255;  // from the eye-side vertex (12 mm vertex distance + 13.5 mm)
+  double object_distance_m = kInf;    // from the rotation centre; infinity: a distant object
+  int grid = 41;                      // grid x grid gazes, each angle from -gaze_max_deg to +gaze_max_deg
   double gaze_max_deg = 40;
   // Half-spacing of the ray bundle in object space (a lateral offset in m, or for a near object that offset
   // divided by the object's distance as an angle): small enough that the wavefront's higher orders leave
@@ -73,19 +73,19 @@ struct LensmapPoint {
   double gaze_x_deg = 0, gaze_y_deg = 0;
   bool valid = false;
   std::string reason;
-  double lens_x_mm = 0, lens_y_mm = 0;   // the chief ray on the eye-side surface, lens frame
-  double vxx = 0, vxy = 0, vyy = 0;      // power matrix (dioptres) in (e_x, e_y), V - V_object
+  double lens_x_mm = 0, lens_y_mm = 0;                // the chief ray on the eye-side surface, lens frame
+  double vxx = 0, vxy = 0, vyy = 0;                   // power matrix (dioptres) in (e_x, e_y), V - V_object
   double sphere_d = 0, cylinder_d = 0, axis_deg = 0;  // minus cylinder, TABO
-  double mean_power_d = 0;               // sphere + cylinder / 2
-  double tangential_d = 0, sagittal_d = 0;  // power in the meridian through the lens axis and across it
-  double power_error_d = 0;              // mean power minus the prescription's
-  double unwanted_cylinder_d = 0;        // |cylinder| (>= 0) of the power matrix minus the prescription's
-  double prism_h = 0, prism_v = 0;       // prism dioptres, base right / base up positive
-  double prentice_h = 0, prentice_v = 0; // Prentice's rule, same signs
-  double object_x_deg = 0, object_y_deg = 0;  // the object's direction from the rotation centre (Fick angles)
+  double mean_power_d = 0;                            // sphere + cylinder / 2
+  double tangential_d = 0, sagittal_d = 0;            // power in the meridian through the lens axis and across it
+  double power_error_d = 0;                           // mean power minus the prescription's
+  double unwanted_cylinder_d = 0;                     // |cylinder| (>= 0) of the power matrix minus the prescription's
+  double prism_h = 0, prism_v = 0;                    // prism dioptres, base right / base up positive
+  double prentice_h = 0, prentice_v = 0;              // Prentice's rule, same signs
+  double object_x_deg = 0, object_y_deg = 0;          // the object's direction from the rotation centre (Fick angles)
   double distortion_pct = 0;
   double lateral_colour_arcmin = 0;
-  double asymmetry_d = 0;                // |V_xy - V_yx| of the fitted matrix: a check of the bundle (~0)
+  double asymmetry_d = 0;  // |V_xy - V_yx| of the fitted matrix: a check of the bundle (~0)
 };
 
 // The eigen-decomposition of a symmetric power matrix (vxx, vxy, vyy in the eye's frame) in minus-cylinder
@@ -99,9 +99,9 @@ struct LensmapResult {
   std::string element;
   LensmapOptions options;
   double n_d = 0, abbe = 0;
-  LensmapPoint centre;                   // gaze (0, 0): the prescription the errors are taken against
-  std::vector<LensmapPoint> points;      // grid x grid, rows from gaze_y = -max up, x from -max right
-  int empty = 0;                         // invalid points (miss or TIR)
+  LensmapPoint centre;               // gaze (0, 0): the prescription the errors are taken against
+  std::vector<LensmapPoint> points;  // grid x grid, rows from gaze_y = -max up, x from -max right
+  int empty = 0;                     // invalid points (miss or TIR)
   int empty_miss = 0, empty_tir = 0;
   // Focimeter: the optical centre (where the chief ray leaves undeviated: zero prism), found by Newton
   // iterations on the gaze; the back vertex power there, measured with a parallel beam on the eye-side
@@ -119,7 +119,7 @@ struct LensmapResult {
   // meridian (a corridor without inset) in steps of kProgressiveStep_deg.
   struct Progressive {
     bool detected = false;
-    double add_d = 0;                 // highest mean power along the meridian minus the far point's
+    double add_d = 0;  // highest mean power along the meridian minus the far point's
     // Far point: the straight-ahead gaze (the prescription). Near point: the first gaze down the meridian
     // where the power reaches 95 % of the add.
     double far_gaze_y_deg = 0, far_lens_y_mm = 0, far_mean_d = 0;
@@ -163,8 +163,8 @@ class Lensmap {
   struct Chief {
     bool ok = false;
     std::string reason;
-    Vec3 front{0}, back{0};   // where it crosses the eye-side and object-side surfaces
-    Vec3 out{0};              // unit direction from the lens towards the object
+    Vec3 front{0}, back{0};  // where it crosses the eye-side and object-side surfaces
+    Vec3 out{0};             // unit direction from the lens towards the object
   };
   Chief chief(const Vec3& g_local, double wavelength_nm) const;
 

@@ -46,18 +46,18 @@ TEST(LensmapCli, WritesCsvJsonAndMaps) {
   const fs::path dir = pvrr::test::freshTestDir("lensmap-ok");
   const CliResult r = runPvrr("lensmap models/spectacle-lens.json --grid 9 --out '" + (dir / "out").string() + "'");
   ASSERT_EQ(r.code, 0) << r.err;
-  for (const char* f : {"lensmap.csv", "lensmap.json", "power_error.png", "power_error.svg", "cylinder.png",
-                        "cylinder.svg", "prism.png", "prism.svg", "lateral_colour.png", "lateral_colour.svg",
-                        "distortion.png", "distortion.svg"})
+  for (const char* f :
+       {"lensmap.csv", "lensmap.json", "power_error.png", "power_error.svg", "cylinder.png", "cylinder.svg",
+        "prism.png", "prism.svg", "lateral_colour.png", "lateral_colour.svg", "distortion.png", "distortion.svg"})
     EXPECT_TRUE(fs::exists(dir / "out" / f)) << f;
   const std::vector<std::string> lines = split(slurp(dir / "out" / "lensmap.csv"), '\n');
   ASSERT_GE(lines.size(), 82u);
   const std::vector<std::string> header = split(lines[0], ',');
   const std::vector<std::string> first14(header.begin(), header.begin() + 14);
-  EXPECT_EQ(first14, (std::vector<std::string>{"gaze_x_deg", "gaze_y_deg", "lens_x_mm", "lens_y_mm", "sphere_d",
-                                               "cylinder_d", "axis_deg", "mean_power_d", "power_error_d",
-                                               "unwanted_cylinder_d", "prism_h", "prism_v", "distortion_pct",
-                                               "lateral_colour_arcmin"}));
+  EXPECT_EQ(first14,
+            (std::vector<std::string>{"gaze_x_deg", "gaze_y_deg", "lens_x_mm", "lens_y_mm", "sphere_d", "cylinder_d",
+                                      "axis_deg", "mean_power_d", "power_error_d", "unwanted_cylinder_d", "prism_h",
+                                      "prism_v", "distortion_pct", "lateral_colour_arcmin"}));
   int empty_rows = 0;
   for (size_t i = 1; i <= 81; ++i) {
     const std::vector<std::string> cells = split(lines[i], ',');
@@ -107,8 +107,10 @@ TEST(LensmapCli, ErrorsAreOneLineAndLeaveNothing) {
                      "models/spectacle-lens.json: elements: no element named \"lens\"");
   expectOneLineError(runPvrr("lensmap models/car-mirror.json --out '" + out + "'"),
                      "models/car-mirror.json: elements: no lens to map");
-  expectOneLineError(runPvrr("lensmap models/spectacle-lens.json --set 'elements[0].eye={\"rotation_centre\": -1}' --out '" + out + "'"),
-                     "elements[0].eye.rotation_centre");
+  expectOneLineError(
+      runPvrr("lensmap models/spectacle-lens.json --set 'elements[0].eye={\"rotation_centre\": -1}' --out '" + out +
+              "'"),
+      "elements[0].eye.rotation_centre");
   expectOneLineError(runPvrr("lensmap models/spectacle-lens.json --object-distance 0.01 --out '" + out + "'"),
                      "--object-distance");
   EXPECT_FALSE(fs::exists(out));

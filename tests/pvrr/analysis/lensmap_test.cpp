@@ -38,7 +38,8 @@ Scene wornScene(const std::string& lens_keys) {
     "elements": [{"name": "lens", "type": "lens", "attached_to_observer": true,
       "pose": {"position": [0, 0, -0.012], "normal": [0, 0, 1], "up": [0, 1, 0]},
       "outline": {"shape": "ellipse", "width": 0.05, "height": 0.04},
-      "material": {"name": "cr39"}, )" + lens_keys + R"(}]})";
+      "material": {"name": "cr39"}, )" +
+                           lens_keys + R"(}]})";
   return buildScene(parseScene(json, "test.json", "."));
 }
 
@@ -125,8 +126,8 @@ void expectAgreesAlongMeridians(const Scene& scene, const char* what) {
       worst_d = std::max({worst_d, std::abs(s - w->sphere()), std::abs(c - w->cylinder()), std::abs(m - w->mean())});
       worst_prism = std::max({worst_prism, std::abs(p.prism_h - w->prism_h), std::abs(p.prism_v - w->prism_v)});
     }
-  std::printf("%s: max disagreement with the independent reference along the meridians: %.2e D, %.2e prism D\n",
-              what, worst_d, worst_prism);
+  std::printf("%s: max disagreement with the independent reference along the meridians: %.2e D, %.2e prism D\n", what,
+              worst_d, worst_prism);
 }
 
 TEST(Lensmap, AgreesWithIndependentReferenceSpectacleLens) {
@@ -143,7 +144,6 @@ TEST(Lensmap, PlusLensCentre) {
   EXPECT_NEAR(c.sphere_d, 2.0, kCentreSphere_d);
   EXPECT_LT(std::abs(c.cylinder_d), kCentreCylinder_d);
 }
-
 
 // Prentice's rule against the traced prism for the shipped -3 D lens (2 mm thick meniscus, +4 D base): the
 // rule overstates the prism by 7.7 % at 2.5 mm and 6.4 % at 4.9 mm of decentration (measured; the issue

@@ -17,8 +17,8 @@
 namespace pvrr::test {
 
 struct WornReading {
-  double vxx = 0, vxy = 0, vyy = 0;   // vergence matrix in the eye's frame (e_x right, e_y up), dioptres
-  double prism_h = 0, prism_v = 0;    // prism dioptres, base right / up positive
+  double vxx = 0, vxy = 0, vyy = 0;  // vergence matrix in the eye's frame (e_x right, e_y up), dioptres
+  double prism_h = 0, prism_v = 0;   // prism dioptres, base right / up positive
   double sphere() const { return 0.5 * (vxx + vyy) + std::hypot(0.5 * (vxx - vyy), vxy); }
   double cylinder() const { return -2 * std::hypot(0.5 * (vxx - vyy), vxy); }
   double mean() const { return 0.5 * (vxx + vyy); }

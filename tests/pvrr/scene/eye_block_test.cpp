@@ -20,7 +20,8 @@ std::string lensScene(const std::string& extra, const std::string& units = "m") 
       "pose": {"position": [0, 0, -0.012], "normal": [0, 0, 1]},
       "outline": {"shape": "circle", "diameter": 0.04},
       "front": {"type": "sphere", "radius": -0.0709}, "back": {"type": "sphere", "radius": -0.1245},
-      "centre_thickness": 0.002, "material": {"name": "cr39"})" + extra + "}]}";
+      "centre_thickness": 0.002, "material": {"name": "cr39"})" +
+         extra + "}]}";
 }
 
 TEST(EyeBlock, DefaultsTo25_5mm) {
@@ -29,8 +30,9 @@ TEST(EyeBlock, DefaultsTo25_5mm) {
 }
 
 TEST(EyeBlock, ReadsTheRotationCentreInTheScenesUnit) {
-  EXPECT_DOUBLE_EQ(parseScene(lensScene(R"(, "eye": {"rotation_centre": 0.027})"), "x.json", ".")
-                       .elements[0].eye_rotation_centre_m, 0.027);
+  EXPECT_DOUBLE_EQ(
+      parseScene(lensScene(R"(, "eye": {"rotation_centre": 0.027})"), "x.json", ".").elements[0].eye_rotation_centre_m,
+      0.027);
   const Scene s = buildScene(parseScene(lensScene(R"(, "eye": {"rotation_centre": 0.027})"), "x.json", "."));
   EXPECT_DOUBLE_EQ(s.elements[0].eye_rotation_centre_m, 0.027);
 }
