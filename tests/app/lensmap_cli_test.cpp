@@ -78,6 +78,14 @@ TEST(LensmapCli, WritesCsvJsonAndMaps) {
   EXPECT_TRUE(j["progressive"].is_null());
   const pvrr::ImageRGB8 png = pvrr::readPng((dir / "out" / "cylinder.png").string());
   EXPECT_GT(png.width, 400);
+  // Not blank: coloured cells (neither grey, white nor black) fill part of the picture.
+  size_t coloured = 0;
+  for (int y = 0; y < png.height; ++y)
+    for (int x = 0; x < png.width; ++x) {
+      const uint8_t* p = png.at(x, y);
+      coloured += (std::max({p[0], p[1], p[2]}) - std::min({p[0], p[1], p[2]}) > 30) ? 1 : 0;
+    }
+  EXPECT_GT(coloured, size_t(png.width * png.height / 10));
   const std::string svg = slurp(dir / "out" / "power_error.svg");
   EXPECT_NE(svg.find("iso-lines every 0.25 D"), std::string::npos);
   fs::remove_all(dir);

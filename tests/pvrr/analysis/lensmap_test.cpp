@@ -261,5 +261,25 @@ TEST(Lensmap, ProgressiveLensShowsAddAndCorridor) {
   EXPECT_GT(r.progressive.corridor_width_mm, 0);
 }
 
+// A near object straight ahead: the paraxial vergence through the lens (surface powers, the reduced thickness)
+// gives the exact axial limit of the bundle, so the two agree to the bundle's truncation (~1e-5 D); the
+// tolerance is the 0.01 D of agreement.
+TEST(Lensmap, NearObjectCentreMatchesParaxialVergence) {
+  const Scene scene = test::shippedScene("spectacle-lens");
+  RayScene rays(scene);
+  LensmapOptions o;
+  o.object_distance_m = 0.4;
+  const LensmapPoint c = Lensmap(rays, 0, o).evaluate(0, 0);
+  ASSERT_TRUE(c.valid);
+  const double n = scene.elements[0].dispersion.index(kLineD_nm), t = 0.002, r = o.rotation_centre_m;
+  const double f1 = (n - 1) / 0.1245, f2 = (n - 1) / -0.070925;   // object side (+4 D), eye side (-7.02 D)
+  const double l1 = -1 / (o.object_distance_m - r - t) + f1;      // after the object-side surface
+  const double l2 = l1 / (1 - (t / n) * l1) + f2;                 // at the eye-side vertex (on the vertex sphere)
+  const double expected = l2 - (-1 / (o.object_distance_m - r));  // minus the object's own vergence there
+  EXPECT_NEAR(c.sphere_d, expected, kAgreement_d);
+  EXPECT_NEAR(c.cylinder_d, 0, kCentreCylinder_d);
+  std::printf("near object 0.4 m: %.6f D traced, %.6f D paraxial\n", c.sphere_d, expected);
+}
+
 }  // namespace
 }  // namespace pvrr
