@@ -276,7 +276,6 @@ Sketch sketchField(const LensmapResult& r, const FieldMap& m, const std::string&
   std::sort(finite.begin(), finite.end());
   const double lo = finite.empty() ? 0 : finite.front();
   const double hi = finite.empty() ? 0 : finite[size_t(std::floor(kColourQuantile * double(finite.size() - 1)))];
-  const bool clipped = !finite.empty() && finite.back() > hi;
   double cmin, cmax;
   if (m.diverging) {
     cmax = std::ceil(std::max(hi, m.step) / m.step - 1e-9) * m.step;
@@ -285,6 +284,7 @@ Sketch sketchField(const LensmapResult& r, const FieldMap& m, const std::string&
     cmin = std::min(0.0, std::floor(lo / m.step) * m.step);
     cmax = std::max(m.step, std::ceil(hi / m.step - 1e-9) * m.step);
   }
+  const bool clipped = !finite.empty() && finite.back() > cmax;
   // Iso-lines every `step`, or every whole multiple of it when that would draw more than kMaxIsoLines.
   double step = m.step;
   {
@@ -370,7 +370,8 @@ Sketch sketchField(const LensmapResult& r, const FieldMap& m, const std::string&
                       Vec2(bx, f.top)},
                      kBlack,
                      1});
-  std::vector<double> ticks = isoLevels(cmin - m.step / 2, cmax + m.step / 2, m.step, 1000);
+  const double tick = niceStep(cmax - cmin, 8);
+  std::vector<double> ticks = isoLevels(cmin - tick / 2, cmax + tick / 2, tick, 1000);
   const size_t every = std::max<size_t>(1, (ticks.size() + 11) / 12);
   for (size_t i = 0; i < ticks.size(); i += every) {
     const double y = f.top + f.size * (1 - (ticks[i] - cmin) / (cmax - cmin));

@@ -281,5 +281,27 @@ TEST(Lensmap, NearObjectCentreMatchesParaxialVergence) {
   std::printf("near object 0.4 m: %.6f D traced, %.6f D paraxial\n", c.sphere_d, expected);
 }
 
+// Signs: the lens frame's +x is the wearer's right (the observer's +x for a lens attached like the shipped
+// one), and prism bases lie towards the thick part: outwards for a minus lens, inwards for a plus lens.
+TEST(Lensmap, GazeAndPrismSigns) {
+  const Scene minus = test::shippedScene("spectacle-lens"), plus = plusScene();
+  RayScene rm(minus), rp(plus);
+  const Lensmap mm(rm, 0, {}), mp(rp, 0, {});
+  const LensmapPoint right = mm.evaluate(15, 0), up = mm.evaluate(0, 15);
+  EXPECT_GT(right.lens_x_mm, 0);
+  EXPECT_NEAR(right.lens_y_mm, 0, 1e-9);
+  EXPECT_GT(up.lens_y_mm, 0);
+  EXPECT_GT(right.prism_h, 0);        // base right
+  EXPECT_GT(up.prism_v, 0);           // base up
+  EXPECT_GT(right.object_x_deg, 15);  // a minus lens shows the object nearer the centre than it is
+  EXPECT_LT(mp.evaluate(15, 0).prism_h, 0);
+  EXPECT_LT(mp.evaluate(0, 15).prism_v, 0);
+  // The world: the observer looks along -z with +x to the right; the lens frame's +x follows it.
+  const Element& el = minus.elements[0];
+  const Vec3 world_x = el.toWorldDir(Vec3(1, 0, 0));
+  const Vec3 view = glm::normalize(minus.observer.target - minus.observer.eye);
+  EXPECT_GT(glm::dot(world_x, glm::cross(view, minus.observer.up)), 0.99);
+}
+
 }  // namespace
 }  // namespace pvrr
