@@ -68,6 +68,17 @@ const std::map<std::string, Command>& commands() {
         "  without it, the scene's own map sizing."}},
       {"plot",
        {cmdPlot, "redraw the plots of a sweep from its CSV", "pvrr plot DIR/sweep.csv [--out DIR]"}},
+      {"lensmap",
+       {cmdLensmap, "power, astigmatism, prism, distortion and colour maps of a spectacle lens as worn",
+        "pvrr lensmap SCENE [--element NAME] [--grid N] [--gaze-max DEG] [--object-distance M] [--set PATH=VALUE]... --out DIR\n"
+        "  Per gaze (Fick angles, N x N from -DEG to +DEG, default 41 and 40), the chief ray through the eye's centre\n"
+        "  of rotation (the lens's \"eye\" block, default 25.5 mm behind its eye-side vertex) traced exactly, and the\n"
+        "  wavefront of an object at infinity (or M metres from the rotation centre) on the vertex sphere.\n"
+        "  Writes DIR/lensmap.csv (gaze_x_deg,gaze_y_deg,lens_x_mm,lens_y_mm,sphere_d,cylinder_d,axis_deg,\n"
+        "  mean_power_d,power_error_d,unwanted_cylinder_d,prism_h,prism_v,distortion_pct,lateral_colour_arcmin,\n"
+        "  tangential_d,sagittal_d,prentice_h,prentice_v,object_x_deg,object_y_deg; empty cells where no ray passes),\n"
+        "  DIR/lensmap.json (conventions, prescription, centre, ranges, empty gazes, focimeter reading) and maps as\n"
+        "  PNG and SVG: power_error, cylinder, prism, lateral_colour, distortion. Conventions: docs/lensmap.md."}},
       {"mesh",
        {cmdMesh, "tessellate a surface and write it as OBJ, PLY or VTP",
         "pvrr mesh (SURFACE_FILE | SCENE --element NAME) [--tessellation N | --tolerance T] --out FILE.obj|.ply|.vtp"}},

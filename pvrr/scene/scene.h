@@ -82,6 +82,7 @@ struct Element {
   Mat4 local_to_world{1.0};  // rigid pose: local +z is the element's front (towards the observer/eye)
   Mat4 world_to_local{1.0};
   bool attached_to_observer = false;
+  double eye_rotation_centre_m = 0.0255;  // lens: the wearer's eye's centre of rotation behind the eye-side vertex
 
   // Mirror: `surface`. Lens: `lens.front` (eye side) and `lens.back`. All in local coordinates.
   cad::SurfacePtr surface;

@@ -253,6 +253,7 @@ Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
     el.name = e.name;
     el.type = e.type == ElementDesc::Type::Lens ? ElementType::Lens : ElementType::Mirror;
     el.attached_to_observer = e.attached_to_observer;
+    el.eye_rotation_centre_m = e.eye_rotation_centre_m;
     el.patches_u = e.patches_u;
     el.patches_v = e.patches_v;
     el.max_patch_fov_rad = radians(e.max_patch_fov_deg);

@@ -195,6 +195,9 @@ struct PoseDesc {
   Vec3 up{0, 1, 0};      // hint for local +y, unit, not parallel to normal (the build orthogonalises)
 };
 
+// The eye's centre of rotation behind a spectacle lens's eye-side vertex when the scene does not say.
+constexpr double kDefaultEyeRotationCentre_m = 0.0255;
+
 struct ElementDesc {
   enum class Type { Mirror, Lens };
   std::string name;
@@ -218,6 +221,9 @@ struct ElementDesc {
   double centre_thickness_m = 0;    // 0: not given
   double min_edge_thickness_m = 0;  // 0: not given
   LensMaterialDesc lens_material;
+  // Lens: the wearer's eye behind it (the `eye` block; pvrr lensmap): its centre of rotation on the lens axis,
+  // this far behind the eye-side vertex (12 mm vertex distance + 13.5 mm by default).
+  double eye_rotation_centre_m = kDefaultEyeRotationCentre_m;
 };
 inline constexpr NameTable<ElementDesc::Type, 2> kElementTypeNames = {
     {{ElementDesc::Type::Mirror, "mirror"}, {ElementDesc::Type::Lens, "lens"}}};

@@ -814,13 +814,19 @@ LensMaterialDesc readLensMaterial(const Ctx& c, const json* j, const std::string
   return m;
 }
 
+// A lens's `eye` block: {"rotation_centre": length > 0}, the eye's centre of rotation behind the eye-side vertex.
+double readEyeRotationCentre(const Ctx& c, const json* j, const std::string& path) {
+  Obj o(c, j, path, "an eye {\"rotation_centre\": a length behind the eye-side vertex}", {"rotation_centre"});
+  return o.length("rotation_centre", kPositive, kDefaultEyeRotationCentre_m);
+}
+
 ElementDesc readElement(const Ctx& c, const json* j, const std::string& path, size_t index) {
   const std::string what = "an element {\"type\": " + alternatives<ElementDesc::Type>() + ", ...}";
   const ElementDesc::Type type = peekChoice<ElementDesc::Type>(c, j, path, what, "type");
   std::vector<std::string> keys = {"name", "type", "pose", "attached_to_observer", "outline", "tessellation",
                                    "patches", "max_patch_fov_deg", "material"};
   if (type == ElementDesc::Type::Mirror) keys.push_back("surface");
-  else keys.insert(keys.end(), {"front", "back", "centre_thickness", "min_edge_thickness", "prescription"});
+  else keys.insert(keys.end(), {"front", "back", "centre_thickness", "min_edge_thickness", "prescription", "eye"});
   Obj o(c, j, path, what, keys);
   ElementDesc e;
   e.type = type;
@@ -866,6 +872,7 @@ ElementDesc readElement(const Ctx& c, const json* j, const std::string& path, si
     e.centre_thickness_m = o.length("centre_thickness", kPositive, 0.0);
     e.min_edge_thickness_m = o.length("min_edge_thickness", kPositive, 0.0);
     e.lens_material = readLensMaterial(c, o.get("material"), o.at("material"));
+    if (o.has("eye")) e.eye_rotation_centre_m = readEyeRotationCentre(c, o.get("eye"), o.at("eye"));
   }
 
   if (analytic) {
