@@ -1,5 +1,5 @@
 #version 330 core
-// Test-only (tests/gl/context_test.cpp): a flat colour into attachment 0 and, into attachment 1, the window
+// Test-only (tests/gl/platform/context_test.cpp): a flat colour into attachment 0 and, into attachment 1, the window
 // coordinates of the fragment (gl_FragCoord.xy, pixel centres at +0.5, origin at the BOTTOM-left) plus a constant.
 uniform vec4 u_color;
 uniform float u_value;

@@ -1,4 +1,4 @@
-// The sweep CSV, mesh files and sweep plots on constructed cases (the accuracy metric: tests/pvrr/accuracy_test.cpp).
+// The sweep CSV, mesh files and sweep plots on constructed cases (the accuracy metric: tests/pvrr/analysis/accuracy_test.cpp).
 #include <gtest/gtest.h>
 
 #include <glm/gtc/matrix_transform.hpp>

@@ -86,7 +86,7 @@ long long samplesPassed(gl::Renderer& r) {
 // the street: in scene order, the table under the page and the road behind the door are shaded first and then
 // covered. Measured at 160 x 120 (all passes): reading lens 0.63 of the fragments, car mirror 0.89 (at 1280 x
 // 720: 0.58 and 0.90). The farthest-first order of reversed-depth maps is checked on its own
-// (DepthSortedDrawOrder in tests/pvrr/closed_mesh_test.cpp).
+// (DepthSortedDrawOrder in tests/pvrr/scene/closed_mesh_test.cpp).
 TEST_P(DrawOrderTest, NearestFirstShadesFewerFragments) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
