@@ -636,4 +636,25 @@ ViewpointFit fitViewpoint(const std::vector<ViewpointRay>& rays, const Viewpoint
   return fit;
 }
 
+ViewpointSolver parseViewpointSolver(const std::string& name) {
+  for (ViewpointSolver s :
+       {ViewpointSolver::kAuto, ViewpointSolver::kGaussNewton, ViewpointSolver::kCeres, ViewpointSolver::kClosedForm})
+    if (name == toString(s)) return s;
+  throw Error("viewpoint solver: expected auto, gauss-newton, ceres or closed-form, got \"" + name + "\"");
+}
+
+const char* toString(ViewpointSolver s) {
+  switch (s) {
+    case ViewpointSolver::kAuto:
+      return "auto";
+    case ViewpointSolver::kGaussNewton:
+      return "gauss-newton";
+    case ViewpointSolver::kCeres:
+      return "ceres";
+    case ViewpointSolver::kClosedForm:
+      return "closed-form";
+  }
+  return "?";
+}
+
 }  // namespace pvrr

@@ -72,6 +72,11 @@ enum class ViewpointSolver {
   kClosedForm,   // closed form (least-squares line distance) only, no angular refinement
 };
 
+// The scene's render.viewpoint_solver: "auto", "gauss-newton", "ceres" or "closed-form"; throws pvrr::Error
+// for another name. toString is its inverse.
+ViewpointSolver parseViewpointSolver(const std::string& name);
+const char* toString(ViewpointSolver s);
+
 struct ViewpointOptions {
   // Cauchy loss scale of the angular residual (rad); <= 0 disables the robust loss (plain least squares on
   // the sines of the angles). Residuals well below it count quadratically, those well above are

@@ -13,6 +13,7 @@
 #include "pvrr/base/math.h"
 #include "cad/tessellate.h"
 #include "pvrr/optics/material.h"
+#include "pvrr/scene/scene_desc.h"
 
 namespace pvrr {
 
@@ -90,7 +91,9 @@ struct Element {
 
   int tess_u = 7, tess_v = 7;       // per-vertex grid of the PVRR path
   int patches_u = 1, patches_v = 1;
-  double max_patch_fov_rad = 0;     // > 0: split patches until each view volume's FOV is below this
+  // > 0: split patches until each view volume's FOV is below this. The default (kDefaultMaxPatchFovDeg,
+  // chosen by measurement: docs/accuracy.md) splits no shipped scene and the stiff ones that need it.
+  double max_patch_fov_rad = kDefaultMaxPatchFovDeg * kPi / 180.0;
 
   MirrorMaterial mirror;
   Dispersion dispersion;            // lens material
@@ -116,6 +119,7 @@ struct RenderSettings {
   int spectral_samples = 16;
   Vec3 background{0.55, 0.7, 0.9};  // linear RGB of escaping rays (the sky)
   double far_distance_m = 1e4;      // where escaping rays get their far point
+  std::string viewpoint_solver = "auto";  // auto | gauss-newton | ceres | closed-form (parseViewpointSolver)
 };
 
 struct Scene {

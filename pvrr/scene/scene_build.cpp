@@ -357,6 +357,7 @@ Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
   rs.dispersion = toString(desc.render.dispersion);
   rs.spectral_samples = desc.render.spectral_samples;
   rs.background = desc.render.background;
+  rs.viewpoint_solver = desc.render.viewpoint_solver;
   scene.updateBounds();
   rs.far_distance_m = std::max(1e3, 100.0 * scene.boundsRadius());
   return scene;

@@ -878,7 +878,7 @@ ElementDesc readElement(const Ctx& c, const json* j, const std::string& path, si
     e.patches_u = (*p)[0].get<int>();
     e.patches_v = (*p)[1].get<int>();
   }
-  e.max_patch_fov_deg = o.number("max_patch_fov_deg", open(0, 180), 0.0, "an angle (degrees)");
+  e.max_patch_fov_deg = o.number("max_patch_fov_deg", open(0, 180), kDefaultMaxPatchFovDeg, "an angle (degrees)");
   return e;
 }
 
@@ -889,7 +889,7 @@ RenderDesc readRender(const Ctx& c, const json* j, const std::string& source) {
   Obj o(c, j, "render", "an object {\"mode\", \"map_size\", \"output\", ...}",
         {"mode", "map_size", "map_texels_per_pixel", "map_reuse_margin_deg", "impostor_iterations", "impostor_layers", "output",
          "max_depth", "dispersion", "spectral_samples",
-         "background"});
+         "background", "viewpoint_solver"});
   const std::string mode = o.choice("mode", {"pvrr", "raster", "raytrace", "envmap", "impostor"}, "pvrr");
   r.mode = mode == "pvrr"       ? RenderDesc::Mode::Pvrr
            : mode == "raster"   ? RenderDesc::Mode::Raster
@@ -912,6 +912,7 @@ RenderDesc readRender(const Ctx& c, const json* j, const std::string& source) {
                                  : RenderDesc::Dispersion::Spectral;
   r.spectral_samples = o.integer("spectral_samples", 3, 256, 16);
   r.background = o.vec3("background", VecKind::ColourNonNegative, r.background);
+  r.viewpoint_solver = o.choice("viewpoint_solver", {"auto", "gauss-newton", "ceres", "closed-form"}, "auto");
   return r;
 }
 
