@@ -23,7 +23,7 @@ namespace pvrr {
 
 // The default of elements[].max_patch_fov_deg: patches whose map would span more are split (issue 26). 90 deg
 // splits no shipped scene (their widest map: the progressive lens's 77 deg) and lowers the median error of
-// every stiff case measured (docs/accuracy.md); 60 deg made a strong toric lens worse, 120 deg the toric and
+// every stiff case measured (docs/method.md, "Every frame checks itself"); 60 deg made a strong toric lens worse, 120 deg the toric and
 // sphere mirrors.
 constexpr double kDefaultMaxPatchFovDeg = 90.0;
 
