@@ -69,6 +69,35 @@ json stagesJson(const FrameStages& s) {
   return a;
 }
 
+json patchQualityJson(const PatchQuality& q) {
+  return {{"verdict", toString(q.verdict)},
+          {"reasons", q.reasons},
+          {"action", q.action},
+          {"fov_deg", q.fov_deg},
+          {"fov_limited", q.fov_limited},
+          {"hits_behind_viewpoint", q.hits_behind},
+          {"fit_rms_angle_arcmin", q.fit_rms_arcmin},
+          {"fit_max_angle_arcmin", q.fit_max_arcmin},
+          {"st_outside_share", q.st_outside_share},
+          {"max_ray_spread_deg", q.max_ray_spread_deg},
+          {"max_normal_spread_deg", q.max_normal_spread_deg},
+          {"max_traced_spread_deg", q.max_traced_spread_deg},
+          {"tir_share", q.tir_share}};
+}
+
+void printQuality(const json& elements, const std::string& prefix) {
+  for (const json& e : elements) {
+    if (!e.contains("quality") || e["quality"]["verdict"] == "good") continue;
+    std::string line = prefix + "quality: " + e["name"].get<std::string>() + " " + e["quality"]["verdict"].get<std::string>() +
+                       ": " + e["quality"]["action"].get<std::string>();
+    for (const json& p : e["patches"])
+      if (p["quality"]["verdict"] != "good")
+        line += "; patch " + std::to_string(p["patch"].get<int>()) + " " + p["quality"]["verdict"].get<std::string>() +
+                " (" + p["quality"]["reasons"].get<std::string>() + ")";
+    std::printf("%s\n", line.c_str());
+  }
+}
+
 json elementsJson(const Scene& scene, const std::vector<ElementFrame>& frames) {
   json out = json::array();
   for (const ElementFrame& f : frames) {
@@ -104,9 +133,11 @@ json elementsJson(const Scene& scene, const std::vector<ElementFrame>& frames) {
                          {"fallback", pv.fit.fallback},
                          {"frustum_fov_deg", {degrees(pv.volume.fov_x_rad), degrees(pv.volume.fov_y_rad)}},
                          {"view_volume_note", pv.volume.note},
-                         {"zooming_hits", pv.volume.zooming.size()}});
+                         {"zooming_hits", pv.volume.zooming.size()},
+                         {"quality", patchQualityJson(pv.quality)}});
     }
     e["patches"] = patches;
+    e["quality"] = {{"verdict", toString(f.quality.verdict)}, {"action", f.quality.action}};
     out.push_back(e);
   }
   return out;
@@ -292,6 +323,7 @@ int cmdRender(const std::vector<std::string>& argv) {
                                         : "";
   std::printf("frame time: %.3f ms (%s, %dx%d, mode %s%s)\n", frame_ms, last.gl_backend.c_str(), last.width, last.height,
               nameOf(mode), spread.c_str());
+  printQuality(last.elements, "");
   if (auto stats = a.get("stats")) {
     json j = {{"scene", scene_path}, {"mode", nameOf(mode)}, {"size", {last.width, last.height}}, {"gl", last.gl_backend},
               {"frame_ms", frame_ms}, {"frame_ms_mean", mean_ms}, {"frame_ms_max", max_ms}, {"frames", frames},

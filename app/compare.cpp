@@ -137,6 +137,7 @@ std::vector<ElementFrame> vertexStageFrames(const Scene& scene, const RayScene& 
   for (int e : which) {
     VertexStageOptions o;
     o.channels = dispersionChannels(scene, e);
+    o.viewpoint.solver = scene.render.viewpoint_solver;
     o.viewer_clip = scene.observer.visibilityProjection() * scene.observer.view();  // as the renderer fits
     ElementFrame f = prepareElement(scene, e);
     traceVertexRays(rays, f, scene.observer.eye, o);
@@ -285,6 +286,7 @@ int cmdCompare(const std::vector<std::string>& argv) {
     std::printf("%-8s %8.2f ms  median %.4f' p95 %.4f' max %.3f'  PSNR %.2f dB (%.2f dB against 2x2)  (%zu px)\n",
                 m.c_str(), frame_ms, st.median_arcmin, st.p95_arcmin, st.max_arcmin, st.psnr_db,
                 jm[m]["psnr_supersampled_db"].get<double>(), st.pixels);
+    printQuality(f.elements, m + std::string(m.size() < 8 ? 8 - m.size() : 0, ' ') + " ");
     if (zs.pixels > 0)
       std::printf("%-8s zooming region: median %.4f' p95 %.4f' (%zu px); outside: median %.4f' (%zu px)\n", m.c_str(),
                   zs.median_arcmin, zs.p95_arcmin, zs.pixels, os.median_arcmin, os.pixels);

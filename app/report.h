@@ -45,6 +45,9 @@ RenderedFrame renderFrame(LoadedScene& ls, RenderMode mode, const std::string& g
 RenderedFrame timedFrame(LoadedScene& ls, RenderMode mode, const std::string& gl_backend_name, int frames,
                          double* median_ms);
 nlohmann::json elementsJson(const Scene& scene, const std::vector<ElementFrame>& frames);
+// One line per element of elementsJson whose quality verdict is not good ("PREFIX quality: NAME degraded:
+// ACTION; patch P: REASONS"), on stdout, so that a picture the mode cannot make right never passes silently.
+void printQuality(const nlohmann::json& elements, const std::string& prefix);
 // The stages of a frame: [{"name", "ms", "ran", "reason"[, "count"][, "note"]}].
 nlohmann::json stagesJson(const FrameStages& s);
 // Per-vertex data as VTK PolyData (.vtp) for ParaView: the grid of each element with point arrays.

@@ -26,6 +26,12 @@ bool sameChannels(const std::vector<ChannelSpec>& a, const std::vector<ChannelSp
   return true;
 }
 
+// A vertex drawn from its traced colour in this patch: a totally reflected lens ray always; any other traced
+// ray only in a patch drawn traced (a neighbouring patch that shares the vertex draws it from its map).
+bool usesTraced(const PatchView& pv, const VertexRay& r) {
+  return r.traced && (r.status == VertexStatus::Tir || pv.draw_traced);
+}
+
 }  // namespace
 
 PvrrPass::~PvrrPass() {
@@ -36,6 +42,9 @@ PvrrPass::~PvrrPass() {
 VertexStageOptions PvrrPass::optionsFor(size_t e) const {
   VertexStageOptions o = ctx.options.vertex;
   if (o.channels.empty()) o.channels = dispersionChannels(ctx.scene, int(e));
+  // The scene's choice, unless it leaves it to the renderer's options (auto).
+  if (ctx.scene.render.viewpoint_solver != ViewpointSolver::kAuto)
+    o.viewpoint.solver = ctx.scene.render.viewpoint_solver;
   // As seen from the eye: the tracer's whole budget (none for a lens drawn dark at the depth limit).
   o.tir_trace_depth = elementInterfaces(ctx.scene.elements[e]) > ctx.scene.render.max_depth ? 0 : ctx.scene.render.max_depth;
   return o;
@@ -114,11 +123,40 @@ bool PvrrPass::cpuStages(FrameStages& stages, FrameCache* cache) {
   }
   s.rays_ms = msSince(t0) - s.texcoord_ms;
   t0 = Clock::now();
-  for (size_t e = 0; e < n_el; ++e)
-    if (!reuse[e]) fitPatchViews(scene, frames[e], opts[e]);
+  for (size_t e = 0; e < n_el; ++e) {
+    if (!reuse[e]) {
+      fitPatchViews(scene, frames[e], opts[e]);
+      refineElement(e);
+    }
+    // Every frame, reused or not: what lies along the rays may have moved. A mirror's outgoing ray has
+    // spent one event of the budget; a lens's has spent its interfaces.
+    const int spent = scene.elements[e].type == ElementType::Lens ? elementInterfaces(scene.elements[e]) : 1;
+    applyTracedFallback(ctx.rays, frames[e], opts[e].tir_trace_depth - spent);
+  }
   s.fit_ms = msSince(t0);
   notePvrrCpuStages(stages, s, frames);
   return s.nothing_moved;
+}
+
+// Adaptive refinement (issue 26 item 2): an element whose triangles span too much curvature for their rays
+// to interpolate well is tessellated finer, traced and fitted again; the grid cache keeps the finer grid for
+// the following frames.
+void PvrrPass::refineElement(size_t e) {
+  ElementFrame& f = frames[e];
+  const Element& el = ctx.scene.elements[e];
+  if (opts[e].refine_max_vertices > 0) {
+    const std::array<int, 2> size = refinedGridSize(f, opts[e].refine_max_vertices);
+    if (size[0] != f.grid.grid_u || size[1] != f.grid.grid_v) {
+      ctx.grid_cache.refine(ctx.scene, int(e), size[0], size[1]);
+      f = prepareElement(ctx.scene, int(e), &ctx.grid_cache.get(ctx.scene, int(e)));
+      traceVertexRays(ctx.rays, f, ctx.scene.observer.eye, opts[e]);
+      fitPatchViews(ctx.scene, f, opts[e]);
+    }
+  }
+  if (ctx.grid_cache.refined(int(e))[0] > 0)
+    f.quality.action = "grid refined from " + std::to_string(el.tess_u) + "x" + std::to_string(el.tess_v) + " to " +
+                       std::to_string(f.grid.grid_u) + "x" + std::to_string(f.grid.grid_v) +
+                       " where its triangles spanned too much curvature; " + f.quality.action;
 }
 
 void PvrrPass::firstPass(FrameStages& stages, FrameCache* cache, bool skip_first_pass, bool continuing) {
@@ -227,7 +265,9 @@ void PvrrPass::uploadPatch(MeshBuffers& mb, const ElementFrame& f, const PatchVi
       data.insert(data.end(), {float(st.x * q), float(st.y * q), float(q)});
     }
     for (size_t j = 0; j < 3; ++j) {
-      const Vec3 w = weight[j] * f.rays[std::min(3 * set + j, channels - 1)][vi].transmittance;
+      // A patch drawn traced reads no map: its vertices' traced colours below are the whole picture.
+      const Vec3 w =
+          pv.draw_traced ? Vec3(0.0) : weight[j] * f.rays[std::min(3 * set + j, channels - 1)][vi].transmittance;
       data.insert(data.end(), {float(w.x), float(w.y), float(w.z)});
     }
     const Vec2 st = pv.st[seen_channel][k];
@@ -237,10 +277,10 @@ void PvrrPass::uploadPatch(MeshBuffers& mb, const ElementFrame& f, const PatchVi
     Vec3 traced(0.0);
     for (size_t j = 0; j < 3 && 3 * set + j < channels; ++j) {
       const VertexRay& r = f.rays[3 * set + j][vi];
-      if (r.traced) traced += weight[j] * r.traced_color;
+      if (usesTraced(pv, r)) traced += weight[j] * r.traced_color;
     }
     const VertexRay& seen_ray = f.rays[seen_channel][vi];
-    const bool seen_traced = set == 0 && seen_ray.traced;
+    const bool seen_traced = set == 0 && usesTraced(pv, seen_ray);
     const glm::vec3 ts = seen_traced ? glm::vec3(seen_ray.traced_seen - anchor) : glm::vec3(0.0f);
     data.insert(data.end(), {float(traced.x), float(traced.y), float(traced.z), seen_traced ? 1.0f : 0.0f, ts.x, ts.y, ts.z});
   }

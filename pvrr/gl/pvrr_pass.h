@@ -30,6 +30,7 @@ class PvrrPass : public ModePass {
   // The CPU stages of the frame into `frames` and `opts`; returns whether nothing moved since the cached
   // frame (its first pass is then kept).
   bool cpuStages(FrameStages& stages, FrameCache* cache);
+  void refineElement(size_t e);
   // The first pass and the nested passes, or why not (map reuse, the eye-fixed cache). skip_first_pass: nothing
   // moved since the cached frame; continuing: a cache that holds an earlier frame (maps are widened for reuse).
   void firstPass(FrameStages& stages, FrameCache* cache, bool skip_first_pass, bool continuing);

@@ -78,10 +78,11 @@ double msSince(std::chrono::steady_clock::time_point t0) {
 }  // namespace
 
 namespace {
-cad::Tessellation tessellateElement(const Element& el) {
-  return cad::tessellateGrid(el.frontSurface(), el.tess_u, el.tess_v, el.has_outline ? &el.outline : nullptr,
+cad::Tessellation tessellateElement(const Element& el, int tess_u, int tess_v) {
+  return cad::tessellateGrid(el.frontSurface(), tess_u, tess_v, el.has_outline ? &el.outline : nullptr,
                              cad::TessellationOptions{true});
 }
+cad::Tessellation tessellateElement(const Element& el) { return tessellateElement(el, el.tess_u, el.tess_v); }
 
 }  // namespace
 
@@ -95,10 +96,19 @@ const cad::Tessellation& ElementGridCache::get(const Scene& scene, int element) 
     e.grid = tessellateElement(el);
     e.surface = surface;
     e.tess_u = el.tess_u, e.tess_v = el.tess_v;
+    e.refined_u = e.refined_v = 0;
     e.has_outline = el.has_outline;
     e.outline = el.outline;
   }
   return e.grid;
+}
+
+void ElementGridCache::refine(const Scene& scene, int element, int tess_u, int tess_v) {
+  get(scene, element);  // the entry is current
+  Entry& e = entries_[size_t(element)];
+  if (tess_u == e.grid.grid_u && tess_v == e.grid.grid_v) return;
+  e.grid = tessellateElement(scene.elements[size_t(element)], tess_u, tess_v);
+  e.refined_u = tess_u, e.refined_v = tess_v;
 }
 
 ElementFrame prepareElement(const Scene& scene, int element, const cad::Tessellation* grid) {
@@ -449,12 +459,13 @@ void fitPatchViews(const Scene& scene, ElementFrame& f, const VertexStageOptions
   const double max_fov = opt.max_patch_fov_rad > 0 ? opt.max_patch_fov_rad : el.max_patch_fov_rad;
   int pu = el.patches_u, pv = el.patches_v;
   f.split_note.clear();
+  f.split_exhausted = false;
   for (int round = 0;; ++round) {
     f.grid_patches = cad::splitGrid(f.grid, pu, pv);
     f.views.clear();
     f.views.resize(f.grid_patches.size());
     for (size_t p = 0; p < f.grid_patches.size(); ++p) fitOnePatch(scene, f, p, el, f.views[p], opt.viewpoint, clip);
-    if (max_fov <= 0 || round >= opt.max_patch_splits) break;
+    if (max_fov <= 0) break;
     double worst_x = 0, worst_y = 0;
     for (const PatchView& v : f.views) {
       if (!v.in_view) continue;  // not drawn: its field of view does not matter
@@ -462,6 +473,10 @@ void fitPatchViews(const Scene& scene, ElementFrame& f, const VertexStageOptions
       worst_y = std::max(worst_y, v.volume.fov_y_rad);
     }
     if (std::max(worst_x, worst_y) <= max_fov) break;
+    if (round >= opt.max_patch_splits) {
+      f.split_exhausted = true;
+      break;
+    }
     // Split along the grid directions whose patches still have room: every patch keeps at least
     // kMinPatchQuads quads a side (a patch of one or two quads fits its viewpoint to a handful of rays and
     // costs a first pass of its own).
@@ -469,7 +484,9 @@ void fitPatchViews(const Scene& scene, ElementFrame& f, const VertexStageOptions
               max_v = std::max(pv, (f.grid.grid_v - 1) / kMinPatchQuads);
     const int next_u = std::min(pu * 2, max_u), next_v = std::min(pv * 2, max_v);
     if (next_u == pu && next_v == pv) {
-      f.split_note = "patch field of view still above the threshold at the finest split the grid allows";
+      f.split_note = "patch field of view still above " + std::to_string(int(std::lround(degrees(max_fov)))) +
+                     " deg at the finest split the grid allows (" + std::to_string(pu) + "x" + std::to_string(pv) + ")";
+      f.split_exhausted = true;
       break;
     }
     f.split_note = "split to " + std::to_string(next_u) + "x" + std::to_string(next_v) +
@@ -479,6 +496,7 @@ void fitPatchViews(const Scene& scene, ElementFrame& f, const VertexStageOptions
   }
   f.patches_u = pu;
   f.patches_v = pv;
+  assessFrameQuality(f);
   f.fit_ms = msSince(t0);
 }
 

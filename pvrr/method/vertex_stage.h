@@ -3,6 +3,7 @@
 // ("viewpoint-fit"), and each vertex's texture coordinates: the projection of its exact hit point through
 // that patch's virtual camera.
 #pragma once
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -10,8 +11,10 @@
 #include "cad/tessellate.h"
 #include "pvrr/base/names.h"
 #include "pvrr/trace/ray_scene.h"
+#include "pvrr/method/frame_quality.h"
 #include "pvrr/method/view_volume.h"
 #include "pvrr/method/viewpoint.h"
+#include "pvrr/trace/ray_scene.h"
 
 namespace pvrr {
 
@@ -65,6 +68,9 @@ struct PatchView {
   };
   std::vector<ViewEdgeSample> view_edge;
   bool in_view = true;    // false: the viewer sees none of the patch (its map need not be rendered)
+  PatchQuality quality;   // assessFrameQuality's verdict on this patch's map
+  // Drawn from its vertices' traced colours (VertexRay::traced, applyTracedFallback) instead of its map.
+  bool draw_traced = false;
 };
 
 // One colour channel (wavelength sample) of the vertex stages. The second pass sums the channels' warped
@@ -109,6 +115,9 @@ struct VertexStageOptions {
     return o;
   }();
   double max_patch_fov_rad = 0;  // overrides the element's when > 0
+  // Adaptive refinement (refinedGridSize, applied by the renderer): the most vertices a refined grid may
+  // have; 0: none. 4096 holds the 63 x 63 grid at which the 50 mm toric mirror renders within 0.8' median.
+  int refine_max_vertices = 4096;
   int max_patch_splits = 4;      // doublings per direction for the automatic split
   // World -> clip of the camera that draws the element (the observer's, or the map camera of the element
   // that shows it). When set, each patch's view volume holds only what that camera sees (ElementFrame::
@@ -143,6 +152,8 @@ struct ElementFrame {
   int rays_beside = 0;  // rays traced beside their own mirror (VertexStageOptions::beside_own_mirror), all channels
   int patches_u = 1, patches_v = 1;
   std::string split_note;                    // why patches were split, if they were
+  bool split_exhausted = false;              // the field-of-view split stopped at the finest split the grid allows
+  ElementQuality quality;                    // assessFrameQuality's verdict (set by fitPatchViews)
   // Per vertex: non-zero when a triangle holding it can be seen by VertexStageOptions::viewer_clip (empty:
   // all vertices, no viewer given): 2 inside the viewer's clip volume, 1 outside it (a corner of a triangle
   // seen in part). Vertices of triangles the viewer cannot see get texture coordinates too, but they shape
@@ -160,12 +171,22 @@ ElementFrame prepareElement(const Scene& scene, int element, const cad::Tessella
 // 1.5 ms), which a rigid element needs once, whatever its pose.
 class ElementGridCache {
  public:
+  // The element's tessellation: its own grid, or the one refine() chose, kept until the element's surface,
+  // grid size or outline changes.
   const cad::Tessellation& get(const Scene& scene, int element);
+  // Tessellates the element at tess_u x tess_v from now on (adaptive refinement, refinedGridSize).
+  void refine(const Scene& scene, int element, int tess_u, int tess_v);
+  // The grid size refine() set and get() still returns; {0, 0} when none.
+  std::array<int, 2> refined(int element) const {
+    if (size_t(element) >= entries_.size()) return {0, 0};
+    return {entries_[size_t(element)].refined_u, entries_[size_t(element)].refined_v};
+  }
 
  private:
   struct Entry {
     cad::SurfacePtr surface;  // held, so that a new surface can never reuse a dropped one's address
-    int tess_u = 0, tess_v = 0;
+    int tess_u = 0, tess_v = 0;        // the element's own grid size (the key)
+    int refined_u = 0, refined_v = 0;  // the refined grid's size; 0: not refined
     bool has_outline = false;
     cad::Outline outline;
     cad::Tessellation grid;

@@ -54,6 +54,7 @@
 #include <string>
 #include <vector>
 
+#include "pvrr/scene/render_desc.h"
 #include "pvrr/base/math.h"
 
 namespace pvrr {
@@ -65,12 +66,7 @@ struct ViewpointRay {
   Vec3 hit;        // origin + t * direction, t > 0: the first scene hit, or a far point for escaping rays
 };
 
-enum class ViewpointSolver {
-  kAuto,         // closed form + own Gauss-Newton; Ceres when the quick solve fails a check (default)
-  kGaussNewton,  // closed form + own Gauss-Newton only
-  kCeres,        // closed form + Ceres (autodiff, DENSE_QR)
-  kClosedForm,   // closed form (least-squares line distance) only, no angular refinement
-};
+// ViewpointSolver: the scene's render.viewpoint_solver (pvrr/scene/render_desc.h, with its name table).
 
 struct ViewpointOptions {
   // Cauchy loss scale of the angular residual (rad); <= 0 disables the robust loss (plain least squares on

@@ -34,6 +34,17 @@ inline constexpr NameTable<DispersionMode, 3> kDispersionModeNames = {
 constexpr const NameTable<DispersionMode, 3>& nameTable(DispersionMode) { return kDispersionModeNames; }
 static_assert(namesAreUnique(kDispersionModeNames));
 
+// How each patch's virtual viewpoint is fitted (pvrr/method/viewpoint.h): auto: closed form + own Gauss-Newton,
+// Ceres when the quick solve fails a check (the default); gauss-newton: closed form + own Gauss-Newton only;
+// ceres: closed form + Ceres (autodiff, DENSE_QR); closed-form: the least-squares line distance only.
+enum class ViewpointSolver { kAuto, kGaussNewton, kCeres, kClosedForm };
+inline constexpr NameTable<ViewpointSolver, 4> kViewpointSolverNames = {{{ViewpointSolver::kAuto, "auto"},
+                                                                        {ViewpointSolver::kGaussNewton, "gauss-newton"},
+                                                                        {ViewpointSolver::kCeres, "ceres"},
+                                                                        {ViewpointSolver::kClosedForm, "closed-form"}}};
+constexpr const NameTable<ViewpointSolver, 4>& nameTable(ViewpointSolver) { return kViewpointSolverNames; }
+static_assert(namesAreUnique(kViewpointSolverNames));
+
 // The settings of the "render" section with their defaults: the defaults of the scene format.
 struct RenderDesc {
   RenderMode mode = RenderMode::Pvrr;
@@ -49,6 +60,7 @@ struct RenderDesc {
   DispersionMode dispersion = DispersionMode::Off;
   int spectral_samples = 16;
   Vec3 background{0.55, 0.7, 0.9};  // linear RGB of escaping rays (the sky)
+  ViewpointSolver viewpoint_solver = ViewpointSolver::kAuto;
 };
 
 }  // namespace pvrr

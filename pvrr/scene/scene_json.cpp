@@ -904,7 +904,7 @@ ElementDesc readElement(const Ctx& c, const json* j, const std::string& path, si
     e.patches_u = (*p)[0].get<int>();
     e.patches_v = (*p)[1].get<int>();
   }
-  e.max_patch_fov_deg = o.number("max_patch_fov_deg", open(0, 180), 0.0, "an angle (degrees)");
+  e.max_patch_fov_deg = o.number("max_patch_fov_deg", open(0, 180), kDefaultMaxPatchFovDeg, "an angle (degrees)");
   return e;
 }
 
@@ -915,7 +915,7 @@ RenderDesc readRender(const Ctx& c, const json* j, const std::string& source) {
   Obj o(c, j, "render", "an object {\"mode\", \"map_size\", \"output\", ...}",
         {"mode", "map_size", "map_texels_per_pixel", "map_reuse_margin_deg", "impostor_iterations", "impostor_layers", "output",
          "max_depth", "dispersion", "spectral_samples",
-         "background"});
+         "background", "viewpoint_solver"});
   r.mode = o.choice<RenderMode>("mode", r.mode);
   r.map_size = o.integer("map_size", 16, kMaxImageSize, r.map_size);
   r.map_texels_per_pixel = o.number("map_texels_per_pixel", closed(0, 1e4), r.map_texels_per_pixel);
@@ -930,6 +930,7 @@ RenderDesc readRender(const Ctx& c, const json* j, const std::string& source) {
   r.dispersion = o.choice<DispersionMode>("dispersion", r.dispersion);
   r.spectral_samples = o.integer("spectral_samples", 3, 256, r.spectral_samples);
   r.background = o.vec3("background", VecKind::ColourNonNegative, r.background);
+  r.viewpoint_solver = o.choice<ViewpointSolver>("viewpoint_solver", r.viewpoint_solver);
   return r;
 }
 
