@@ -1160,16 +1160,6 @@ int editDistance(const std::string& a, const std::string& b) {
   return d[n][m];
 }
 
-SceneDesc parseScene(const std::string& json_text, const std::string& name_for_messages, const std::string& base_dir,
-                     const std::vector<std::string>& set_overrides) {
-  Ctx c;
-  c.file = name_for_messages;
-  c.base_dir = base_dir;
-  json doc = parseJson(json_text, name_for_messages);
-  for (const std::string& o : set_overrides) c.overrides.push_back(applyOverride(doc, o, name_for_messages));
-  return readScene(c, doc);
-}
-
 // The byte offset of the first byte that is not part of a well-formed UTF-8 sequence (RFC 3629: no overlong
 // forms, no surrogates, nothing above U+10FFFF), or npos when the whole text is UTF-8.
 static size_t firstInvalidUtf8(const std::string& text) {
@@ -1199,6 +1189,31 @@ static size_t firstInvalidUtf8(const std::string& text) {
   return std::string::npos;
 }
 
+SceneDesc parseScene(const std::string& json_text, const std::string& name_for_messages, const std::string& base_dir,
+                     const std::vector<std::string>& set_overrides) {
+  // UTF-8 first: the JSON parser's own message would quote the bad byte, and a --set value that is not UTF-8
+  // was kept as a string that the JSON library cannot print (found by tests/fuzz/scene_fuzz.cpp).
+  if (const size_t bad = firstInvalidUtf8(json_text); bad != std::string::npos) {
+    const size_t line = size_t(std::count(json_text.begin(), json_text.begin() + std::ptrdiff_t(bad), '\n')) + 1;
+    throw Error(name_for_messages + ": byte " + std::to_string(bad) + " (line " + std::to_string(line) +
+                "): not valid UTF-8; a scene file is UTF-8 text");
+  }
+  for (const std::string& o : set_overrides)
+    if (const size_t bad = firstInvalidUtf8(o); bad != std::string::npos) {
+      std::string shown = o;
+      for (char& ch : shown)
+        if (static_cast<unsigned char>(ch) >= 0x80 || static_cast<unsigned char>(ch) < 0x20) ch = '?';
+      throw Error(name_for_messages + ": --set " + shown + ": byte " + std::to_string(bad) +
+                  " is not valid UTF-8 (non-ASCII bytes shown as ?)");
+    }
+  Ctx c;
+  c.file = name_for_messages;
+  c.base_dir = base_dir;
+  json doc = parseJson(json_text, name_for_messages);
+  for (const std::string& o : set_overrides) c.overrides.push_back(applyOverride(doc, o, name_for_messages));
+  return readScene(c, doc);
+}
+
 SceneDesc loadScene(const std::string& path, const std::vector<std::string>& set_overrides) {
   std::error_code ec;
   if (fs::is_directory(path, ec)) throw Error(path + ": is a directory, expected a scene file (.json)");
@@ -1207,14 +1222,8 @@ SceneDesc loadScene(const std::string& path, const std::vector<std::string>& set
   std::ostringstream ss;
   ss << in.rdbuf();
   if (in.bad()) throw Error(path + ": cannot read the scene file");
-  const std::string text = ss.str();
-  if (const size_t bad = firstInvalidUtf8(text); bad != std::string::npos) {
-    const size_t line = size_t(std::count(text.begin(), text.begin() + std::ptrdiff_t(bad), '\n')) + 1;
-    throw Error(path + ": byte " + std::to_string(bad) + " (line " + std::to_string(line) +
-                "): not valid UTF-8; a scene file is UTF-8 text");
-  }
   const std::string dir = fs::path(path).parent_path().string();
-  return parseScene(text, path, dir, set_overrides);
+  return parseScene(ss.str(), path, dir, set_overrides);  // checks UTF-8 first
 }
 
 const char* toString(TextureDesc::Kind k) {

@@ -142,6 +142,14 @@ TEST_F(InputCli, SceneInUtf16IsRefusedAtByteZero) {
   expectRefusal(render(scene), {"utf16.json: byte 0 (line 1): not valid UTF-8"});
 }
 
+TEST_F(InputCli, SetValueThatIsNotUtf8IsRefused) {
+  // Found by tests/fuzz/scene_fuzz.cpp: the value was kept as a string the JSON library could not print, an
+  // internal error (exit code 2).
+  write("ok.obj", std::string(kTriangle) + "f 1 2 3\n");
+  const CliResult r = pvrr::test::runPvrr("render '" + sceneWithMesh("ok.obj") + "' --set 'description=caf\xe9' --out '" + out() + "'");
+  expectRefusal(r, {"scene.json: --set description=caf?: byte 15 is not valid UTF-8"});
+}
+
 TEST_F(InputCli, EyeOnTheMirrorSurfaceIsExplained) {
   // Before: "fitViewpoint: ray 12: expected a finite origin ...", naming neither the scene nor the cause.
   const std::string scene = write("eye-on-mirror.json", R"({
