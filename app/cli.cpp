@@ -1,6 +1,7 @@
 #include "app/cli.h"
 
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <map>
 #include <string>
@@ -115,6 +116,10 @@ int runMain(int argc, char** argv) {
       throw Error("pvrr: unknown command \"" + args[0] + "\"" + (hint.empty() ? "" : "; did you mean \"" + hint + "\"?") +
                   " (see: pvrr help)");
     }
+    // Test-only hook (tests/app/input_cli_test.cpp): exercises the internal-error path (exit code 2), which no
+    // valid or invalid input should reach. The variable's name says what it is for.
+    if (const char* hook = std::getenv("PVRR_TEST_ONLY_FORCE_INTERNAL_ERROR"); hook && std::string(hook) == "1")
+      PVRR_CHECK(false, << "(forced by PVRR_TEST_ONLY_FORCE_INTERNAL_ERROR=1 before running \"" << args[0] << "\")");
     // Every file the command writes appears when it succeeds, none when it fails at any point.
     OutputTransaction outputs;
     const int rc = it->second.run(std::vector<std::string>(args.begin() + 1, args.end()));
@@ -125,6 +130,9 @@ int runMain(int argc, char** argv) {
     return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "pvrr: internal error: %s\n", e.what());
+    return 2;
+  } catch (...) {
+    std::fprintf(stderr, "pvrr: internal error: an exception of unknown type\n");
     return 2;
   }
 }

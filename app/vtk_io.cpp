@@ -5,6 +5,8 @@
 #include <vtkIntArray.h>
 #include <vtkNew.h>
 #include <vtkOBJReader.h>
+#include <vtkObjectFactory.h>
+#include <vtkOutputWindow.h>
 #include <vtkPLYReader.h>
 #include <vtkPLYWriter.h>
 #include <vtkPointData.h>
@@ -18,6 +20,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "app/mesh_check.h"
 #include "app/report.h"
 #include "pvrr/base/error.h"
 
@@ -65,11 +68,66 @@ void writeAtomicWith(Writer* w, const std::string& path) {
   });
 }
 
+// Collects what VTK would print (its errors and warnings go to a global output window, stderr by default)
+// while an instance is alive, so that a reader's failure becomes one pvrr::Error instead of VTK's log lines.
+class CapturedVtkOutput : public vtkOutputWindow {
+ public:
+  static CapturedVtkOutput* New();
+  vtkTypeMacro(CapturedVtkOutput, vtkOutputWindow);
+  void DisplayText(const char* t) override { text += t ? t : ""; }
+  void DisplayErrorText(const char* t) override { DisplayText(t); }
+  void DisplayWarningText(const char* t) override { DisplayText(t); }
+  void DisplayGenericWarningText(const char* t) override { DisplayText(t); }
+  void DisplayDebugText(const char* t) override { DisplayText(t); }
+  std::string text;
+};
+vtkStandardNewMacro(CapturedVtkOutput);
+
+class ScopedVtkCapture {
+ public:
+  ScopedVtkCapture() : previous_(vtkOutputWindow::GetInstance()) {
+    vtkOutputWindow::SetInstance(window_);
+  }
+  ~ScopedVtkCapture() { vtkOutputWindow::SetInstance(previous_); }
+  ScopedVtkCapture(const ScopedVtkCapture&) = delete;
+  ScopedVtkCapture& operator=(const ScopedVtkCapture&) = delete;
+  // The last line of VTK's last message (the reason, without VTK's source file and object address).
+  std::string reason() const {
+    std::string t = window_->text;
+    while (!t.empty() && (t.back() == '\n' || t.back() == ' ')) t.pop_back();
+    const size_t nl = t.rfind('\n');
+    if (nl != std::string::npos) t = t.substr(nl + 1);
+    const size_t obj = t.find("): ");
+    if (obj != std::string::npos) t = t.substr(obj + 3);
+    return t;
+  }
+  bool any() const { return !window_->text.empty(); }
+
+ private:
+  vtkSmartPointer<vtkOutputWindow> previous_;
+  vtkNew<CapturedVtkOutput> window_;
+};
+
+std::string readWholeFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path + ": cannot open the mesh file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw Error(path + ": cannot read the mesh file");
+  return ss.str();
+}
+
 }  // namespace
 
 MeshData readMeshFile(const std::string& path) {
-  if (!fs::exists(path)) throw Error(path + ": no such file");
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw Error(path + ": no such file");
+  if (fs::is_directory(path, ec)) throw Error(path + ": is a directory, expected an .obj or .ply mesh");
   const std::string ext = lowerExtension(path);
+  // Our own checks first: VTK's readers accept bad indices and nan, and crash on some malformed PLY files.
+  if (ext == ".obj") checkObjText(readWholeFile(path), path);
+  else if (ext == ".ply") checkPlyData(readWholeFile(path), path);
+  ScopedVtkCapture vtk_output;
   vtkSmartPointer<vtkPolyData> pd;
   if (ext == ".obj") {
     vtkNew<vtkOBJReader> r;
@@ -83,6 +141,19 @@ MeshData readMeshFile(const std::string& path) {
     pd = r->GetOutput();
   } else {
     throw Error(path + ": expected an .obj or .ply mesh");
+  }
+  if (!pd || pd->GetNumberOfPoints() == 0 || pd->GetNumberOfPolys() == 0)
+    throw Error(path + ": no triangles could be read" + (vtk_output.any() ? " (VTK: " + vtk_output.reason() + ")" : ""));
+  // Defence behind the checks above: every face of what VTK read refers to one of its points.
+  {
+    vtkCellArray* faces = pd->GetPolys();
+    faces->InitTraversal();
+    vtkNew<vtkIdList> ids;
+    for (vtkIdType f = 0; faces->GetNextCell(ids); ++f)
+      for (vtkIdType k = 0; k < ids->GetNumberOfIds(); ++k)
+        if (ids->GetId(k) < 0 || ids->GetId(k) >= pd->GetNumberOfPoints())
+          throw Error(path + ": face " + std::to_string(f) + ": vertex index " + std::to_string(ids->GetId(k)) +
+                      " is out of range (the file has " + std::to_string(pd->GetNumberOfPoints()) + " vertices)");
   }
   vtkNew<vtkTriangleFilter> tri;
   tri->SetInputData(pd);

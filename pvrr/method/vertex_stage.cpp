@@ -157,6 +157,14 @@ static void traceVertexRaysFrom(const RayScene& rays, ElementFrame& f, const Vec
     clearance = rays.tangentClearance(f.element, f.grid.positions, f.grid.normals);
     if (clearance->ahead.size() != f.world_pos.size()) clearance.reset();  // a mirror without candidates
   }
+  // An eye exactly on a vertex of the element has no ray to it: say so in the scene's terms (otherwise the
+  // fit later stops on a zero direction). An eye on the surface between vertices renders.
+  if (!origins)
+    for (size_t i = 0; i < f.world_pos.size(); ++i)
+      if (!isFinite(glm::normalize(f.world_pos[i] - eye)))
+        throw Error(scene.source_path + ": observer.eye lies on the surface of elements[" + std::to_string(f.element) +
+                    "] (" + el.name + ") (at its vertex " + std::to_string(i) +
+                    "), so no ray from the eye reaches it; move the eye off the surface");
   std::vector<char> beside(opt.channels.size() * f.world_pos.size(), 0);  // counted after the loops
   for (size_t c = 0; c < opt.channels.size(); ++c) {
     const double wl = opt.channels[c].wavelength_nm > 0 ? opt.channels[c].wavelength_nm : kLineD_nm;

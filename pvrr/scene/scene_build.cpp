@@ -193,8 +193,23 @@ Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
         break;
       case EnvObjectDesc::Type::Mesh: {
         if (!load_mesh) throw Error(what + ": no mesh reader is available in this program");
-        MeshData md = load_mesh(o.file);
+        MeshData md;
+        try {
+          md = load_mesh(o.file);
+        } catch (const Error& e) {
+          throw Error(what + ": " + e.what());  // the reader names the file and the place in it
+        }
         if (md.positions.empty() || md.triangles.empty()) throw Error(what + ": " + o.file + " holds no triangles");
+        // The loader is a callback: what it returns is checked before anything indexes with it.
+        for (size_t v = 0; v < md.positions.size(); ++v)
+          if (!isFinite(md.positions[v]))
+            throw Error(what + ": " + o.file + ": vertex " + std::to_string(v) + " is not finite");
+        for (size_t t = 0; t < md.triangles.size(); ++t)
+          for (int k = 0; k < 3; ++k)
+            if (md.triangles[t][k] >= md.positions.size())
+              throw Error(what + ": " + o.file + ": triangle " + std::to_string(t) + ": vertex index " +
+                          std::to_string(md.triangles[t][k]) + " is out of range (the mesh has " +
+                          std::to_string(md.positions.size()) + " vertices)");
         mesh.anchor = o.position;
         for (size_t v = 0; v < md.positions.size(); ++v) {
           const Vec3 p = o.rotation * (o.scale * md.positions[v]);

@@ -1179,8 +1179,52 @@ int editDistance(const std::string& a, const std::string& b) {
   return d[n][m];
 }
 
+// The byte offset of the first byte that is not part of a well-formed UTF-8 sequence (RFC 3629: no overlong
+// forms, no surrogates, nothing above U+10FFFF), or npos when the whole text is UTF-8.
+static size_t firstInvalidUtf8(const std::string& text) {
+  const auto* b = reinterpret_cast<const unsigned char*>(text.data());
+  const size_t n = text.size();
+  size_t i = 0;
+  while (i < n) {
+    const unsigned char c = b[i];
+    size_t len = 0;
+    unsigned char lo = 0x80, hi = 0xBF;  // the allowed range of the second byte
+    if (c < 0x80) len = 1;
+    else if (c >= 0xC2 && c <= 0xDF) len = 2;
+    else if (c == 0xE0) len = 3, lo = 0xA0;
+    else if ((c >= 0xE1 && c <= 0xEC) || c == 0xEE || c == 0xEF) len = 3;
+    else if (c == 0xED) len = 3, hi = 0x9F;
+    else if (c == 0xF0) len = 4, lo = 0x90;
+    else if (c >= 0xF1 && c <= 0xF3) len = 4;
+    else if (c == 0xF4) len = 4, hi = 0x8F;
+    else return i;
+    if (len > 1) {
+      if (i + 1 >= n || b[i + 1] < lo || b[i + 1] > hi) return i;
+      for (size_t k = 2; k < len; ++k)
+        if (i + k >= n || b[i + k] < 0x80 || b[i + k] > 0xBF) return i;
+    }
+    i += len;
+  }
+  return std::string::npos;
+}
+
 SceneDesc parseScene(const std::string& json_text, const std::string& name_for_messages, const std::string& base_dir,
                      const std::vector<std::string>& set_overrides) {
+  // UTF-8 first: the JSON parser's own message would quote the bad byte, and a --set value that is not UTF-8
+  // was kept as a string that the JSON library cannot print (found by tests/fuzz/scene_fuzz.cpp).
+  if (const size_t bad = firstInvalidUtf8(json_text); bad != std::string::npos) {
+    const size_t line = size_t(std::count(json_text.begin(), json_text.begin() + std::ptrdiff_t(bad), '\n')) + 1;
+    throw Error(name_for_messages + ": byte " + std::to_string(bad) + " (line " + std::to_string(line) +
+                "): not valid UTF-8; a scene file is UTF-8 text");
+  }
+  for (const std::string& o : set_overrides)
+    if (const size_t bad = firstInvalidUtf8(o); bad != std::string::npos) {
+      std::string shown = o;
+      for (char& ch : shown)
+        if (static_cast<unsigned char>(ch) >= 0x80 || static_cast<unsigned char>(ch) < 0x20) ch = '?';
+      throw Error(name_for_messages + ": --set " + shown + ": byte " + std::to_string(bad) +
+                  " is not valid UTF-8 (non-ASCII bytes shown as ?)");
+    }
   Ctx c;
   c.file = name_for_messages;
   c.base_dir = base_dir;
@@ -1190,13 +1234,15 @@ SceneDesc parseScene(const std::string& json_text, const std::string& name_for_m
 }
 
 SceneDesc loadScene(const std::string& path, const std::vector<std::string>& set_overrides) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw Error(path + ": is a directory, expected a scene file (.json)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path + ": cannot open the scene file");
   std::ostringstream ss;
   ss << in.rdbuf();
   if (in.bad()) throw Error(path + ": cannot read the scene file");
   const std::string dir = fs::path(path).parent_path().string();
-  return parseScene(ss.str(), path, dir, set_overrides);
+  return parseScene(ss.str(), path, dir, set_overrides);  // checks UTF-8 first
 }
 
 }  // namespace pvrr
