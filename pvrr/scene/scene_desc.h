@@ -252,6 +252,8 @@ struct VehicleDesc {
   // stopped first by one of them is obstructed. Rays stopped by the other environment objects (a following
   // car, a building) are followed on to the road.
   std::vector<std::string> obstructions;
+  // The regulations pvrr fov checks by default (ids of models/regulations/*.json).
+  std::vector<std::string> regulations;
 };
 inline constexpr NameTable<VehicleDesc::Side, 2> kVehicleSideNames = {
     {{VehicleDesc::Side::Left, "left"}, {VehicleDesc::Side::Right, "right"}}};

@@ -938,8 +938,8 @@ RenderDesc readRender(const Ctx& c, const json* j, const std::string& source) {
 VehicleDesc readVehicle(const Ctx& c, const json* j, const std::vector<EnvObjectDesc>& environment) {
   Obj o(c, j, "vehicle",
         "an object {\"forward\", \"up\", \"road_height\", \"outermost\", \"ocular_points\", \"driver_side\", "
-        "\"obstructions\"}",
-        {"forward", "up", "road_height", "outermost", "ocular_points", "driver_side", "obstructions"});
+        "\"obstructions\", \"regulations\"}",
+        {"forward", "up", "road_height", "outermost", "ocular_points", "driver_side", "obstructions", "regulations"});
   VehicleDesc v;
   v.up = o.vec3("up", VecKind::Direction);
   v.forward = o.vec3("forward", VecKind::Direction);
@@ -976,6 +976,12 @@ VehicleDesc readVehicle(const Ctx& c, const json* j, const std::vector<EnvObject
     for (const EnvObjectDesc& e : environment)
       if (e.type != EnvObjectDesc::Type::Ground) v.obstructions.push_back(e.name);
   }
+  if (const json* regs = arrayAt(c, o.get("regulations"), o.at("regulations"), "an array of regulation ids"))
+    for (size_t i = 0; i < regs->size(); ++i) {
+      if (!(*regs)[i].is_string() || (*regs)[i].get<std::string>().empty())
+        c.expected(indexPath(o.at("regulations"), i), "a regulation id (a string)", &(*regs)[i]);
+      v.regulations.push_back((*regs)[i].get<std::string>());
+    }
   return v;
 }
 

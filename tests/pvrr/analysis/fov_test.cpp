@@ -91,6 +91,15 @@ std::optional<Vec2> roadPoint(const VehicleFrame& frame, const Vec3& a, const Ve
   return Vec2(v.x, v.y);
 }
 
+// The other way round: the largest distance from a reference point within kCheckRadius_m to the footprint's
+// outline (so that the footprint runs along the whole reference, not only along a part of it).
+double worstReferenceError(const EyeFootprint& f, const std::vector<Vec2>& reference) {
+  double worst = 0;
+  for (const Vec2& p : reference)
+    if (glm::length(p) <= kCheckRadius_m) worst = std::max(worst, polylineDistance(p, f.outline));
+  return worst;
+}
+
 TEST(Fov, VehicleFrameAxes) {
   Fixture fx(sceneJson(R"({"type": "plane"})"));
   const VehicleFrame fr = fx.frame();
@@ -126,6 +135,7 @@ TEST(Fov, PlaneMirrorMatchesClosedForm) {
                 kCheckRadius_m, worst);
     EXPECT_GT(checked, 50);
     EXPECT_LT(worst, kPlaneTol_m);
+    EXPECT_LT(worstReferenceError(f, reference), kPlaneTol_m);
     EXPECT_EQ(f.count(RayFate::Obstructed), 0);
     EXPECT_EQ(f.count(RayFate::Back), 0);
   }
@@ -165,6 +175,9 @@ TEST(Fov, SphericalMirrorMatchesIndependentSampling) {
                 kCheckRadius_m, worst);
     EXPECT_GT(checked, 50);
     EXPECT_LT(worst, kSphereTol_m);
+    const double back = worstReferenceError(f, reference);
+    std::printf("  reference to footprint outline: worst %.3g m\n", back);
+    EXPECT_LT(back, kSphereTol_m);
   }
 }
 
