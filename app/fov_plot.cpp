@@ -153,8 +153,9 @@ std::vector<std::string> writeFovPlot(const std::string& dir, const std::string&
     for (const Vec2& m : z.result->missed) {
       const Vec2 p = a.px(m);
       if (p.x < a.left || p.x > x1 || p.y < a.top || p.y > y1) continue;
-      k.lines.push_back({{p - Vec2(2.5, 2.5), p + Vec2(2.5, 2.5)}, kFail, 1.5});
-      k.lines.push_back({{p + Vec2(-2.5, 2.5), p + Vec2(2.5, -2.5)}, kFail, 1.5});
+      k.polys.push_back({{p + Vec2(-1.2, -1.2), p + Vec2(1.2, -1.2), p + Vec2(1.2, 1.2), p + Vec2(-1.2, 1.2)},
+                         {0.6, 0.05, 0.05},
+                         1});
     }
 
   // Legend and the figures per zone.
@@ -167,7 +168,7 @@ std::vector<std::string> writeFovPlot(const std::string& dir, const std::string&
     ly += 18;
   }
   k.polys.push_back({{Vec2(a.left, ly - 12), Vec2(a.left + 30, ly - 12), Vec2(a.left + 30, ly), Vec2(a.left, ly)}, kObstructed, 0.35});
-  k.texts.push_back({a.left + 38, ly, "obstructed (vehicle.obstructions)      x: zone point not seen", 12, 0, kBlack});
+  k.texts.push_back({a.left + 38, ly, "obstructed (vehicle.obstructions)      dots: zone points not seen clearly", 12, 0, kBlack});
   ly += 22;
   for (const FovPlotZone& z : zones) {
     const Rgb c = z.result->pass ? kPass : kFail;
