@@ -87,7 +87,8 @@ const std::map<std::string, Command>& commands() {
         "  the mirror, reflected exactly and continued to the road; the footprint per eye and the share of each\n"
         "  regulation zone (models/regulations/ID.json; default: vehicle.regulations) covered and obstructed.\n"
         "  Writes DIR/fov.json (element, eyes, footprint polygons in the vehicle frame, zones with\n"
-        "  covered_fraction, obstructed_fraction, pass, verified) and the plan view DIR/fov.png and .svg.\n"
+        "  covered_fraction, obstructed_fraction, pass, verified; surface: mean and principal radii, magnification\n"
+        "  range), the plan view DIR/fov.png and .svg, and the magnification map DIR/magnification.png and .svg.\n"
         "  Conventions: docs/fov.md."}},
       {"mesh",
        {cmdMesh, "tessellate a surface and write it as OBJ, PLY or VTP",

@@ -1,5 +1,6 @@
 // pvrr fov: a mirror's field of view on the road, checked against regulation zones (issue 21; the computation
 // and its conventions: pvrr/analysis/fov.h; the zones: models/regulations/*.json, docs/fov.md).
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -21,6 +22,12 @@ using nlohmann::json;
 namespace pvrr::app {
 
 namespace {
+
+// A plane mirror's principal magnifications are 1 to rounding (the test measures 1e-6 at most); a mirror
+// within this of 1 everywhere is of unit magnification.
+constexpr double kUnitMagnificationTol = 1e-4;
+
+json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
 json polygonJson(const std::vector<Vec2>& p) {
   json a = json::array();
@@ -88,6 +95,7 @@ int cmdFov(const std::vector<std::string>& argv) {
 
   const VehicleFrame frame(vehicle);
   RayScene rays(scene);
+  const SurfaceFigures figures = surfaceFigures(rays, index, 0.5 * (vehicle.eye_left + vehicle.eye_right), options);
   std::vector<EyeFootprint> feet;
   if (eyes_opt != "right") feet.push_back(traceFootprint(rays, index, frame, vehicle.eye_left, "left", options));
   if (eyes_opt != "left") feet.push_back(traceFootprint(rays, index, frame, vehicle.eye_right, "right", options));
@@ -142,9 +150,25 @@ int cmdFov(const std::vector<std::string>& argv) {
   std::string summary;
   for (const Regulation& r : regs) {
     json mirror = json::array();
-    for (const MirrorRequirement& q : r.mirror)
-      mirror.push_back({{"name", q.name}, {"value", q.value}, {"meaning", q.meaning}, {"source", q.source},
-                        {"verified", q.verified}, {"checked", false}});
+    for (const MirrorRequirement& q : r.mirror) {
+      json req = {{"name", q.name}, {"value", q.value}, {"meaning", q.meaning}, {"source", q.source},
+                  {"verified", q.verified}, {"checked", false}};
+      // The requirements the surface figures answer; the others are listed, not checked.
+      if (q.name == "min_mean_radius_m") {
+        req["checked"] = true;
+        req["pass"] = figures.mean_radius_m >= q.value;
+      } else if (q.name == "unit_magnification") {
+        req["checked"] = true;
+        req["pass"] = std::abs(figures.magnification_min - 1) <= kUnitMagnificationTol &&
+                      std::abs(figures.magnification_max - 1) <= kUnitMagnificationTol;
+      }
+      if (req["checked"].get<bool>()) {
+        all_pass = all_pass && req["pass"].get<bool>();
+        summary += r.id + " / mirror " + q.name + ": " + (req["pass"].get<bool>() ? "pass" : "FAIL") +
+                   (q.verified ? "" : " (value unverified)") + "\n";
+      }
+      mirror.push_back(req);
+    }
     j["regulations"].push_back({{"id", r.id}, {"title", r.title}, {"document", r.document}, {"file", r.path},
                                 {"verified", r.verified}, {"mirror_requirements", mirror}});
     for (const FovZone& z : r.zones) {
@@ -168,15 +192,26 @@ int cmdFov(const std::vector<std::string>& argv) {
     }
   }
   j["pass"] = regs.empty() ? json(nullptr) : json(all_pass);
-  j["surface"] = nullptr;  // mirror surface figures: not computed yet (issue 21 item 4)
+  j["surface"] = {{"mean_radius_m", num(figures.mean_radius_m)},
+                  {"principal_radius_min_m", num(figures.principal_radius_min_m)},
+                  {"principal_radius_max_m", num(figures.principal_radius_max_m)},
+                  {"magnification_min", num(figures.magnification_min)},
+                  {"magnification_max", num(figures.magnification_max)},
+                  {"eye", "the midpoint of the ocular points"},
+                  {"definitions",
+                   "radii 1/k (> 0 convex, null where flat); mean_radius_m: the average over the grid of each "
+                   "sample's (r1 + r2) / 2; magnification: principal angular magnifications of distant objects "
+                   "relative to a plane mirror (pvrr/analysis/fov.h)"}};
 
   writeFileAtomic((fs::path(*out) / "fov.json").string(), j.dump(2) + "\n");
   std::string title = el.name + " field of view";
   for (const Regulation& r : regs) title += (&r == &regs.front() ? ": " : ", ") + r.title;
   const bool driver_side = regs.empty() || regs.front().driver_side;
   const std::vector<std::string> plots = writeFovPlot(*out, title, frame, driver_side, eyes, plot_zones, options);
+  const std::vector<std::string> mag = writeMagnificationPlot(*out, el.name + " magnification", figures);
   std::printf("%s\n", (fs::path(*out) / "fov.json").string().c_str());
   for (const std::string& p : plots) std::printf("%s\n", p.c_str());
+  for (const std::string& p : mag) std::printf("%s\n", p.c_str());
   std::printf("%s", summary.c_str());
   return 0;
 }

@@ -181,4 +181,62 @@ std::vector<std::string> writeFovPlot(const std::string& dir, const std::string&
   return writeSketch(dir, "fov", k);
 }
 
+std::vector<std::string> writeMagnificationPlot(const std::string& dir, const std::string& title,
+                                                const SurfaceFigures& s) {
+  Sketch k;
+  k.width = 640;
+  k.height = 600;
+  const double left = 70, top = 80, size = 440;
+  const int m = s.n - 1;
+  double lo = kInf, hi = -kInf;
+  for (double v : s.magnification)
+    if (std::isfinite(v)) {
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+  if (!(hi > lo)) {  // a plane mirror: one value
+    lo = std::isfinite(lo) ? lo - 0.01 : 0.99;
+    hi = lo + 0.02;
+  }
+  // Yellow (low magnification: the most compressed image) to dark blue (the highest).
+  const std::vector<Rgb> stops = {{1.0, 0.95, 0.55}, {0.55, 0.8, 0.6}, {0.2, 0.55, 0.7}, {0.1, 0.2, 0.5}};
+  auto colour = [&](double v) {
+    double t = std::clamp((v - lo) / (hi - lo), 0.0, 1.0) * double(stops.size() - 1);
+    const size_t i = std::min(size_t(t), stops.size() - 2);
+    t -= double(i);
+    const Rgb &a = stops[i], &b = stops[i + 1];
+    return Rgb{a.r + (b.r - a.r) * t, a.g + (b.g - a.g) * t, a.b + (b.b - a.b) * t};
+  };
+  k.texts.push_back({k.width / 2.0, 28, title, 16, 1, kBlack});
+  k.texts.push_back({k.width / 2.0, 50,
+                     "magnification of distant objects relative to a plane mirror: " + fmt("%.3f", s.magnification_min) +
+                         " to " + fmt("%.3f", s.magnification_max) + " (principal)",
+                     12, 1, kDark});
+  for (int j = 0; j < m; ++j)
+    for (int i = 0; i < m; ++i) {
+      const double v = s.magnification[size_t(j) * size_t(m) + size_t(i)];
+      const double x0 = left + size * i / m, x1 = left + size * (i + 1) / m;
+      const double y1 = top + size * (m - j) / m, y0 = top + size * (m - j - 1) / m;
+      k.rects.push_back({x0, y0, x1, y1, std::isfinite(v) ? colour(v) : kGrey});
+    }
+  k.lines.push_back({{Vec2(left, top), Vec2(left + size, top), Vec2(left + size, top + size), Vec2(left, top + size),
+                      Vec2(left, top)},
+                     kBlack,
+                     1});
+  k.texts.push_back({left + size / 2, top + size + 24, "mirror parameter u (as in the scene's element frame)", 12, 1, kBlack});
+  k.texts.push_back({left, top - 8, "v", 12, 0, kBlack});
+  // Colour bar with five labels (geometric mean of the principal magnifications).
+  const double bx = left + size + 30, bw = 24;
+  for (int q = 0; q < 100; ++q) {
+    const double t0 = q / 100.0, t1 = (q + 1) / 100.0;
+    k.rects.push_back({bx, top + size * (1 - t1), bx + bw, top + size * (1 - t0), colour(lo + (hi - lo) * (t0 + t1) / 2)});
+  }
+  for (int q = 0; q <= 4; ++q) {
+    const double t = q / 4.0;
+    k.texts.push_back({bx + bw + 6, top + size * (1 - t) + 4, fmt("%.3f", lo + (hi - lo) * t), 11, 0, kBlack});
+  }
+  k.texts.push_back({bx, top - 8, "x", 12, 0, kBlack});
+  return writeSketch(dir, "magnification", k);
+}
+
 }  // namespace pvrr::app

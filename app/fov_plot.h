@@ -20,6 +20,11 @@ std::vector<std::string> writeFovPlot(const std::string& dir, const std::string&
                                       bool driver_side, const std::vector<const EyeFootprint*>& eyes,
                                       const std::vector<FovPlotZone>& zones, const FovOptions& options);
 
+// DIR/magnification.png and .svg: the magnification map (SurfaceFigures::magnification) over the mirror's
+// parameter square (u to the right, v up), a colour bar with its range; grey where the eye sees the back.
+std::vector<std::string> writeMagnificationPlot(const std::string& dir, const std::string& title,
+                                                const SurfaceFigures& s);
+
 // The plot's depth axis: metres behind the ocular points to [0, 1) (exposed for tests).
 double fovDepthAxis(double behind_m);
 

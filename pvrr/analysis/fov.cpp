@@ -235,4 +235,72 @@ ZoneResult evaluateZone(const FovZone& z, const VehicleFrame& frame, const std::
   return res;
 }
 
+SurfaceFigures surfaceFigures(const RayScene& rays, int element, const Vec3& eye_world, const FovOptions& options) {
+  const Element& el = rays.scene().elements[size_t(element)];
+  const cad::Surface& surface = el.frontSurface();
+  const cad::ParamDomain dom = surface.domain();
+  SurfaceFigures out;
+  const int n = out.n = options.samples;
+  std::vector<Vec3> d(size_t(n) * size_t(n)), r(d.size());
+  std::vector<bool> front(d.size(), false);
+  double radius_sum = 0;
+  int radius_count = 0;
+  double rmin = kInf, rmax = -kInf;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const size_t k = size_t(j) * size_t(n) + size_t(i);
+      const Vec2 s(-1 + 2.0 * i / (n - 1), -1 + 2.0 * j / (n - 1));
+      const Vec2 uv = el.has_outline ? el.outline.fromSquare(s)
+                                     : Vec2(dom.u0 + (dom.u1 - dom.u0) * 0.5 * (s.x + 1),
+                                            dom.v0 + (dom.v1 - dom.v0) * 0.5 * (s.y + 1));
+      const cad::SurfacePoint sp = surface.sample(uv.x, uv.y, true);
+      const Vec3 p = el.toWorldPoint(sp.p), nrm = glm::normalize(el.toWorldDir(sp.n));
+      d[k] = glm::normalize(p - eye_world);
+      r[k] = reflect(d[k], nrm);
+      front[k] = glm::dot(d[k], nrm) < 0;
+      const double r1 = sp.k.k1 != 0 ? 1 / sp.k.k1 : kInf, r2 = sp.k.k2 != 0 ? 1 / sp.k.k2 : kInf;
+      radius_sum += 0.5 * (r1 + r2);
+      ++radius_count;
+      for (double v : {r1, r2}) {
+        rmin = std::min(rmin, v);
+        rmax = std::max(rmax, v);
+      }
+    }
+  out.mean_radius_m = radius_sum / radius_count;
+  out.principal_radius_min_m = rmin;
+  out.principal_radius_max_m = rmax;
+  // Angular differences of unit vectors a, b, c (c - a, b - a) in the plane perpendicular to their mean.
+  auto frame2 = [](const Vec3& a, const Vec3& b, const Vec3& c) {
+    const Vec3 m = glm::normalize(a + b + c);
+    const Vec3 e1 = glm::normalize(glm::cross(m, std::abs(m.z) < 0.9 ? Vec3(0, 0, 1) : Vec3(1, 0, 0)));
+    const Vec3 e2 = glm::cross(m, e1);
+    const Vec3 du = b - a, dv = c - a;
+    return glm::dmat2(glm::dot(du, e1), glm::dot(du, e2), glm::dot(dv, e1), glm::dot(dv, e2));
+  };
+  out.magnification.assign(size_t(n - 1) * size_t(n - 1), std::nan(""));
+  out.principal_magnifications.assign(out.magnification.size(), Vec2(std::nan("")));
+  double mmin = kInf, mmax = 0;
+  for (int j = 0; j + 1 < n; ++j)
+    for (int i = 0; i + 1 < n; ++i) {
+      const size_t a = size_t(j) * size_t(n) + size_t(i), b = a + 1, c = a + size_t(n);
+      if (!front[a] || !front[b] || !front[c]) continue;
+      const glm::dmat2 D = frame2(d[a], d[b], d[c]), R = frame2(r[a], r[b], r[c]);
+      if (std::abs(glm::determinant(R)) < 1e-300) continue;
+      const glm::dmat2 M = D * glm::inverse(R);
+      // Singular values of a 2 x 2 matrix from its Frobenius norm and determinant.
+      const double f2 = M[0][0] * M[0][0] + M[0][1] * M[0][1] + M[1][0] * M[1][0] + M[1][1] * M[1][1];
+      const double det = std::abs(glm::determinant(M));
+      const double disc = std::sqrt(std::max(0.0, f2 * f2 - 4 * det * det));
+      const double s1 = std::sqrt(0.5 * (f2 + disc)), s2 = std::sqrt(std::max(0.0, 0.5 * (f2 - disc)));
+      const size_t cell = size_t(j) * size_t(n - 1) + size_t(i);
+      out.magnification[cell] = std::sqrt(det);
+      out.principal_magnifications[cell] = Vec2(s1, s2);
+      mmin = std::min(mmin, s2);
+      mmax = std::max(mmax, s1);
+    }
+  out.magnification_min = mmin;
+  out.magnification_max = mmax;
+  return out;
+}
+
 }  // namespace pvrr

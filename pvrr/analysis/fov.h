@@ -102,6 +102,26 @@ std::vector<Vec2> zoneInVehicle(const FovZone& z, const VehicleFrame& frame, dou
 ZoneResult evaluateZone(const FovZone& z, const VehicleFrame& frame, const std::vector<const EyeFootprint*>& eyes,
                         const FovOptions& options = {});
 
+// The mirror surface's own figures over the same grid (FovOptions::samples) of its parameter square.
+//  - Principal radii 1/k1, 1/k2 (cad/surface.h's sign: > 0 convex as seen from the front; +inf where flat).
+//    mean_radius_m: the average over the samples of (r1 + r2) / 2, each sample's mean of its two principal
+//    radii (after R46 Annex 7's r = (r_i + r'_i) / 2 at measuring points; here over every sample, not three
+//    points: an engineering figure, not the type-approval measurement).
+//  - Magnification of distant objects seen from `eye_world`, relative to a plane mirror at the same place: per
+//    grid cell, M = D R^-1, with D the eye rays' and R the reflected rays' angular differences across the cell
+//    (each in the plane perpendicular to the cell's mean ray). Its singular values are the principal
+//    magnifications (1, 1 for a plane mirror; for a sphere of radius R seen from distance d at incidence i,
+//    1 / (1 + 2 d / (R cos i)) and 1 / (1 + 2 d cos i / R), Coddington's equations). `magnification` holds
+//    their geometric mean per cell, (n - 1) x (n - 1) row-major; NaN where a corner faces the eye with its back.
+struct SurfaceFigures {
+  int n = 0;
+  double mean_radius_m = kInf, principal_radius_min_m = kInf, principal_radius_max_m = kInf;
+  double magnification_min = 0, magnification_max = 0;  // the smallest and largest principal magnification
+  std::vector<double> magnification;
+  std::vector<Vec2> principal_magnifications;  // per cell: (larger, smaller) singular value
+};
+SurfaceFigures surfaceFigures(const RayScene& rays, int element, const Vec3& eye_world, const FovOptions& options = {});
+
 // Inside test for a simple polygon (even-odd).
 bool insidePolygon(const std::vector<Vec2>& poly, Vec2 p);
 

@@ -27,7 +27,8 @@ TEST(FovCli, CarMirrorAgainstR46ClassIII) {
   const fs::path dir = pvrr::test::freshTestDir("fov-ok");
   const CliResult r = runPvrr("fov models/car-mirror.json --samples 61 --out '" + (dir / "out").string() + "'");
   ASSERT_EQ(r.code, 0) << r.err;
-  for (const char* f : {"fov.json", "fov.png", "fov.svg"}) EXPECT_TRUE(fs::exists(dir / "out" / f)) << f;
+  for (const char* f : {"fov.json", "fov.png", "fov.svg", "magnification.png", "magnification.svg"})
+    EXPECT_TRUE(fs::exists(dir / "out" / f)) << f;
   const nlohmann::json j = nlohmann::json::parse(slurp(dir / "out" / "fov.json"));
   EXPECT_EQ(j["element"], "door-mirror");
   EXPECT_EQ(j["eyes"], (nlohmann::json{"left", "right"}));
@@ -43,6 +44,13 @@ TEST(FovCli, CarMirrorAgainstR46ClassIII) {
     EXPECT_FALSE(z["verified"].get<bool>());  // R46's zone numbers are not confirmed in the primary text yet
   }
   EXPECT_NE(r.out.find("r46-class-iii / "), std::string::npos) << r.out;
+  // The convex mirror: radii of about 1.3 m, magnification below 1.
+  const auto& s = j["surface"];
+  EXPECT_GT(s["mean_radius_m"].get<double>(), 1.0);
+  EXPECT_LT(s["mean_radius_m"].get<double>(), 2.0);
+  EXPECT_LE(s["principal_radius_min_m"].get<double>(), s["principal_radius_max_m"].get<double>());
+  EXPECT_GT(s["magnification_min"].get<double>(), 0);
+  EXPECT_LT(s["magnification_max"].get<double>(), 1);
   fs::remove_all(dir);
 }
 
@@ -56,6 +64,10 @@ TEST(FovCli, OneEyeAndAnExplicitRegulation) {
   EXPECT_FALSE(j["footprint"].contains("right"));
   ASSERT_EQ(j["zones"].size(), 1u);
   EXPECT_EQ(j["zones"][0]["regulation"], "fmvss111-driver");
+  // FMVSS 111 asks for a plane (unit magnification) mirror: the convex car mirror fails it.
+  EXPECT_EQ(j["regulations"][0]["mirror_requirements"][0]["name"], "unit_magnification");
+  EXPECT_FALSE(j["regulations"][0]["mirror_requirements"][0]["pass"].get<bool>());
+  EXPECT_FALSE(j["pass"].get<bool>());
   fs::remove_all(dir);
 }
 
