@@ -37,10 +37,14 @@ json polygonJson(const std::vector<Vec2>& p) {
 
 const char* eyesName(FovZone::Eyes e) {
   switch (e) {
-    case FovZone::Eyes::Either: return "either";
-    case FovZone::Eyes::Both: return "both";
-    case FovZone::Eyes::Left: return "left";
-    case FovZone::Eyes::Right: return "right";
+    case FovZone::Eyes::Either:
+      return "either";
+    case FovZone::Eyes::Both:
+      return "both";
+    case FovZone::Eyes::Left:
+      return "left";
+    case FovZone::Eyes::Right:
+      return "right";
   }
   return "";
 }
@@ -108,9 +112,9 @@ int cmdFov(const std::vector<std::string>& argv) {
   if (road == 0) {
     const EyeFootprint& f = feet.front();
     throw Error(el_path + ": the mirror sees no road from the " + f.eye + " ocular point (of " +
-                std::to_string(f.fate.size()) + " rays: " + std::to_string(f.count(RayFate::Horizon)) + " above the horizon, " +
-                std::to_string(f.count(RayFate::Obstructed)) + " obstructed, " + std::to_string(f.count(RayFate::Back)) +
-                " on its back)");
+                std::to_string(f.fate.size()) + " rays: " + std::to_string(f.count(RayFate::Horizon)) +
+                " above the horizon, " + std::to_string(f.count(RayFate::Obstructed)) + " obstructed, " +
+                std::to_string(f.count(RayFate::Back)) + " on its back)");
   }
 
   json j;
@@ -119,13 +123,16 @@ int cmdFov(const std::vector<std::string>& argv) {
   j["eyes"] = json::array();
   for (const EyeFootprint& f : feet) j["eyes"].push_back(f.eye);
   j["conventions"] = {
-      {"frame", "vehicle frame: metres, origin on the road below the midpoint of the ocular points, x forward, y to "
-                "the left, z up"},
-      {"footprint", "the image on the road of the mirror's boundary, counter-clockwise; rays beyond horizon_m "
-                    "(horizontally from the mirror) or above the horizon are placed horizon_m away along their "
-                    "horizontal direction"},
-      {"coverage", "zone samples uniform across the zone and in the angle of depression from the ocular points; "
-                   "a zone 'to the horizon' is checked out to zone_horizon_m behind the ocular points"}};
+      {"frame",
+       "vehicle frame: metres, origin on the road below the midpoint of the ocular points, x forward, y to "
+       "the left, z up"},
+      {"footprint",
+       "the image on the road of the mirror's boundary, counter-clockwise; rays beyond horizon_m "
+       "(horizontally from the mirror) or above the horizon are placed horizon_m away along their "
+       "horizontal direction"},
+      {"coverage",
+       "zone samples uniform across the zone and in the angle of depression from the ocular points; "
+       "a zone 'to the horizon' is checked out to zone_horizon_m behind the ocular points"}};
   j["horizon_m"] = options.horizon_m;
   j["zone_horizon_m"] = options.zone_horizon_m;
   j["samples"] = options.samples;
@@ -151,8 +158,8 @@ int cmdFov(const std::vector<std::string>& argv) {
   for (const Regulation& r : regs) {
     json mirror = json::array();
     for (const MirrorRequirement& q : r.mirror) {
-      json req = {{"name", q.name}, {"value", q.value}, {"meaning", q.meaning}, {"source", q.source},
-                  {"verified", q.verified}, {"checked", false}};
+      json req = {{"name", q.name},     {"value", q.value},       {"meaning", q.meaning},
+                  {"source", q.source}, {"verified", q.verified}, {"checked", false}};
       // The requirements the surface figures answer; the others are listed, not checked.
       if (q.name == "min_mean_radius_m") {
         req["checked"] = true;
@@ -169,8 +176,12 @@ int cmdFov(const std::vector<std::string>& argv) {
       }
       mirror.push_back(req);
     }
-    j["regulations"].push_back({{"id", r.id}, {"title", r.title}, {"document", r.document}, {"file", r.path},
-                                {"verified", r.verified}, {"mirror_requirements", mirror}});
+    j["regulations"].push_back({{"id", r.id},
+                                {"title", r.title},
+                                {"document", r.document},
+                                {"file", r.path},
+                                {"verified", r.verified},
+                                {"mirror_requirements", mirror}});
     for (const FovZone& z : r.zones) {
       results.push_back(evaluateZone(z, frame, eyes, options));
       const ZoneResult& zr = results.back();

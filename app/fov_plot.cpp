@@ -10,7 +10,7 @@ namespace pvrr::app {
 
 namespace {
 
-constexpr double kDepthScale_m = 20;             // fovDepthAxis: this far behind lies at mid-width
+constexpr double kDepthScale_m = 20;                      // fovDepthAxis: this far behind lies at mid-width
 constexpr double kOutwardMin_m = -3, kOutwardMax_m = 10;  // lateral range shown, outward from the outermost point
 
 const Rgb kPass{0.15, 0.65, 0.25}, kFail{0.85, 0.15, 0.12}, kLeftEye{0.12, 0.35, 0.85}, kRightEye{0.95, 0.55, 0.05},
@@ -53,7 +53,8 @@ std::vector<Vec2> clip(std::vector<Vec2> poly, const PlotArea& a) {
 std::vector<Vec2> toPx(const std::vector<Vec2>& poly, const PlotArea& a, int split = 1) {
   std::vector<Vec2> out;
   for (size_t i = 0; i < poly.size(); ++i)
-    for (int k = 0; k < split; ++k) out.push_back(a.px(poly[i] + (poly[(i + 1) % poly.size()] - poly[i]) * (double(k) / split)));
+    for (int k = 0; k < split; ++k)
+      out.push_back(a.px(poly[i] + (poly[(i + 1) % poly.size()] - poly[i]) * (double(k) / split)));
   return out;
 }
 
@@ -80,8 +81,13 @@ std::vector<std::string> writeFovPlot(const std::string& dir, const std::string&
   for (const FovPlotZone& z : zones) all_pass = all_pass && z.result->pass;
   k.texts.push_back({k.width / 2.0, 28, title, 17, 1, kBlack});
   k.texts.push_back({k.width / 2.0, 52,
-                     zones.empty() ? "no regulation zones" : (all_pass ? "PASS: every zone covered" : "FAIL: see the red zones and the marked points"),
-                     15, 1, zones.empty() ? kDark : all_pass ? kPass : kFail});
+                     zones.empty()
+                         ? "no regulation zones"
+                         : (all_pass ? "PASS: every zone covered" : "FAIL: see the red zones and the marked points"),
+                     15, 1,
+                     zones.empty() ? kDark
+                     : all_pass    ? kPass
+                                   : kFail});
 
   // The road (light) and the vehicle's own side (grey band inside its outermost point).
   k.rects.push_back({a.left, a.top, x1, y1, {0.96, 0.96, 0.94}});
@@ -96,7 +102,8 @@ std::vector<std::string> writeFovPlot(const std::string& dir, const std::string&
     k.texts.push_back({x, y1 + 18, fmt("%g", d), 11, 1, kBlack});
   }
   k.texts.push_back({x1, y1 + 18, "horizon", 11, 1, kBlack});
-  k.texts.push_back({a.left + a.width / 2, y1 + 40, "metres behind the ocular points (compressed: d / (d + 20 m))", 12, 1, kBlack});
+  k.texts.push_back(
+      {a.left + a.width / 2, y1 + 40, "metres behind the ocular points (compressed: d / (d + 20 m))", 12, 1, kBlack});
   for (double s = kOutwardMin_m; s <= kOutwardMax_m + 1e-9; s += 1) {
     const double y = a.top + a.height * (kOutwardMax_m - s) / (kOutwardMax_m - kOutwardMin_m);
     k.lines.push_back({{Vec2(a.left, y), Vec2(x1, y)}, s == 0 ? kDark : kGrey, s == 0 ? 1.5 : 1});
@@ -153,9 +160,8 @@ std::vector<std::string> writeFovPlot(const std::string& dir, const std::string&
     for (const Vec2& m : z.result->missed) {
       const Vec2 p = a.px(m);
       if (p.x < a.left || p.x > x1 || p.y < a.top || p.y > y1) continue;
-      k.polys.push_back({{p + Vec2(-1.2, -1.2), p + Vec2(1.2, -1.2), p + Vec2(1.2, 1.2), p + Vec2(-1.2, 1.2)},
-                         {0.6, 0.05, 0.05},
-                         1});
+      k.polys.push_back(
+          {{p + Vec2(-1.2, -1.2), p + Vec2(1.2, -1.2), p + Vec2(1.2, 1.2), p + Vec2(-1.2, 1.2)}, {0.6, 0.05, 0.05}, 1});
     }
 
   // Legend and the figures per zone.
@@ -163,18 +169,22 @@ std::vector<std::string> writeFovPlot(const std::string& dir, const std::string&
   for (const EyeFootprint* f : eyes) {
     const Rgb c = f->eye == "left" ? kLeftEye : kRightEye;
     k.lines.push_back({{Vec2(a.left, ly - 4), Vec2(a.left + 30, ly - 4)}, c, 2, f->eye == "right"});
-    const std::string reach = f->sees_horizon ? "reaches the horizon" : fmt("road reach %.0f m, no horizon", f->reach_m);
+    const std::string reach =
+        f->sees_horizon ? "reaches the horizon" : fmt("road reach %.0f m, no horizon", f->reach_m);
     k.texts.push_back({a.left + 38, ly, f->eye + " eye footprint: " + reach, 12, 0, kBlack});
     ly += 18;
   }
-  k.polys.push_back({{Vec2(a.left, ly - 12), Vec2(a.left + 30, ly - 12), Vec2(a.left + 30, ly), Vec2(a.left, ly)}, kObstructed, 0.35});
-  k.texts.push_back({a.left + 38, ly, "obstructed (vehicle.obstructions)      dots: zone points not seen clearly", 12, 0, kBlack});
+  k.polys.push_back({{Vec2(a.left, ly - 12), Vec2(a.left + 30, ly - 12), Vec2(a.left + 30, ly), Vec2(a.left, ly)},
+                     kObstructed,
+                     0.35});
+  k.texts.push_back(
+      {a.left + 38, ly, "obstructed (vehicle.obstructions)      dots: zone points not seen clearly", 12, 0, kBlack});
   ly += 22;
   for (const FovPlotZone& z : zones) {
     const Rgb c = z.result->pass ? kPass : kFail;
     k.texts.push_back({a.left, ly,
-                       (z.result->pass ? "PASS  " : "FAIL  ") + z.zone->name + ": covered " + pct(z.result->covered_fraction) +
-                           ", obstructed " + pct(z.result->obstructed_fraction),
+                       (z.result->pass ? "PASS  " : "FAIL  ") + z.zone->name + ": covered " +
+                           pct(z.result->covered_fraction) + ", obstructed " + pct(z.result->obstructed_fraction),
                        12, 0, c});
     ly += 18;
   }
@@ -209,8 +219,8 @@ std::vector<std::string> writeMagnificationPlot(const std::string& dir, const st
   };
   k.texts.push_back({k.width / 2.0, 28, title, 16, 1, kBlack});
   k.texts.push_back({k.width / 2.0, 50,
-                     "magnification of distant objects relative to a plane mirror: " + fmt("%.3f", s.magnification_min) +
-                         " to " + fmt("%.3f", s.magnification_max) + " (principal)",
+                     "magnification of distant objects relative to a plane mirror: " +
+                         fmt("%.3f", s.magnification_min) + " to " + fmt("%.3f", s.magnification_max) + " (principal)",
                      12, 1, kDark});
   for (int j = 0; j < m; ++j)
     for (int i = 0; i < m; ++i) {
@@ -223,13 +233,15 @@ std::vector<std::string> writeMagnificationPlot(const std::string& dir, const st
                       Vec2(left, top)},
                      kBlack,
                      1});
-  k.texts.push_back({left + size / 2, top + size + 24, "mirror parameter u (as in the scene's element frame)", 12, 1, kBlack});
+  k.texts.push_back(
+      {left + size / 2, top + size + 24, "mirror parameter u (as in the scene's element frame)", 12, 1, kBlack});
   k.texts.push_back({left, top - 8, "v", 12, 0, kBlack});
   // Colour bar with five labels (geometric mean of the principal magnifications).
   const double bx = left + size + 30, bw = 24;
   for (int q = 0; q < 100; ++q) {
     const double t0 = q / 100.0, t1 = (q + 1) / 100.0;
-    k.rects.push_back({bx, top + size * (1 - t1), bx + bw, top + size * (1 - t0), colour(lo + (hi - lo) * (t0 + t1) / 2)});
+    k.rects.push_back(
+        {bx, top + size * (1 - t1), bx + bw, top + size * (1 - t0), colour(lo + (hi - lo) * (t0 + t1) / 2)});
   }
   for (int q = 0; q <= 4; ++q) {
     const double t = q / 4.0;

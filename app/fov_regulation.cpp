@@ -42,7 +42,8 @@ struct Reader {
                 double hi) const {
     const json& v = sourced(o, key, path, verified);
     if (!v.is_number() || v.get<double>() < lo || v.get<double>() > hi)
-      fail(path + "." + key + ".value", "expected a number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+      fail(path + "." + key + ".value",
+           "expected a number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
     return v.get<double>();
   }
 };
@@ -146,7 +147,8 @@ Regulation loadRegulation(const std::string& id, const std::vector<std::string>&
       q.source = r.string(m[i], "source", p);
       if (!m[i].contains("value") || !m[i]["value"].is_number()) r.fail(p + ".value", "expected a number");
       q.value = m[i]["value"].get<double>();
-      if (!m[i].contains("verified") || !m[i]["verified"].is_boolean()) r.fail(p + ".verified", "expected true or false");
+      if (!m[i].contains("verified") || !m[i]["verified"].is_boolean())
+        r.fail(p + ".verified", "expected true or false");
       q.verified = m[i]["verified"].get<bool>();
       if (m[i].contains("note") && m[i]["note"].is_string()) q.note = m[i]["note"].get<std::string>();
       reg.verified = reg.verified && q.verified;

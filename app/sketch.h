@@ -46,7 +46,6 @@ struct Sketch {
 
 inline const Rgb kBlack{0, 0, 0}, kWhite{1, 1, 1}, kGrey{0.82, 0.82, 0.82}, kDark{0.25, 0.25, 0.25};
 
-
 std::string hex(const Rgb& c);
 std::string svg(const Sketch& k);
 void writePng(const std::string& path, const Sketch& k);

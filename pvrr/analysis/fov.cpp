@@ -43,7 +43,7 @@ double cross2(Vec2 a, Vec2 b) { return a.x * b.y - a.y * b.x; }
 
 bool inTriangle(Vec2 p, Vec2 a, Vec2 b, Vec2 c) {
   const double d1 = cross2(b - a, p - a), d2 = cross2(c - b, p - b), d3 = cross2(a - c, p - c);
-  const bool neg = d1 < 0 || d2 < 0 || d3 < 0, pos = d1 > 0 || d2 > 0 || d3 > 0;
+  const bool neg = d1 < 0 || d2 < 0 || d3<0, pos = d1> 0 || d2 > 0 || d3 > 0;
   return !(neg && pos);
 }
 
@@ -58,9 +58,7 @@ VehicleFrame::VehicleFrame(const VehicleDesc& v) : v_(v) {
 }
 
 Vec3 VehicleFrame::toVehicle(const Vec3& w) const { return toVehicleDir(w - origin_); }
-Vec3 VehicleFrame::toVehicleDir(const Vec3& w) const {
-  return Vec3(glm::dot(w, x_), glm::dot(w, y_), glm::dot(w, z_));
-}
+Vec3 VehicleFrame::toVehicleDir(const Vec3& w) const { return Vec3(glm::dot(w, x_), glm::dot(w, y_), glm::dot(w, z_)); }
 Vec3 VehicleFrame::toWorld(const Vec3& p) const { return origin_ + p.x * x_ + p.y * y_ + p.z * z_; }
 
 int EyeFootprint::count(RayFate f) const { return int(std::count(fate.begin(), fate.end(), f)); }
@@ -219,10 +217,18 @@ ZoneResult evaluateZone(const FovZone& z, const VehicleFrame& frame, const std::
   for (size_t s = 0; s < pts.size(); ++s) {
     int st = 0;
     switch (z.eyes) {
-      case FovZone::Eyes::Either: st = (sl[s] == 1 || sr[s] == 1) ? 1 : (sl[s] || sr[s]) ? 2 : 0; break;
-      case FovZone::Eyes::Both: st = (sl[s] == 1 && sr[s] == 1) ? 1 : (sl[s] && sr[s]) ? 2 : 0; break;
-      case FovZone::Eyes::Left: st = sl[s]; break;
-      case FovZone::Eyes::Right: st = sr[s]; break;
+      case FovZone::Eyes::Either:
+        st = (sl[s] == 1 || sr[s] == 1) ? 1 : (sl[s] || sr[s]) ? 2 : 0;
+        break;
+      case FovZone::Eyes::Both:
+        st = (sl[s] == 1 && sr[s] == 1) ? 1 : (sl[s] && sr[s]) ? 2 : 0;
+        break;
+      case FovZone::Eyes::Left:
+        st = sl[s];
+        break;
+      case FovZone::Eyes::Right:
+        st = sr[s];
+        break;
     }
     seen += st == 1;
     obs += st == 2;

@@ -49,8 +49,8 @@ class VehicleFrame {
 enum class RayFate { Road, Horizon, Obstructed, Back };
 
 struct FovOptions {
-  int samples = 121;          // grid samples along each side of the mirror's parameter square
-  double horizon_m = 1000;    // the road reach of the map (see CONVENTIONS)
+  int samples = 121;            // grid samples along each side of the mirror's parameter square
+  double horizon_m = 1000;      // the road reach of the map (see CONVENTIONS)
   double zone_horizon_m = 500;  // zones "to the horizon" are checked out to this far behind the ocular points
   int zone_samples_x = 80, zone_samples_y = 24;
 };
@@ -82,7 +82,7 @@ struct FovZone {
   bool verified = false;
   enum class Eyes { Either, Both, Left, Right } eyes = Eyes::Either;
   double allowed_obstructed_fraction = 0;
-  bool driver_side = true;  // the zone lies on the driver's side (else the passenger's)
+  bool driver_side = true;    // the zone lies on the driver's side (else the passenger's)
   std::vector<Vec2> polygon;  // zone coordinates (CONVENTIONS); x = -kInf: the horizon
 };
 

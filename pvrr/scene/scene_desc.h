@@ -241,8 +241,8 @@ struct ObserverDesc {
 // the road below the midpoint of the two ocular points, x forward, y to the left, z up.
 struct VehicleDesc {
   enum class Side { Left, Right };
-  Vec3 forward{0, 0, -1};  // unit, perpendicular to up
-  Vec3 up{0, 1, 0};        // unit, the road's normal
+  Vec3 forward{0, 0, -1};    // unit, perpendicular to up
+  Vec3 up{0, 1, 0};          // unit, the road's normal
   double road_height_m = 0;  // the road plane: points p with dot(p, up) = road_height_m
   // The outermost point of the vehicle on each side (world), and the driver's ocular points (world).
   Vec3 outermost_left{0}, outermost_right{0};

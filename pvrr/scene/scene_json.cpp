@@ -954,12 +954,14 @@ VehicleDesc readVehicle(const Ctx& c, const json* j, const std::vector<EnvObject
     r = p.point("right");
     for (const auto& [side, q] : {std::pair<const char*, Vec3>{"left", l}, {"right", r}})
       if (glm::dot(q, v.up) - v.road_height_m <= 0) p.expected(side, "a point above the road (vehicle.road_height)");
-    if (glm::dot(l - r, left) <= 0) p.expected("left", "a point to the left of " + p.at("right") + " (seen facing vehicle.forward)");
+    if (glm::dot(l - r, left) <= 0)
+      p.expected("left", "a point to the left of " + p.at("right") + " (seen facing vehicle.forward)");
   };
   pair("outermost", v.outermost_left, v.outermost_right);
   pair("ocular_points", v.eye_left, v.eye_right);
   v.driver_side = o.choice<VehicleDesc::Side>("driver_side");
-  if (const json* obs = arrayAt(c, o.get("obstructions"), o.at("obstructions"), "an array of environment object names")) {
+  if (const json* obs =
+          arrayAt(c, o.get("obstructions"), o.at("obstructions"), "an array of environment object names")) {
     std::vector<std::string> names;
     for (const EnvObjectDesc& e : environment) names.push_back(e.name);
     for (size_t i = 0; i < obs->size(); ++i) {
@@ -987,8 +989,7 @@ VehicleDesc readVehicle(const Ctx& c, const json* j, const std::vector<EnvObject
 
 SceneDesc readScene(Ctx& c, const json& doc) {
   Obj top(c, &doc, "", "a JSON object (a scene)",
-          {"version", "units", "description", "observer", "environment", "lights", "elements", "render",
-           "vehicle"});
+          {"version", "units", "description", "observer", "environment", "lights", "elements", "render", "vehicle"});
   SceneDesc s;
   {
     const json* v = top.get("version");

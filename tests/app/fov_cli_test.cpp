@@ -56,8 +56,8 @@ TEST(FovCli, CarMirrorAgainstR46ClassIII) {
 
 TEST(FovCli, OneEyeAndAnExplicitRegulation) {
   const fs::path dir = pvrr::test::freshTestDir("fov-left");
-  const CliResult r = runPvrr("fov models/car-mirror.json --samples 31 --eyes left --regulation fmvss111-driver --out '" +
-                              dir.string() + "'");
+  const CliResult r = runPvrr(
+      "fov models/car-mirror.json --samples 31 --eyes left --regulation fmvss111-driver --out '" + dir.string() + "'");
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(slurp(dir / "fov.json"));
   EXPECT_EQ(j["eyes"], (nlohmann::json{"left"}));

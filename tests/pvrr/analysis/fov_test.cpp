@@ -59,7 +59,8 @@ double segmentDistance(Vec2 p, Vec2 a, Vec2 b) {
 }
 double polylineDistance(Vec2 p, const std::vector<Vec2>& loop) {
   double best = kInf;
-  for (size_t i = 0; i < loop.size(); ++i) best = std::min(best, segmentDistance(p, loop[i], loop[(i + 1) % loop.size()]));
+  for (size_t i = 0; i < loop.size(); ++i)
+    best = std::min(best, segmentDistance(p, loop[i], loop[(i + 1) % loop.size()]));
   return best;
 }
 
@@ -209,7 +210,8 @@ TEST(Fov, SurfaceFigures) {
   const Vec3 p = el.toWorldPoint(Vec3(0)), nrm = glm::normalize(el.toWorldDir(Vec3(0, 0, 1)));
   const double dist = glm::length(p - mid), cos_i = glm::dot(glm::normalize(mid - p), nrm);
   const double m_t = 1 / (1 + 2 * dist / (kR * cos_i)), m_s = 1 / (1 + 2 * dist * cos_i / kR);
-  std::printf("sphere R=%.1f m: principal magnifications %.5f, %.5f; Coddington %.5f, %.5f\n", kR, got.x, got.y, m_s, m_t);
+  std::printf("sphere R=%.1f m: principal magnifications %.5f, %.5f; Coddington %.5f, %.5f\n", kR, got.x, got.y, m_s,
+              m_t);
   EXPECT_NEAR(got.x, m_s, kMagnificationTol);
   EXPECT_NEAR(got.y, m_t, kMagnificationTol);
   EXPECT_LT(s.magnification_max, 1);

@@ -33,8 +33,8 @@ std::string errorOf(const std::string& json) {
 
 TEST(VehicleBlock, OptionalAndRead) {
   EXPECT_FALSE(parseScene(scene(""), "x.json", ".").vehicle.has_value());
-  const SceneDesc d = parseScene(scene(kGood + R"(, "obstructions": ["own-door"], "regulations": ["r46-class-iii"]})"),
-                                 "x.json", ".");
+  const SceneDesc d =
+      parseScene(scene(kGood + R"(, "obstructions": ["own-door"], "regulations": ["r46-class-iii"]})"), "x.json", ".");
   ASSERT_TRUE(d.vehicle.has_value());
   EXPECT_EQ(d.vehicle->forward, Vec3(0, 0, -1));
   EXPECT_EQ(d.vehicle->eye_left, Vec3(-0.0325, 1.2, 0));
@@ -54,15 +54,20 @@ TEST(VehicleBlock, ErrorsNameTheJsonPath) {
     v.replace(v.find(from), from.size(), to);
     return scene(v + "}");
   };
-  EXPECT_NE(errorOf(with(R"("forward": [0, 0, -1])", R"("forward": [0, 1, -1])")).find("x.json: vehicle.forward: expected a direction perpendicular"),
+  EXPECT_NE(errorOf(with(R"("forward": [0, 0, -1])", R"("forward": [0, 1, -1])"))
+                .find("x.json: vehicle.forward: expected a direction perpendicular"),
             std::string::npos);
-  EXPECT_NE(errorOf(with(R"("left": [-0.0325, 1.2, 0])", R"("left": [0.5, 1.2, 0])")).find("vehicle.ocular_points.left: expected a point to the left"),
+  EXPECT_NE(errorOf(with(R"("left": [-0.0325, 1.2, 0])", R"("left": [0.5, 1.2, 0])"))
+                .find("vehicle.ocular_points.left: expected a point to the left"),
             std::string::npos);
-  EXPECT_NE(errorOf(with(R"("left": [-0.45, 1, 0])", R"("left": [-0.45, -1, 0])")).find("vehicle.outermost.left: expected a point above the road"),
+  EXPECT_NE(errorOf(with(R"("left": [-0.45, 1, 0])", R"("left": [-0.45, -1, 0])"))
+                .find("vehicle.outermost.left: expected a point above the road"),
             std::string::npos);
   EXPECT_NE(errorOf(with(R"("driver_side": "left")", R"("driver_side": "lefft")")).find("vehicle.driver_side"),
             std::string::npos);
-  EXPECT_NE(errorOf(scene(kGood + R"(, "obstructions": ["own-dor"]})")).find("vehicle.obstructions[0]: expected the name of an environment object, got \"own-dor\"; did you mean \"own-door\"?"),
+  EXPECT_NE(errorOf(scene(kGood + R"(, "obstructions": ["own-dor"]})"))
+                .find("vehicle.obstructions[0]: expected the name of an environment object, got \"own-dor\"; did you "
+                      "mean \"own-door\"?"),
             std::string::npos);
   EXPECT_NE(errorOf(scene(kGood + R"(, "ocular": 1})")).find("vehicle.ocular: unknown key"), std::string::npos);
 }
