@@ -146,7 +146,13 @@ int cmdFov(const std::vector<std::string>& argv) {
                  {"back", f.count(RayFate::Back)},
                  {"road_reach_m", f.reach_m},
                  {"sees_horizon", f.sees_horizon}};
-  fp["union"] = nullptr;  // not computed yet (issue 21); each zone's "either" coverage is the union's
+  // The union of the eyes' footprints: its outer loops (and any holes, clockwise).
+  json un = json::array();
+  if (feet.size() == 2)
+    for (const std::vector<Vec2>& loop : polygonUnion(feet[0].outline, feet[1].outline)) un.push_back(polygonJson(loop));
+  else
+    un.push_back(polygonJson(feet[0].outline));
+  fp["union"] = {{"polygons", un}};
   j["footprint"] = fp;
   j["zones"] = json::array();
   j["regulations"] = json::array();

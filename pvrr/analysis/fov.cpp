@@ -144,6 +144,64 @@ std::vector<Vec2> zoneInVehicle(const FovZone& z, const VehicleFrame& frame, dou
   return out;
 }
 
+std::vector<std::vector<Vec2>> polygonUnion(const std::vector<Vec2>& a, const std::vector<Vec2>& b) {
+  struct Piece {
+    Vec2 from, to;
+  };
+  // Every edge of `p` split at its crossings with the edges of `q`, keeping the pieces outside q.
+  auto outside = [](const std::vector<Vec2>& p, const std::vector<Vec2>& q, std::vector<Piece>& out) {
+    for (size_t i = 0; i < p.size(); ++i) {
+      const Vec2 s0 = p[i], s1 = p[(i + 1) % p.size()], d = s1 - s0;
+      std::vector<double> ts = {0, 1};
+      for (size_t j = 0; j < q.size(); ++j) {
+        const Vec2 e0 = q[j], e = q[(j + 1) % q.size()] - e0;
+        const double den = cross2(d, e);
+        if (den == 0) continue;
+        const double t = cross2(e0 - s0, e) / den, u = cross2(e0 - s0, d) / den;
+        if (t > 0 && t < 1 && u >= 0 && u <= 1) ts.push_back(t);
+      }
+      std::sort(ts.begin(), ts.end());
+      for (size_t k = 0; k + 1 < ts.size(); ++k) {
+        const Vec2 x0 = s0 + d * ts[k], x1 = s0 + d * ts[k + 1];
+        if (!insidePolygon(q, 0.5 * (x0 + x1))) out.push_back({x0, x1});
+      }
+    }
+  };
+  std::vector<Piece> pieces;
+  outside(a, b, pieces);
+  outside(b, a, pieces);
+  // Chain: each piece's end meets the start of the next (a crossing point is computed twice, once per
+  // polygon, so ends are matched to the nearest start within a tolerance of the polygons' size).
+  double extent = 0;
+  for (const Piece& pc : pieces) extent = std::max({extent, std::abs(pc.from.x), std::abs(pc.from.y)});
+  const double tol = 1e-9 * std::max(1.0, extent);
+  std::vector<bool> used(pieces.size(), false);
+  std::vector<std::vector<Vec2>> loops;
+  for (size_t start = 0; start < pieces.size(); ++start) {
+    if (used[start]) continue;
+    std::vector<Vec2> loop;
+    size_t cur = start;
+    while (!used[cur]) {
+      used[cur] = true;
+      loop.push_back(pieces[cur].from);
+      size_t next = pieces.size();
+      double best = tol;
+      for (size_t k = 0; k < pieces.size(); ++k) {
+        if (used[k] && k != start) continue;
+        const double dist = glm::length(pieces[k].from - pieces[cur].to);
+        if (dist <= best) {
+          best = dist;
+          next = k;
+        }
+      }
+      if (next == pieces.size() || next == start) break;
+      cur = next;
+    }
+    if (loop.size() >= 3) loops.push_back(loop);
+  }
+  return loops;
+}
+
 bool insidePolygon(const std::vector<Vec2>& poly, Vec2 p) {
   bool in = false;
   for (size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {

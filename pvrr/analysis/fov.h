@@ -122,6 +122,11 @@ struct SurfaceFigures {
 };
 SurfaceFigures surfaceFigures(const RayScene& rays, int element, const Vec3& eye_world, const FovOptions& options = {});
 
+// The union of two simple polygons as closed loops (no repeated last point), each counter-clockwise for an
+// outer boundary: the edges of each split where they cross the other's, those outside the other kept and
+// chained. Overlapping collinear edges are not handled (two eyes' footprints never share an edge).
+std::vector<std::vector<Vec2>> polygonUnion(const std::vector<Vec2>& a, const std::vector<Vec2>& b);
+
 // Inside test for a simple polygon (even-odd).
 bool insidePolygon(const std::vector<Vec2>& poly, Vec2 p);
 

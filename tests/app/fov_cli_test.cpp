@@ -36,6 +36,8 @@ TEST(FovCli, CarMirrorAgainstR46ClassIII) {
     EXPECT_GT(j["footprint"][eye]["polygon"].size(), 100u);
     EXPECT_GT(j["footprint"][eye]["road"].get<int>(), 0);
   }
+  ASSERT_GE(j["footprint"]["union"]["polygons"].size(), 1u);
+  EXPECT_GT(j["footprint"]["union"]["polygons"][0].size(), 100u);
   ASSERT_EQ(j["zones"].size(), 2u);  // the scene's default regulation: r46-class-iii, two zones
   for (const auto& z : j["zones"]) {
     EXPECT_EQ(z["regulation"], "r46-class-iii");

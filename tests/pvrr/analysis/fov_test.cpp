@@ -52,6 +52,8 @@ struct Fixture {
   VehicleFrame frame() const { return VehicleFrame(*desc.vehicle); }
 };
 
+double cross2d(Vec2 a, Vec2 b) { return a.x * b.y - a.y * b.x; }
+
 double segmentDistance(Vec2 p, Vec2 a, Vec2 b) {
   const Vec2 d = b - a;
   const double t = glm::dot(d, d) > 0 ? std::clamp(glm::dot(p - a, d) / glm::dot(d, d), 0.0, 1.0) : 0.0;
@@ -215,6 +217,31 @@ TEST(Fov, SurfaceFigures) {
   EXPECT_NEAR(got.x, m_s, kMagnificationTol);
   EXPECT_NEAR(got.y, m_t, kMagnificationTol);
   EXPECT_LT(s.magnification_max, 1);
+}
+
+double loopArea(const std::vector<Vec2>& p) {
+  double a = 0;
+  for (size_t i = 0; i < p.size(); ++i) a += cross2d(p[i], p[(i + 1) % p.size()]);
+  return 0.5 * a;
+}
+
+TEST(Fov, PolygonUnion) {
+  constexpr double kAreaTol = 1e-12;  // exact arithmetic on these coordinates but for rounding
+  const std::vector<Vec2> a = {Vec2(0, 0), Vec2(2, 0), Vec2(2, 2), Vec2(0, 2)};
+  const std::vector<Vec2> b = {Vec2(1, 1), Vec2(3, 1), Vec2(3, 3), Vec2(1, 3)};
+  const auto u = polygonUnion(a, b);
+  ASSERT_EQ(u.size(), 1u);
+  EXPECT_NEAR(loopArea(u[0]), 7, kAreaTol);
+  const std::vector<Vec2> far = {Vec2(5, 5), Vec2(6, 5), Vec2(6, 6), Vec2(5, 6)};
+  EXPECT_EQ(polygonUnion(a, far).size(), 2u);  // disjoint: both kept
+  // The two eyes' footprints of a plane mirror: one loop holding every vertex of both.
+  Fixture fx(sceneJson(R"({"type": "plane"})"));
+  const EyeFootprint l = traceFootprint(*fx.rays, 0, fx.frame(), kEyeL, "left");
+  const EyeFootprint r = traceFootprint(*fx.rays, 0, fx.frame(), kEyeR, "right");
+  const auto lr = polygonUnion(l.outline, r.outline);
+  ASSERT_EQ(lr.size(), 1u);
+  EXPECT_GE(loopArea(lr[0]), std::max(loopArea(l.outline), loopArea(r.outline)));
+  EXPECT_LE(loopArea(lr[0]), loopArea(l.outline) + loopArea(r.outline));
 }
 
 // A box across the reflected rays obstructs them; the same box not named in vehicle.obstructions does not.
