@@ -149,7 +149,8 @@ int cmdFov(const std::vector<std::string>& argv) {
   // The union of the eyes' footprints: its outer loops (and any holes, clockwise).
   json un = json::array();
   if (feet.size() == 2)
-    for (const std::vector<Vec2>& loop : polygonUnion(feet[0].outline, feet[1].outline)) un.push_back(polygonJson(loop));
+    for (const std::vector<Vec2>& loop : polygonUnion(feet[0].outline, feet[1].outline))
+      un.push_back(polygonJson(loop));
   else
     un.push_back(polygonJson(feet[0].outline));
   fp["union"] = {{"polygons", un}};
