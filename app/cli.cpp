@@ -80,6 +80,17 @@ const std::map<std::string, Command>& commands() {
         "  tangential_d,sagittal_d,prentice_h,prentice_v,object_x_deg,object_y_deg; empty cells where no ray passes),\n"
         "  DIR/lensmap.json (conventions, prescription, centre, ranges, empty gazes, focimeter reading) and maps as\n"
         "  PNG and SVG: power_error, cylinder, prism, lateral_colour, distortion. Conventions: docs/lensmap.md."}},
+      {"fov",
+       {cmdFov, "a mirror's field of view on the road, checked against regulation zones",
+        "pvrr fov SCENE [--element NAME] [--regulation ID]... [--eyes both|left|right] [--samples N]\n"
+        "         [--set PATH=VALUE]... --out DIR\n"
+        "  From each of the vehicle's ocular points (the scene's \"vehicle\" block), N x N rays (default 121) through\n"
+        "  the mirror, reflected exactly and continued to the road; the footprint per eye and the share of each\n"
+        "  regulation zone (models/regulations/ID.json; default: vehicle.regulations) covered and obstructed.\n"
+        "  Writes DIR/fov.json (element, eyes, footprint polygons in the vehicle frame, zones with\n"
+        "  covered_fraction, obstructed_fraction, pass, verified; surface: mean and principal radii, magnification\n"
+        "  range), the plan view DIR/fov.png and .svg, and the magnification map DIR/magnification.png and .svg.\n"
+        "  Conventions: docs/fov.md."}},
       {"mesh",
        {cmdMesh, "tessellate a surface and write it as OBJ, PLY or VTP",
         "pvrr mesh (SURFACE_FILE | SCENE --element NAME) [--tessellation N | --tolerance T] --out FILE.obj|.ply|.vtp"}},

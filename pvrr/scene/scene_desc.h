@@ -242,6 +242,30 @@ struct ObserverDesc {
   int image_width = 800, image_height = 600;
 };
 
+// The vehicle a mirror is mounted on (the `vehicle` block; pvrr fov): the frame the regulations' fields of
+// view are written in. World positions in metres. The vehicle frame (pvrr/analysis/fov.h) has its origin on
+// the road below the midpoint of the two ocular points, x forward, y to the left, z up.
+struct VehicleDesc {
+  enum class Side { Left, Right };
+  Vec3 forward{0, 0, -1};    // unit, perpendicular to up
+  Vec3 up{0, 1, 0};          // unit, the road's normal
+  double road_height_m = 0;  // the road plane: points p with dot(p, up) = road_height_m
+  // The outermost point of the vehicle on each side (world), and the driver's ocular points (world).
+  Vec3 outermost_left{0}, outermost_right{0};
+  Vec3 eye_left{0}, eye_right{0};
+  Side driver_side = Side::Left;
+  // Names of environment objects that obstruct the driver's view (the vehicle's own door, housing): a ray
+  // stopped first by one of them is obstructed. Rays stopped by the other environment objects (a following
+  // car, a building) are followed on to the road.
+  std::vector<std::string> obstructions;
+  // The regulations pvrr fov checks by default (ids of models/regulations/*.json).
+  std::vector<std::string> regulations;
+};
+inline constexpr NameTable<VehicleDesc::Side, 2> kVehicleSideNames = {
+    {{VehicleDesc::Side::Left, "left"}, {VehicleDesc::Side::Right, "right"}}};
+constexpr const NameTable<VehicleDesc::Side, 2>& nameTable(VehicleDesc::Side) { return kVehicleSideNames; }
+static_assert(namesAreUnique(kVehicleSideNames));
+
 struct SceneDesc {
   int version = 1;
   std::string source;    // the file name used in messages
@@ -254,6 +278,7 @@ struct SceneDesc {
   std::vector<LightDesc> lights;
   std::vector<ElementDesc> elements;
   RenderDesc render;
+  std::optional<VehicleDesc> vehicle;  // absent: no vehicle frame (pvrr fov needs one)
 };
 
 }  // namespace pvrr

@@ -934,9 +934,63 @@ RenderDesc readRender(const Ctx& c, const json* j, const std::string& source) {
   return r;
 }
 
+// The vehicle frame (pvrr fov). Checked here: up and forward perpendicular, the ocular points and outermost
+// points above the road, each left point to the left of its right one, obstructions naming environment objects.
+VehicleDesc readVehicle(const Ctx& c, const json* j, const std::vector<EnvObjectDesc>& environment) {
+  Obj o(c, j, "vehicle",
+        "an object {\"forward\", \"up\", \"road_height\", \"outermost\", \"ocular_points\", \"driver_side\", "
+        "\"obstructions\", \"regulations\"}",
+        {"forward", "up", "road_height", "outermost", "ocular_points", "driver_side", "obstructions", "regulations"});
+  VehicleDesc v;
+  v.up = o.vec3("up", VecKind::Direction);
+  v.forward = o.vec3("forward", VecKind::Direction);
+  if (std::abs(glm::dot(v.up, v.forward)) > std::sin(radians(0.1)))
+    o.expected("forward", "a direction perpendicular to vehicle.up (within 0.1 deg)");
+  v.forward = glm::normalize(v.forward - glm::dot(v.forward, v.up) * v.up);
+  v.road_height_m = o.length("road_height", kAny, 0);
+  const Vec3 left = glm::cross(v.up, v.forward);
+  auto pair = [&](const std::string& key, Vec3& l, Vec3& r) {
+    Obj p(c, o.get(key), o.at(key), "an object {\"left\": [x, y, z], \"right\": [x, y, z]}", {"left", "right"});
+    l = p.point("left");
+    r = p.point("right");
+    for (const auto& [side, q] : {std::pair<const char*, Vec3>{"left", l}, {"right", r}})
+      if (glm::dot(q, v.up) - v.road_height_m <= 0) p.expected(side, "a point above the road (vehicle.road_height)");
+    if (glm::dot(l - r, left) <= 0)
+      p.expected("left", "a point to the left of " + p.at("right") + " (seen facing vehicle.forward)");
+  };
+  pair("outermost", v.outermost_left, v.outermost_right);
+  pair("ocular_points", v.eye_left, v.eye_right);
+  v.driver_side = o.choice<VehicleDesc::Side>("driver_side");
+  if (const json* obs =
+          arrayAt(c, o.get("obstructions"), o.at("obstructions"), "an array of environment object names")) {
+    std::vector<std::string> names;
+    for (const EnvObjectDesc& e : environment) names.push_back(e.name);
+    for (size_t i = 0; i < obs->size(); ++i) {
+      const json& n = (*obs)[i];
+      const std::string path = indexPath(o.at("obstructions"), i);
+      if (!n.is_string() || std::find(names.begin(), names.end(), n.get<std::string>()) == names.end()) {
+        const std::string near = n.is_string() ? nearest(n.get<std::string>(), names) : "";
+        c.fail(path, "expected the name of an environment object, got " + show(&n) +
+                         (near.empty() ? "" : "; did you mean " + inQuotes(near) + "?"));
+      }
+      v.obstructions.push_back(n.get<std::string>());
+    }
+  } else {
+    for (const EnvObjectDesc& e : environment)
+      if (e.type != EnvObjectDesc::Type::Ground) v.obstructions.push_back(e.name);
+  }
+  if (const json* regs = arrayAt(c, o.get("regulations"), o.at("regulations"), "an array of regulation ids"))
+    for (size_t i = 0; i < regs->size(); ++i) {
+      if (!(*regs)[i].is_string() || (*regs)[i].get<std::string>().empty())
+        c.expected(indexPath(o.at("regulations"), i), "a regulation id (a string)", &(*regs)[i]);
+      v.regulations.push_back((*regs)[i].get<std::string>());
+    }
+  return v;
+}
+
 SceneDesc readScene(Ctx& c, const json& doc) {
   Obj top(c, &doc, "", "a JSON object (a scene)",
-          {"version", "units", "description", "observer", "environment", "lights", "elements", "render"});
+          {"version", "units", "description", "observer", "environment", "lights", "elements", "render", "vehicle"});
   SceneDesc s;
   {
     const json* v = top.get("version");
@@ -984,6 +1038,7 @@ SceneDesc readScene(Ctx& c, const json& doc) {
     }
   }
   s.render = readRender(c, top.get("render"), c.file);
+  if (top.has("vehicle")) s.vehicle = readVehicle(c, top.get("vehicle"), s.environment);
   return s;
 }
 
