@@ -161,7 +161,11 @@ void Viewer::frame() {
     rays_->updateElementPoses();
   }
   window_.context().makeCurrent();
-  const gl::RasterFrame f = renderer_->render(mode_, &cache_);
+  // A screenshot frame is drawn whole, every stage run (its own empty cache), so that it is what pvrr render
+  // draws of the saved view: frames that reuse earlier maps (map reuse, render.map_reuse_margin_deg) differ
+  // from a fresh frame in places, as they do in pvrr render --frames --orbit.
+  gl::FrameCache whole;
+  const gl::RasterFrame f = renderer_->render(mode_, pending_screenshots_.empty() ? &cache_ : &whole);
   cache_.environment_changed = false;  // the environment never changes while the window is open
   window_.present(renderer_->colorTexture(), ob.width, ob.height);
   if (!pending_screenshots_.empty()) {
