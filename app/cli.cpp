@@ -50,7 +50,8 @@ const std::map<std::string, Command>& commands() {
         "  F12 writes out/view-N.png, V out/view-N.json (a scene that pvrr render reproduces); Esc quits.\n"
         "  --script {\"size\":[w,h],\"events\":[{\"at_frame\":N,\"do\":...}]}, do one of: \"set\" (\"path\", \"value\": as --set),\n"
         "  \"turn_head\" (\"yaw_deg\", \"pitch_deg\": positive turns left, looks up), \"move_eye\" (\"by\": [x,y,z] metres in\n"
-        "  the observer frame: x right, y up, -z forward), \"screenshot\" (\"file\": PNG, the frame without the panel),\n"
+        "  the observer frame: x right, y up, -z forward), \"screenshot\" (\"file\": PNG, the frame without the panel,\n"
+        "  or with it: \"panel\": true),\n"
         "  \"save_view\" (\"file\": JSON), \"quit\".\n"
         "  --stats writes {\"frames\", \"fps_median\", \"frame_ms_median\", \"frame_ms_max\", \"mode\", \"size\", \"gl\"} at exit\n"
         "  (frame time: the whole loop, render, present, panel and swap)."}},

@@ -23,7 +23,7 @@ const std::map<std::string, std::pair<EventKind, std::vector<std::string>>>& kin
       {"set", {EventKind::Set, {"path", "value"}}},
       {"turn_head", {EventKind::TurnHead, {"yaw_deg", "pitch_deg"}}},
       {"move_eye", {EventKind::MoveEye, {"by"}}},
-      {"screenshot", {EventKind::Screenshot, {"file"}}},
+      {"screenshot", {EventKind::Screenshot, {"file", "panel"}}},
       {"save_view", {EventKind::SaveView, {"file"}}},
       {"quit", {EventKind::Quit, {}}},
   };
@@ -119,6 +119,10 @@ ScriptEvent readEvent(const Reader& r, const json& e, const std::string& path) {
       ev.file = r.text(r.need(e, path, "file"), path + ".file", "a PNG file name");
       if (ev.file.size() < 4 || ev.file.substr(ev.file.size() - 4) != ".png")
         r.expected(path + ".file", "a file name ending in \".png\"", e.at("file"));
+      if (e.contains("panel")) {
+        if (!e.at("panel").is_boolean()) r.expected(path + ".panel", "true or false", e.at("panel"));
+        ev.with_panel = e.at("panel").get<bool>();
+      }
       break;
     case EventKind::SaveView:
       ev.file = r.text(r.need(e, path, "file"), path + ".file", "a scene file name");

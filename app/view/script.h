@@ -21,6 +21,7 @@ struct ScriptEvent {
   double yaw_deg = 0, pitch_deg = 0;  // turn_head: positive yaw turns left, positive pitch looks up
   Vec3 by_m{0};                       // move_eye: metres in the observer frame (x right, y up, -z forward)
   std::string file;                   // screenshot, save_view
+  bool with_panel = false;            // screenshot: with the panel over the frame ("panel": true)
 };
 
 struct Script {

@@ -89,9 +89,11 @@ class Viewer {
   gl::FrameCache cache_;
 
   bool quit_ = false, show_panel_ = true;
-  std::vector<std::string> pending_screenshots_;
+  std::vector<std::string> pending_screenshots_, panel_screenshots_;
   int frames_ = 0, saved_ = 0;
   std::vector<double> frame_ms_;   // every frame, for --stats
+  // Where each frame's time went: the renderer's frame, presenting it, the panel, the swap and input.
+  std::vector<double> render_ms_, present_ms_, panel_ms_, swap_ms_;
   std::deque<double> recent_ms_;   // the last frames, for the panel
   bool dragging_ = false;
   double last_x_ = 0, last_y_ = 0;
@@ -131,7 +133,7 @@ void Viewer::runEvents() {
           break;
         case EventKind::TurnHead: turnHead(pose_, radians(e.yaw_deg), radians(e.pitch_deg)); break;
         case EventKind::MoveEye: moveEye(pose_, design_, e.by_m); break;
-        case EventKind::Screenshot: pending_screenshots_.push_back(e.file); break;
+        case EventKind::Screenshot: (e.with_panel ? panel_screenshots_ : pending_screenshots_).push_back(e.file); break;
         case EventKind::SaveView: saveViewTo(e.file); break;
         case EventKind::Quit: quit_ = true; break;
       }
@@ -167,7 +169,9 @@ void Viewer::frame() {
   gl::FrameCache whole;
   const gl::RasterFrame f = renderer_->render(mode_, pending_screenshots_.empty() ? &cache_ : &whole);
   cache_.environment_changed = false;  // the environment never changes while the window is open
+  const auto t_render = Clock::now();
   window_.present(renderer_->colorTexture(), ob.width, ob.height);
+  const auto t_present = Clock::now();
   if (!pending_screenshots_.empty()) {
     // Screenshots show the frame alone: taken before the panel is drawn over it.
     const ImageRGB8 img = window_.readBackBuffer(ob.width, ob.height);
@@ -178,6 +182,12 @@ void Viewer::frame() {
   const double shown_ms = recent_ms_.empty() ? f.frame_ms : recent_ms_.back();
   if (show_panel_) panel(f, shown_ms);
   window_.endPanel();
+  if (!panel_screenshots_.empty()) {
+    const ImageRGB8 img = window_.readBackBuffer(ob.width, ob.height);
+    for (const std::string& file : panel_screenshots_) writePngAtomic(file, img, MissingFolder::Create);
+    panel_screenshots_.clear();
+  }
+  const auto t_panel = Clock::now();
   window_.swapAndPoll();
 
   // Mouse-look: a left-button drag outside the panel turns the head.
@@ -191,6 +201,13 @@ void Viewer::frame() {
 
   const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   frame_ms_.push_back(ms);
+  const auto span = [](Clock::time_point a, Clock::time_point b) {
+    return std::chrono::duration<double, std::milli>(b - a).count();
+  };
+  render_ms_.push_back(span(t0, t_render));
+  present_ms_.push_back(span(t_render, t_present));
+  panel_ms_.push_back(span(t_present, t_panel));
+  swap_ms_.push_back(span(t_panel, Clock::now()));
   recent_ms_.push_back(ms);
   if (recent_ms_.size() > 60) recent_ms_.pop_front();
   ++frames_;
@@ -293,7 +310,7 @@ void Viewer::run() {
     if (quit_ || window_.closeRequested()) break;
     frame();
   }
-  if (!pending_screenshots_.empty()) frame();  // a screenshot asked for on the last frame
+  if (!pending_screenshots_.empty() || !panel_screenshots_.empty()) frame();  // asked for on the last frame
 }
 
 json Viewer::stats() const {
@@ -304,6 +321,13 @@ json Viewer::stats() const {
           {"frame_ms_median", med},
           {"frame_ms_max", t.empty() ? 0.0 : *std::max_element(t.begin(), t.end())},
           {"mode", nameOf(mode_)},
+          // Medians of the frame's parts (ms): the renderer's frame (as pvrr render times it, plus the head's
+          // update), presenting it, the panel (with any screenshot), and the swap with the input.
+          {"parts_ms_median",
+           {{"render", t.empty() ? 0.0 : median(render_ms_)},
+            {"present", t.empty() ? 0.0 : median(present_ms_)},
+            {"panel", t.empty() ? 0.0 : median(panel_ms_)},
+            {"swap", t.empty() ? 0.0 : median(swap_ms_)}}},
           {"size", {design_.width, design_.height}},
           {"gl", glName()}};
 }

@@ -8,7 +8,9 @@
 #include <backends/imgui_impl_opengl3.h>
 #include <imgui.h>
 
+#include <cstdint>
 #include <cstdlib>
+#include <vector>
 
 #include "pvrr/base/error.h"
 
@@ -18,7 +20,10 @@ namespace {
 std::string g_glfw_error;  // the last GLFW error, for the messages
 void onGlfwError(int code, const char* text) { g_glfw_error = std::string(text) + " (GLFW error " + std::to_string(code) + ")"; }
 
-// A full-screen triangle; each fragment copies its texel and encodes it as linearToSrgb (pvrr/base/image.h) does.
+// A full-screen triangle; each fragment copies its texel, encoded to sRGB through a table of linearToSrgb8
+// (pvrr/base/image.h) over the 65536 values of the renderer's 16-bit target (a float target is rounded to them
+// first: at most 1/131070 off, under 0.03 of a code). The table is exact where pow() in the shader was not, and
+// cheaper: three pow() a pixel cost llvmpipe about 10 ms at 1280 x 720 (docs/performance.md).
 constexpr const char* kPresentVs = R"(#version 330 core
 void main() {
   vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
@@ -26,10 +31,11 @@ void main() {
 })";
 constexpr const char* kPresentFs = R"(#version 330 core
 uniform sampler2D u_frame;
+uniform sampler2D u_srgb;  // 256 x 256 R8: texel (k & 255, k >> 8) holds the code of k / 65535
 out vec4 out_color;
 float encode(float c) {
-  c = clamp(c, 0.0, 1.0);
-  return c <= 0.0031308 ? 12.92 * c : 1.055 * pow(c, 1.0 / 2.4) - 0.055;
+  int k = int(clamp(c, 0.0, 1.0) * 65535.0 + 0.5);
+  return texelFetch(u_srgb, ivec2(k & 255, k >> 8), 0).r;
 }
 void main() {
   vec3 c = texelFetch(u_frame, ivec2(gl_FragCoord.xy), 0).rgb;
@@ -121,6 +127,15 @@ Window::Window(int width, int height, WindowGl api, bool vsync, const std::strin
   glGetProgramiv(program_, GL_LINK_STATUS, &ok);
   if (!ok) throw Error("pvrr view: the present program does not link");
   glGenVertexArrays(1, &vao_);
+  std::vector<std::uint8_t> table(65536);
+  for (size_t k = 0; k < table.size(); ++k) table[k] = linearToSrgb8(double(float(k) / 65535.0f));
+  glGenTextures(1, &srgb_table_);
+  glBindTexture(GL_TEXTURE_2D, srgb_table_);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_R8, 256, 256, 0, GL_RED, GL_UNSIGNED_BYTE, table.data());
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glBindTexture(GL_TEXTURE_2D, 0);
   gl::checkGlError("creating the present program");
 
   IMGUI_CHECKVERSION();
@@ -142,6 +157,7 @@ Window::~Window() {
     context_->makeCurrent();
     if (program_) glDeleteProgram(program_);
     if (vao_) glDeleteVertexArrays(1, &vao_);
+    if (srgb_table_) glDeleteTextures(1, &srgb_table_);
     context_.reset();
   }
   if (window_) glfwDestroyWindow(window_);
@@ -164,6 +180,10 @@ void Window::present(unsigned texture, int width, int height) {
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_2D, texture);
   glUniform1i(glGetUniformLocation(program_, "u_frame"), 0);
+  glActiveTexture(GL_TEXTURE1);
+  glBindTexture(GL_TEXTURE_2D, srgb_table_);
+  glUniform1i(glGetUniformLocation(program_, "u_srgb"), 1);
+  glActiveTexture(GL_TEXTURE0);
   glBindVertexArray(vao_);
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glBindVertexArray(0);

@@ -44,7 +44,7 @@ class Window {
  private:
   GLFWwindow* window_ = nullptr;
   std::unique_ptr<gl::GlContext> context_;
-  unsigned program_ = 0, vao_ = 0;
+  unsigned program_ = 0, vao_ = 0, srgb_table_ = 0;
   bool imgui_ = false;
 };
 
