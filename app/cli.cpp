@@ -28,7 +28,9 @@ const std::map<std::string, Command>& commands() {
        {cmdRender, "render a scene to PNG (default: models/car-mirror.json -> out/car-mirror.png)",
         "pvrr render [SCENE] [--mode pvrr|raster|envmap|impostor|raytrace] [--size WxH] [--out FILE.png]\n"
         "            [--gl auto|egl|osmesa] [--set PATH=VALUE]... [--stats FILE.json] [--frames N] [--orbit DEG]\n"
-        "  Renders SCENE (default models/car-mirror.json) and prints the output path and the frame time.\n"
+        "  Renders SCENE (default models/car-mirror.json) and prints the output path and the frame time: for one\n"
+        "  frame, the steady time (one more frame, not written, every stage run again) and the first, cold frame's\n"
+        "  (stats: frame_ms_steady, frame_ms_first).\n"
         "  --stats writes {\"frame_ms\", \"stages\":[{\"name\",\"ms\",\"ran\",\"reason\"}], \"elements\":[...]}.\n"
         "  --frames N renders N frames (the observer turning by --orbit DEG in total about the vertical axis\n"
         "  through the eye; elements attached to the observer turn with it) and reports per-stage counts\n"
