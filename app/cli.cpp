@@ -54,7 +54,7 @@ const std::map<std::string, Command>& commands() {
         "  \"turn_head\" (\"yaw_deg\", \"pitch_deg\": positive turns left, looks up), \"move_eye\" (\"by\": [x,y,z] metres in\n"
         "  the observer frame: x right, y up, -z forward), \"screenshot\" (\"file\": PNG, the frame without the panel,\n"
         "  or with it: \"panel\": true),\n"
-        "  \"save_view\" (\"file\": JSON), \"quit\".\n"
+        "  \"save_view\" (\"file\": JSON), \"key\" (\"key\": a GLFW key name of the keys above, \"shift\": true|false), \"quit\".\n"
         "  --stats writes {\"frames\", \"fps_median\", \"frame_ms_median\", \"frame_ms_max\", \"mode\", \"size\", \"gl\"} at exit\n"
         "  (frame time: the whole loop, render, present, panel and swap)."}},
       {"gl-info",

@@ -1,5 +1,7 @@
 #include "app/view/script.h"
 
+#define GLFW_INCLUDE_NONE  // the key codes only
+#include <GLFW/glfw3.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -26,11 +28,24 @@ const std::map<std::string, std::pair<EventKind, std::vector<std::string>>>& kin
       {"screenshot", {EventKind::Screenshot, {"file", "panel"}}},
       {"save_view", {EventKind::SaveView, {"file"}}},
       {"quit", {EventKind::Quit, {}}},
+      {"key", {EventKind::Key, {"key", "shift"}}},
   };
   return table;
 }
 // Issue 25's other events, not in this version yet: named so that a script using them is told so.
-const std::set<std::string> kLater = {"turn_element", "reference", "wipe", "overlay", "key", "drag"};
+const std::set<std::string> kLater = {"turn_element", "reference", "wipe", "overlay", "drag"};
+
+// The keys the viewer answers to, by their GLFW names (GLFW_KEY_<name>).
+const std::map<std::string, int>& keyCodes() {
+  static const std::map<std::string, int> table = {
+      {"W", GLFW_KEY_W},         {"A", GLFW_KEY_A},       {"S", GLFW_KEY_S},         {"D", GLFW_KEY_D},
+      {"R", GLFW_KEY_R},         {"F", GLFW_KEY_F},       {"H", GLFW_KEY_H},         {"V", GLFW_KEY_V},
+      {"1", GLFW_KEY_1},         {"2", GLFW_KEY_2},       {"3", GLFW_KEY_3},         {"4", GLFW_KEY_4},
+      {"LEFT", GLFW_KEY_LEFT},   {"RIGHT", GLFW_KEY_RIGHT}, {"UP", GLFW_KEY_UP},     {"DOWN", GLFW_KEY_DOWN},
+      {"HOME", GLFW_KEY_HOME},   {"TAB", GLFW_KEY_TAB},   {"F12", GLFW_KEY_F12},     {"ESCAPE", GLFW_KEY_ESCAPE},
+  };
+  return table;
+}
 
 std::string shown(const json& j) {
   std::string s = j.dump();
@@ -129,6 +144,24 @@ ScriptEvent readEvent(const Reader& r, const json& e, const std::string& path) {
       if (ev.file.size() < 5 || ev.file.substr(ev.file.size() - 5) != ".json")
         r.expected(path + ".file", "a file name ending in \".json\"", e.at("file"));
       break;
+    case EventKind::Key: {
+      const std::string name = r.text(r.need(e, path, "key"), path + ".key", "a GLFW key name");
+      const auto k = keyCodes().find(name);
+      if (k == keyCodes().end()) {
+        std::string names;
+        std::vector<std::string> all;
+        for (const auto& [n, code] : keyCodes()) names += (names.empty() ? "" : ", ") + n, all.push_back(n);
+        const std::string hint = nearest(name, all);
+        r.fail(path + ".key", "expected one of " + names + ", got \"" + name + "\"" +
+                                  (hint.empty() ? std::string() : "; did you mean \"" + hint + "\"?"));
+      }
+      ev.key = k->second;
+      if (e.contains("shift")) {
+        if (!e.at("shift").is_boolean()) r.expected(path + ".shift", "true or false", e.at("shift"));
+        ev.shift = e.at("shift").get<bool>();
+      }
+      break;
+    }
     case EventKind::Quit: break;
   }
   return ev;

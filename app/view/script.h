@@ -10,7 +10,7 @@
 
 namespace pvrr::app::view {
 
-enum class EventKind { Set, TurnHead, MoveEye, Screenshot, SaveView, Quit };
+enum class EventKind { Set, TurnHead, MoveEye, Screenshot, SaveView, Quit, Key };
 
 struct ScriptEvent {
   int at_frame = 0;
@@ -22,6 +22,8 @@ struct ScriptEvent {
   Vec3 by_m{0};                       // move_eye: metres in the observer frame (x right, y up, -z forward)
   std::string file;                   // screenshot, save_view
   bool with_panel = false;            // screenshot: with the panel over the frame ("panel": true)
+  int key = 0;                        // key: the GLFW key code of "key" (a GLFW key name: "W", "LEFT", "HOME")
+  bool shift = false;                 // key: with Shift held ("shift": true)
 };
 
 struct Script {

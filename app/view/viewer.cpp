@@ -1,8 +1,6 @@
 #include "app/view/viewer.h"
 
-#include "pvrr/gl/gl.h"  // glad before GLFW (window.h includes no GL)
-
-#define GLFW_INCLUDE_NONE
+#define GLFW_INCLUDE_NONE  // no GL header: the viewer itself makes no GL call
 #include <GLFW/glfw3.h>
 #include <imgui.h>
 #include <nlohmann/json.hpp>
@@ -64,6 +62,11 @@ class Viewer {
   void frame();
   void panel(const gl::RasterFrame& f, double frame_ms);
   void onKey(int key, int action, int mods);
+  void setMode(RenderMode m) {
+    if (m == mode_) return;
+    mode_ = m;
+    cache_ = gl::FrameCache{};  // the cache holds the last mode's maps
+  }
   void screenshot(const std::string& file);
   void saveViewTo(const std::string& file);
   std::string glName() const {
@@ -136,6 +139,7 @@ void Viewer::runEvents() {
         case EventKind::Screenshot: (e.with_panel ? panel_screenshots_ : pending_screenshots_).push_back(e.file); break;
         case EventKind::SaveView: saveViewTo(e.file); break;
         case EventKind::Quit: quit_ = true; break;
+        case EventKind::Key: onKey(e.key, GLFW_PRESS, e.shift ? GLFW_MOD_SHIFT : 0); break;  // the keyboard's path
       }
     } catch (const Error& err) {
       throw Error(script_path_ + ": " + e.where + ": " + err.what());
@@ -226,10 +230,7 @@ void Viewer::panel(const gl::RasterFrame& f, double frame_ms) {
   ImGui::Text("mode:");
   for (RenderMode m : {RenderMode::Pvrr, RenderMode::Envmap, RenderMode::Impostor, RenderMode::Raster}) {
     ImGui::SameLine();
-    if (ImGui::RadioButton(nameOf(m), mode_ == m) && mode_ != m) {
-      mode_ = m;
-      cache_ = gl::FrameCache{};
-    }
+    if (ImGui::RadioButton(nameOf(m), mode_ == m)) setMode(m);
   }
   const Observer& ob = ls_.scene.observer;
   ImGui::Text("eye [%.3f, %.3f, %.3f] m, head yaw %.1f, pitch %.1f deg", ob.eye.x, ob.eye.y, ob.eye.z,
@@ -287,10 +288,10 @@ void Viewer::onKey(int key, int action, int mods) {
     case GLFW_KEY_DOWN: turnHead(pose_, 0, -turn); break;
     case GLFW_KEY_HOME:
     case GLFW_KEY_H: pose_ = HeadPose{}; break;
-    case GLFW_KEY_1: mode_ = RenderMode::Pvrr, cache_ = {}; break;
-    case GLFW_KEY_2: mode_ = RenderMode::Envmap, cache_ = {}; break;
-    case GLFW_KEY_3: mode_ = RenderMode::Impostor, cache_ = {}; break;
-    case GLFW_KEY_4: mode_ = RenderMode::Raster, cache_ = {}; break;
+    case GLFW_KEY_1: setMode(RenderMode::Pvrr); break;
+    case GLFW_KEY_2: setMode(RenderMode::Envmap); break;
+    case GLFW_KEY_3: setMode(RenderMode::Impostor); break;
+    case GLFW_KEY_4: setMode(RenderMode::Raster); break;
     case GLFW_KEY_TAB: show_panel_ = !show_panel_; break;
     case GLFW_KEY_F12: pending_screenshots_.push_back("out/view-" + std::to_string(++saved_) + ".png"); break;
     case GLFW_KEY_V: saveViewTo("out/view-" + std::to_string(++saved_) + ".json"); break;

@@ -51,8 +51,8 @@ TEST(ViewScript, ReadsEveryEventInFrameOrder) {
 }
 
 TEST(ViewScript, ErrorsNameTheFileAndTheJsonPath) {
-  EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "fly"}]})"),
-            "s.json: events[0].do: expected one of move_eye, quit, save_view, screenshot, set, turn_head, got \"fly\"");
+  EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "teleport"}]})"),
+            "s.json: events[0].do: expected one of key, move_eye, quit, save_view, screenshot, set, turn_head, got \"teleport\"");
   EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "quit"}, {"at_frame": -1, "do": "quit"}]})"),
             "s.json: events[1].at_frame: expected a frame number >= 0, got -1");
   EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "turn_head", "yaw_dg": 3}]})"),
@@ -63,8 +63,12 @@ TEST(ViewScript, ErrorsNameTheFileAndTheJsonPath) {
             "s.json: events[0].file: expected a file name ending in \".png\", got \"a.jpg\"");
   EXPECT_EQ(errorOf(R"({"size": [320], "events": []})"), "s.json: size: expected [width, height] in pixels, got [320]");
   EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "wipe", "x": 0.5}]})"),
-            "s.json: events[0].do: \"wipe\" is not implemented yet (implemented: move_eye, quit, save_view, screenshot, "
-            "set, turn_head)");
+            "s.json: events[0].do: \"wipe\" is not implemented yet (implemented: key, move_eye, quit, save_view, "
+            "screenshot, set, turn_head)");
+  EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "key", "key": "HOM"}]})").substr(0, 32),
+            "s.json: events[0].key: expected ");
+  EXPECT_NE(errorOf(R"({"events": [{"at_frame": 1, "do": "key", "key": "HOM"}]})").find("did you mean \"HOME\"?"),
+            std::string::npos);
   EXPECT_EQ(errorOf("{\"events\": [\n  {\"at_frame\": 1,}]}"), "s.json:2:18: syntax error: syntax error while parsing object key - unexpected '}'; expected string literal");
   EXPECT_EQ(errorOf(R"({"size": [320, 240]})"), "s.json: (top level): missing \"events\"");
 }

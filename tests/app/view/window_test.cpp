@@ -117,6 +117,36 @@ TEST(ViewWindow, SpectacleLensTurnsWithTheHeadAndMatchesRender) {
                                   {"at_frame": 4, "do": "move_eye", "by": [0.01, 0, 0]})");
 }
 
+// Keys go through the keyboard's path: Left turns the head 1 degree, as turn_head does; H returns to the design
+// eye point.
+TEST(ViewWindow, KeysTurnTheHeadAndReturnToTheDesignEye) {
+  const fs::path dir = freshTestDir("view-keys");
+  const fs::path script = dir / "script.json", by_key = dir / "key.png", by_turn = dir / "turn.png",
+                 home = dir / "home.png", start = dir / "start.png";
+  writeText(script, R"({"size": [256, 192], "events": [
+      {"at_frame": 1, "do": "screenshot", "file": ")" + start.string() + R"("},
+      {"at_frame": 2, "do": "key", "key": "LEFT"},
+      {"at_frame": 3, "do": "screenshot", "file": ")" + by_key.string() + R"("},
+      {"at_frame": 4, "do": "key", "key": "W", "shift": true},
+      {"at_frame": 4, "do": "key", "key": "UP"},
+      {"at_frame": 5, "do": "key", "key": "H"},
+      {"at_frame": 6, "do": "screenshot", "file": ")" + home.string() + R"("},
+      {"at_frame": 7, "do": "quit"}]})");
+  CliResult r;
+  RUN_VIEW_OR_SKIP("models/plane-mirror.json --script '" + script.string() + "'", &r);
+  ASSERT_EQ(r.code, 0) << r.err;
+  writeText(script, R"({"size": [256, 192], "events": [
+      {"at_frame": 2, "do": "turn_head", "yaw_deg": 1},
+      {"at_frame": 3, "do": "screenshot", "file": ")" + by_turn.string() + R"("},
+      {"at_frame": 4, "do": "quit"}]})");
+  RUN_VIEW_OR_SKIP("models/plane-mirror.json --script '" + script.string() + "'", &r);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(compareImages(readPng(by_key.string()), readPng(by_turn.string()), 0).failing_pixels, 0);
+  EXPECT_GT(compareImages(readPng(by_key.string()), readPng(start.string()), 0).failing_pixels, 0);  // it turned
+  EXPECT_EQ(compareImages(readPng(home.string()), readPng(start.string()), 0).failing_pixels, 0);
+  fs::remove_all(dir);
+}
+
 // "set" rebuilds the scene: a mode change by script shows that mode's picture.
 TEST(ViewWindow, SetChangesTheModeLive) {
   const fs::path dir = freshTestDir("view-set");
