@@ -33,7 +33,8 @@ bool runView(const std::string& args, CliResult* r, std::string* why) {
     *r = runPvrr("view " + args);
     return true;
   }
-  {  // the virtual screen is larger than any window the tests open
+  // Parallel tests may race for a display number (xvfb-run -a): a few tries before giving up.
+  for (int attempt = 0; attempt < 3; ++attempt) {  // the virtual screen is larger than any window the tests open
     const std::string cmd = "cd '" PVRR_SOURCE_DIR "' && xvfb-run -a -s '-screen 0 1600x1000x24' '" PVRR_BINARY
                             "' view " + args;
     static int n = 0;
@@ -48,12 +49,10 @@ bool runView(const std::string& args, CliResult* r, std::string* why) {
     r->err = se.str();
     fs::remove(out.string() + ".out");
     fs::remove(out.string() + ".err");
-    if (r->err.find("Xvfb failed to start") != std::string::npos) {
-      *why = "xvfb-run could not start Xvfb: " + r->err;
-      return false;
-    }
+    if (r->err.find("Xvfb failed to start") == std::string::npos) return true;
   }
-  return true;
+  *why = "xvfb-run could not start Xvfb (3 tries): " + r->err;
+  return false;
 }
 
 void writeText(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
