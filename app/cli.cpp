@@ -9,6 +9,7 @@
 
 #include "app/args.h"
 #include "app/commands.h"
+#include "app/view/viewer.h"
 #include "pvrr/base/atomic_file.h"
 #include "pvrr/base/error.h"
 
@@ -28,7 +29,9 @@ const std::map<std::string, Command>& commands() {
        {cmdRender, "render a scene to PNG (default: models/car-mirror.json -> out/car-mirror.png)",
         "pvrr render [SCENE] [--mode pvrr|raster|envmap|impostor|raytrace] [--size WxH] [--out FILE.png]\n"
         "            [--gl auto|egl|osmesa] [--set PATH=VALUE]... [--stats FILE.json] [--frames N] [--orbit DEG]\n"
-        "  Renders SCENE (default models/car-mirror.json) and prints the output path and the frame time.\n"
+        "  Renders SCENE (default models/car-mirror.json) and prints the output path and the frame time: for one\n"
+        "  frame, the steady time (one more frame, not written, every stage run again) and the first, cold frame's\n"
+        "  (stats: frame_ms_steady, frame_ms_first).\n"
         "  --stats writes {\"frame_ms\", \"stages\":[{\"name\",\"ms\",\"ran\",\"reason\"}], \"elements\":[...]}.\n"
         "  --frames N renders N frames (the observer turning by --orbit DEG in total about the vertical axis\n"
         "  through the eye; elements attached to the observer turn with it) and reports per-stage counts\n"
@@ -39,6 +42,22 @@ const std::map<std::string, Command>& commands() {
         "  inside it (render.map_reuse_margin_deg).\n"
         "  The stats' \"memory\" holds the resident memory after frame 100 (the first frame when N < 100), at\n"
         "  the end, their difference (rss_growth_mb), the peak, and 20 samples over the run."}},
+      {"view",
+       {cmdView, "open a design-review window: the scene live, head and eye moved by mouse and keys",
+        "pvrr view [SCENE] [--mode pvrr|raster|envmap|impostor] [--gl auto|glx|egl] [--size WxH] [--set PATH=VALUE]...\n"
+        "          [--script FILE.json] [--stats FILE.json]\n"
+        "  Opens a window (an X display; under xvfb-run without one) rendering SCENE (default models/car-mirror.json)\n"
+        "  every frame with the same renderer as pvrr render, and a panel with the frame time, fps and each stage's\n"
+        "  time or why it was skipped. Keys: drag or arrows turn the head about the eye; W/S, A/D, R/F move the eye\n"
+        "  (1 cm; Shift 10 cm); Home or H returns to the design eye point; 1-4 choose the mode; Tab hides the panel;\n"
+        "  F12 writes out/view-N.png, V out/view-N.json (a scene that pvrr render reproduces); Esc quits.\n"
+        "  --script {\"size\":[w,h],\"events\":[{\"at_frame\":N,\"do\":...}]}, do one of: \"set\" (\"path\", \"value\": as --set),\n"
+        "  \"turn_head\" (\"yaw_deg\", \"pitch_deg\": positive turns left, looks up), \"move_eye\" (\"by\": [x,y,z] metres in\n"
+        "  the observer frame: x right, y up, -z forward), \"screenshot\" (\"file\": PNG, the frame without the panel,\n"
+        "  or with it: \"panel\": true),\n"
+        "  \"save_view\" (\"file\": JSON), \"key\" (\"key\": a GLFW key name of the keys above, \"shift\": true|false), \"quit\".\n"
+        "  --stats writes {\"frames\", \"fps_median\", \"frame_ms_median\", \"frame_ms_max\", \"mode\", \"size\", \"gl\"} at exit\n"
+        "  (frame time: the whole loop, render, present, panel and swap)."}},
       {"gl-info",
        {cmdGlInfo, "print the GL backend, GL_VERSION and GL_RENDERER",
         "pvrr gl-info [--gl auto|egl|osmesa]\n  The backend can also be chosen with the PVRR_GL variable."}},

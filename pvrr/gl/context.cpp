@@ -123,15 +123,7 @@ std::unique_ptr<GlContext> GlContext::create(GlBackend requested, int major, int
         std::unique_ptr<GlContext> context(new GlContext(factory(maj, min)));
         t_current = context.get();
         context->loadEntryPoints();
-        context->gl_version_ = glString(GL_VERSION);
-        context->gl_renderer_ = glString(GL_RENDERER);
-        context->gl_vendor_ = glString(GL_VENDOR);
-        context->glsl_version_ = glString(GL_SHADING_LANGUAGE_VERSION);
-        glGetIntegerv(GL_MAJOR_VERSION, &context->gl_major_);
-        glGetIntegerv(GL_MINOR_VERSION, &context->gl_minor_);
-        if (context->gl_major_ * 10 + context->gl_minor_ < kGlFloorMajor * 10 + kGlFloorMinor) {
-          throw Error("context reports GL_VERSION \"" + context->gl_version_ + "\", below the 3.3 floor");
-        }
+        context->queryStrings();
         context->is_hardware_ =
             context->backend_->deviceIsHardware() && !containsSoftwareRasteriser(context->gl_renderer_);
         checkGlError("GL context creation");
@@ -156,6 +148,56 @@ std::unique_ptr<GlContext> GlContext::create(GlBackend requested, int major, int
     }
   }
   throw Error("could not create an OpenGL context (--gl " + glBackendName(requested) + "); tried:" + failures.str());
+}
+
+void GlContext::queryStrings() {
+  gl_version_ = glString(GL_VERSION);
+  gl_renderer_ = glString(GL_RENDERER);
+  gl_vendor_ = glString(GL_VENDOR);
+  glsl_version_ = glString(GL_SHADING_LANGUAGE_VERSION);
+  glGetIntegerv(GL_MAJOR_VERSION, &gl_major_);
+  glGetIntegerv(GL_MINOR_VERSION, &gl_minor_);
+  if (gl_major_ * 10 + gl_minor_ < kGlFloorMajor * 10 + kGlFloorMinor) {
+    throw Error("context reports GL_VERSION \"" + gl_version_ + "\", below the 3.3 floor");
+  }
+}
+
+namespace {
+
+// A context made by someone else (GlContext::adopt): its owner's callbacks make it current and release it.
+class ForeignBackend final : public detail::ContextBackend {
+ public:
+  explicit ForeignBackend(ForeignContext f) : f_(std::move(f)) {}
+  void makeCurrent() override { f_.make_current(); }
+  void releaseCurrent() noexcept override {
+    if (f_.release_current) f_.release_current();
+  }
+  GLADloadfunc loader() const override { return reinterpret_cast<GLADloadfunc>(f_.get_proc_address); }
+  std::string backendName() const override { return f_.backend_name; }
+  bool deviceIsHardware() const override { return true; }  // decided by the renderer string alone
+
+ private:
+  ForeignContext f_;
+};
+
+}  // namespace
+
+std::unique_ptr<GlContext> GlContext::adopt(ForeignContext foreign) {
+  if (!foreign.make_current || !foreign.get_proc_address) {
+    throw Error("GlContext::adopt: " + foreign.backend_name + ": no make-current callback or entry-point loader");
+  }
+  if (t_current != nullptr) {
+    t_current->backend_->releaseCurrent();
+    t_current = nullptr;
+  }
+  std::unique_ptr<GlContext> context(new GlContext(std::make_unique<ForeignBackend>(std::move(foreign))));
+  context->backend_->makeCurrent();
+  t_current = context.get();
+  context->loadEntryPoints();
+  context->queryStrings();
+  context->is_hardware_ = !containsSoftwareRasteriser(context->gl_renderer_);
+  checkGlError("adopting a GL context");
+  return context;
 }
 
 void GlContext::makeCurrent() {

@@ -1,9 +1,12 @@
 // Headless OpenGL contexts: EGL (a GPU device, Mesa's software device, or surfaceless Mesa) and OSMesa, chosen at
 // run time. There is no default framebuffer to draw into: all rendering goes to a pvrr::gl::Framebuffer.
+// A third kind is adopted, not created: a context someone else made (a window's, `pvrr view`), which the
+// renderer draws into the same way (GlContext::adopt).
 //
 // Threading: GL entry points are process-wide (glad), so use GL from one thread at a time; makeCurrent() reloads
 // them whenever a different context becomes current.
 #pragma once
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -31,12 +34,25 @@ GlBackend glBackendFromEnvironment(GlBackend fallback = GlBackend::Auto);
 inline constexpr int kGlFloorMajor = 3;
 inline constexpr int kGlFloorMinor = 3;
 
+// A context pvrr did not create (a window toolkit's), for GlContext::adopt. pvrr never destroys it.
+struct ForeignContext {
+  using Proc = void (*)();
+  std::string backend_name;              // what backendName() reports, e.g. "glfw-glx"
+  std::function<void()> make_current;    // makes it current on this thread (throws pvrr::Error on failure)
+  std::function<void()> release_current; // detaches it from this thread; never throws
+  Proc (*get_proc_address)(const char* name) = nullptr;  // the entry-point loader while it is current
+};
+
 class GlContext {
  public:
   // Creates a core-profile context of version major.minor (falling back to 3.3 core where that fails), makes it
   // current on this thread and loads the GL entry points. Throws pvrr::Error listing every path tried and why
   // each failed (the step and the EGL error name, e.g. "eglCreateContext: EGL_BAD_MATCH").
   static std::unique_ptr<GlContext> create(GlBackend requested, int major = 4, int minor = 5);
+
+  // Wraps a context that is current on this thread (a window's): loads the GL entry points from it and reads
+  // its strings. Throws pvrr::Error when it is below the 3.3 core floor or no entry points load.
+  static std::unique_ptr<GlContext> adopt(ForeignContext foreign);
 
   ~GlContext();
   GlContext(const GlContext&) = delete;
@@ -67,6 +83,7 @@ class GlContext {
  private:
   explicit GlContext(std::unique_ptr<detail::ContextBackend> backend);
   void loadEntryPoints();
+  void queryStrings();  // GL_VERSION etc. of the current context; throws below the floor
 
   std::unique_ptr<detail::ContextBackend> backend_;
   std::string backend_name_, gl_version_, gl_renderer_, gl_vendor_, glsl_version_, creation_notes_;

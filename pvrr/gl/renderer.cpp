@@ -120,6 +120,7 @@ RasterFrame Renderer::render(RenderMode mode, FrameCache* cache) {
   return impl_->render(mode, cache);
 }
 void Renderer::setReadBack(bool on) { impl_->options.read_back = on; }
+unsigned Renderer::colorTexture() const { return impl_->frame_target ? impl_->frame_target->colorTexture(0) : 0u; }
 
 RasterFrame Renderer::Impl::render(RenderMode mode, FrameCache* cache) {
   const auto frame_start = Clock::now();

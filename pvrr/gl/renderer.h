@@ -99,6 +99,10 @@ class Renderer {
   RasterFrame render(RenderMode mode, FrameCache* cache = nullptr);
   // RendererOptions::read_back for the next frames (e.g. only the last of a run is written out).
   void setReadBack(bool on);
+  // The GL texture holding the last frame's linear colour (0 before the first frame), for a window to present
+  // without a readback: GL_TEXTURE_2D of the frame's size, rows bottom-up as GL stores them, RGBA16 or RGBA32F
+  // (RendererOptions::seen_points). Valid until the next render() in the renderer's context.
+  unsigned colorTexture() const;
 
  private:
   struct Impl;

@@ -1,0 +1,38 @@
+// Scripted runs of `pvrr view` (--script FILE.json), for tests and demos:
+//   {"size": [w, h], "events": [{"at_frame": N, "do": ..., ...}, ...]}
+// Each event runs before frame N is drawn (frames count from 0). Parsed and validated whole before the window
+// opens; every problem throws pvrr::Error "<file>: <json.path>: <message>" (syntax: "<file>:LINE:COL: ...").
+#pragma once
+#include <string>
+#include <vector>
+
+#include "pvrr/base/math.h"
+
+namespace pvrr::app::view {
+
+enum class EventKind { Set, TurnHead, MoveEye, Screenshot, SaveView, Quit, Key };
+
+struct ScriptEvent {
+  int at_frame = 0;
+  EventKind kind = EventKind::Quit;
+  std::string where;  // "events[3]", for messages about the event at run time
+  // set: a scene path as --set takes it and its value as JSON text ("render.mode", "\"envmap\"").
+  std::string path, value_json;
+  double yaw_deg = 0, pitch_deg = 0;  // turn_head: positive yaw turns left, positive pitch looks up
+  Vec3 by_m{0};                       // move_eye: metres in the observer frame (x right, y up, -z forward)
+  std::string file;                   // screenshot, save_view
+  bool with_panel = false;            // screenshot: with the panel over the frame ("panel": true)
+  int key = 0;                        // key: the GLFW key code of "key" (a GLFW key name: "W", "LEFT", "HOME")
+  bool shift = false;                 // key: with Shift held ("shift": true)
+};
+
+struct Script {
+  int width = 0, height = 0;  // 0: not given
+  std::vector<ScriptEvent> events;  // in the order they run (by at_frame, then file order)
+};
+
+// `name` prefixes every message.
+Script parseScript(const std::string& json_text, const std::string& name);
+Script loadScript(const std::string& path);
+
+}  // namespace pvrr::app::view

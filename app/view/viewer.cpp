@@ -1,0 +1,378 @@
+#include "app/view/viewer.h"
+
+#define GLFW_INCLUDE_NONE  // no GL header: the viewer itself makes no GL call
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <deque>
+#include <optional>
+
+#include "app/args.h"
+#include "app/commands.h"
+#include "app/report.h"
+#include "app/view/head.h"
+#include "app/view/save_view.h"
+#include "app/view/script.h"
+#include "app/view/window.h"
+#include "pvrr/analysis/accuracy.h"
+#include "pvrr/base/error.h"
+#include "pvrr/base/format.h"
+#include "pvrr/scene/scene_json.h"
+
+namespace pvrr::app {
+namespace view {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using nlohmann::json;
+
+// Eye steps (metres) and head turns (degrees) of one key press; Shift multiplies by kFast.
+constexpr double kEyeStepM = 0.01, kTurnStepDeg = 1.0, kFast = 10.0;
+// Mouse-look: degrees of head turn per pixel of drag.
+constexpr double kLookDegPerPixel = 0.1;
+
+class Viewer {
+ public:
+  Viewer(Window& window, std::string scene_path, std::vector<std::string> overrides, std::optional<RenderMode> mode,
+         int width, int height, std::string script_path, Script script)
+      : window_(window), scene_path_(std::move(scene_path)), overrides_(std::move(overrides)), cli_mode_(mode),
+        width_(width), height_(height), script_path_(std::move(script_path)), script_(std::move(script)) {
+    glfwSetWindowUserPointer(window_.handle(), this);
+    glfwSetKeyCallback(window_.handle(), [](GLFWwindow* w, int key, int, int action, int mods) {
+      static_cast<Viewer*>(glfwGetWindowUserPointer(w))->onKey(key, action, mods);
+    });
+    rebuild();
+  }
+  ~Viewer() {
+    window_.context().makeCurrent();  // GL objects go while their context is current
+    renderer_.reset();
+    glfwSetKeyCallback(window_.handle(), nullptr);
+  }
+
+  void run();
+  json stats() const;
+
+ private:
+  void rebuild();
+  void runEvents();
+  void frame();
+  void panel(const gl::RasterFrame& f, double frame_ms);
+  void onKey(int key, int action, int mods);
+  void setMode(RenderMode m) {
+    if (m == mode_) return;
+    mode_ = m;
+    cache_ = gl::FrameCache{};  // the cache holds the last mode's maps
+  }
+  void screenshot(const std::string& file);
+  void saveViewTo(const std::string& file);
+  std::string glName() const {
+    return window_.context().backendName() + " (" + window_.context().glRenderer() + ")";
+  }
+
+  Window& window_;
+  std::string scene_path_;
+  std::vector<std::string> overrides_;  // --set, then the script's "set" events
+  std::optional<RenderMode> cli_mode_;
+  int width_, height_;
+  std::string script_path_;
+  Script script_;
+  size_t next_event_ = 0;
+
+  LoadedScene ls_;
+  Observer design_;  // the scene's observer: the design eye point
+  HeadPose pose_;
+  RenderMode mode_ = RenderMode::Pvrr;
+  bool any_attached_ = false;
+  std::unique_ptr<RayScene> rays_;
+  std::unique_ptr<gl::Renderer> renderer_;
+  gl::FrameCache cache_;
+
+  bool quit_ = false, show_panel_ = true;
+  std::vector<std::string> pending_screenshots_, panel_screenshots_;
+  int frames_ = 0, saved_ = 0;
+  std::vector<double> frame_ms_;   // every frame, for --stats
+  // Where each frame's time went: the renderer's frame, presenting it, the panel, the swap and input.
+  std::vector<double> render_ms_, present_ms_, panel_ms_, swap_ms_;
+  std::deque<double> recent_ms_;   // the last frames, for the panel
+  bool dragging_ = false;
+  double last_x_ = 0, last_y_ = 0;
+};
+
+void Viewer::rebuild() {
+  window_.context().makeCurrent();
+  renderer_.reset();
+  rays_.reset();
+  ls_ = loadScene(scene_path_, overrides_, width_, height_);
+  design_ = ls_.scene.observer;
+  mode_ = cli_mode_ ? *cli_mode_ : ls_.scene.render.mode;
+  if (!isRasterMode(mode_))
+    throw Error("pvrr view: mode " + std::string(nameOf(mode_)) + " is not a live mode; expected one of " +
+                nameListIf<RenderMode>(isRasterMode));
+  any_attached_ = std::any_of(ls_.scene.elements.begin(), ls_.scene.elements.end(),
+                              [](const Element& e) { return e.attached_to_observer; });
+  RaySceneOptions ro;
+  ro.moving_elements = any_attached_;  // the head moves them
+  rays_ = std::make_unique<RayScene>(ls_.scene, ro);
+  gl::RendererOptions opt = gl::rendererOptionsFor(ls_.scene);
+  opt.seen_points = false;  // the picture only, as pvrr render draws it
+  opt.read_back = false;    // presented from the GPU
+  renderer_ = std::make_unique<gl::Renderer>(ls_.scene, *rays_, opt);
+  cache_ = gl::FrameCache{};
+}
+
+void Viewer::runEvents() {
+  while (next_event_ < script_.events.size() && script_.events[next_event_].at_frame <= frames_) {
+    const ScriptEvent& e = script_.events[next_event_++];
+    try {
+      switch (e.kind) {
+        case EventKind::Set:
+          overrides_.push_back(e.path + "=" + e.value_json);
+          if (e.path.rfind("render.mode", 0) == 0) cli_mode_.reset();
+          rebuild();
+          break;
+        case EventKind::TurnHead: turnHead(pose_, radians(e.yaw_deg), radians(e.pitch_deg)); break;
+        case EventKind::MoveEye: moveEye(pose_, design_, e.by_m); break;
+        case EventKind::Screenshot: (e.with_panel ? panel_screenshots_ : pending_screenshots_).push_back(e.file); break;
+        case EventKind::SaveView: saveViewTo(e.file); break;
+        case EventKind::Quit: quit_ = true; break;
+        case EventKind::Key: onKey(e.key, GLFW_PRESS, e.shift ? GLFW_MOD_SHIFT : 0); break;  // the keyboard's path
+      }
+    } catch (const Error& err) {
+      throw Error(script_path_ + ": " + e.where + ": " + err.what());
+    }
+    if (quit_) return;
+  }
+}
+
+void Viewer::frame() {
+  int fw = 0, fh = 0;
+  window_.framebufferSize(&fw, &fh);
+  if (fw > 0 && fh > 0 && (fw != design_.width || fh != design_.height)) {
+    // The window was resized: the picture follows it (the maps are sized from the picture).
+    design_.width = width_ = fw;
+    design_.height = height_ = fh;
+    cache_ = gl::FrameCache{};
+  }
+  const auto t0 = Clock::now();
+  const Observer ob = headObserver(design_, pose_);
+  Observer& current = ls_.scene.observer;
+  const bool moved = ob.eye != current.eye || ob.target != current.target;
+  current = ob;
+  if (moved && any_attached_) {
+    updateAttachedElements(ls_.scene, ls_.desc);
+    rays_->updateElementPoses();
+  }
+  window_.context().makeCurrent();
+  // A screenshot frame is drawn whole, every stage run (its own empty cache), so that it is what pvrr render
+  // draws of the saved view: frames that reuse earlier maps (map reuse, render.map_reuse_margin_deg) differ
+  // from a fresh frame in places, as they do in pvrr render --frames --orbit.
+  gl::FrameCache whole;
+  const gl::RasterFrame f = renderer_->render(mode_, pending_screenshots_.empty() ? &cache_ : &whole);
+  cache_.environment_changed = false;  // the environment never changes while the window is open
+  const auto t_render = Clock::now();
+  window_.present(renderer_->colorTexture(), ob.width, ob.height);
+  const auto t_present = Clock::now();
+  if (!pending_screenshots_.empty()) {
+    // Screenshots show the frame alone: taken before the panel is drawn over it.
+    const ImageRGB8 img = window_.readBackBuffer(ob.width, ob.height);
+    for (const std::string& file : pending_screenshots_) writePngAtomic(file, img, MissingFolder::Create);
+    pending_screenshots_.clear();
+  }
+  window_.beginPanel();
+  const double shown_ms = recent_ms_.empty() ? f.frame_ms : recent_ms_.back();
+  if (show_panel_) panel(f, shown_ms);
+  window_.endPanel();
+  if (!panel_screenshots_.empty()) {
+    const ImageRGB8 img = window_.readBackBuffer(ob.width, ob.height);
+    for (const std::string& file : panel_screenshots_) writePngAtomic(file, img, MissingFolder::Create);
+    panel_screenshots_.clear();
+  }
+  const auto t_panel = Clock::now();
+  window_.swapAndPoll();
+
+  // Mouse-look: a left-button drag outside the panel turns the head.
+  double x = 0, y = 0;
+  glfwGetCursorPos(window_.handle(), &x, &y);
+  const bool down = glfwGetMouseButton(window_.handle(), GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
+  if (down && dragging_) turnHead(pose_, -radians(kLookDegPerPixel * (x - last_x_)), -radians(kLookDegPerPixel * (y - last_y_)));
+  dragging_ = down && (dragging_ || !ImGui::GetIO().WantCaptureMouse);
+  last_x_ = x;
+  last_y_ = y;
+
+  const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  frame_ms_.push_back(ms);
+  const auto span = [](Clock::time_point a, Clock::time_point b) {
+    return std::chrono::duration<double, std::milli>(b - a).count();
+  };
+  render_ms_.push_back(span(t0, t_render));
+  present_ms_.push_back(span(t_render, t_present));
+  panel_ms_.push_back(span(t_present, t_panel));
+  swap_ms_.push_back(span(t_panel, Clock::now()));
+  recent_ms_.push_back(ms);
+  if (recent_ms_.size() > 60) recent_ms_.pop_front();
+  ++frames_;
+}
+
+void Viewer::panel(const gl::RasterFrame& f, double frame_ms) {
+  ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(460, 0), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowBgAlpha(0.85f);
+  ImGui::Begin("pvrr view");
+  const double med = median(std::vector<double>(recent_ms_.begin(), recent_ms_.end()));
+  ImGui::Text("frame %.2f ms, %.1f fps (median of the last %zu: %.2f ms)", frame_ms, med > 0 ? 1000.0 / med : 0.0,
+              recent_ms_.size(), med);
+  ImGui::Text("renderer %.2f ms; %dx%d", f.frame_ms, f.width, f.height);
+  ImGui::TextWrapped("GL: %s, %s", glName().c_str(), window_.context().glVersion().c_str());
+  ImGui::Text("mode:");
+  for (RenderMode m : {RenderMode::Pvrr, RenderMode::Envmap, RenderMode::Impostor, RenderMode::Raster}) {
+    ImGui::SameLine();
+    if (ImGui::RadioButton(nameOf(m), mode_ == m)) setMode(m);
+  }
+  const Observer& ob = ls_.scene.observer;
+  ImGui::Text("eye [%.3f, %.3f, %.3f] m, head yaw %.1f, pitch %.1f deg", ob.eye.x, ob.eye.y, ob.eye.z,
+              degrees(pose_.yaw_rad), degrees(pose_.pitch_rad));
+  if (ImGui::Button("design eye (Home)")) pose_ = HeadPose{};
+  ImGui::SameLine();
+  if (ImGui::Button("screenshot (F12)")) pending_screenshots_.push_back("out/view-" + std::to_string(++saved_) + ".png");
+  ImGui::SameLine();
+  if (ImGui::Button("save view (V)")) saveViewTo("out/view-" + std::to_string(++saved_) + ".json");
+  if (ImGui::BeginTable("stages", 3, ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingStretchProp)) {
+    ImGui::TableSetupColumn("stage", ImGuiTableColumnFlags_WidthStretch, 1.0f);
+    ImGui::TableSetupColumn("ms", ImGuiTableColumnFlags_WidthFixed, 50.0f);
+    ImGui::TableSetupColumn("ran, or why not", ImGuiTableColumnFlags_WidthStretch, 2.2f);
+    ImGui::TableHeadersRow();
+    for (const StageTiming& s : f.stages.stages) {
+      ImGui::TableNextRow();
+      ImGui::TableNextColumn();
+      ImGui::TextUnformatted(s.name.c_str());
+      ImGui::TableNextColumn();
+      if (s.ran) ImGui::Text("%.2f", s.ms);
+      ImGui::TableNextColumn();
+      const std::string what = s.ran ? "ran" + (s.note.empty() ? std::string() : ": " + s.note) : "skipped: " + s.reason;
+      ImGui::TextWrapped("%s", what.c_str());
+    }
+    ImGui::EndTable();
+  }
+  if (ImGui::CollapsingHeader("keys")) {
+    ImGui::TextUnformatted(
+        "drag (left button)  turn the head\n"
+        "arrows              turn the head 1 deg (Shift: 10)\n"
+        "W/S A/D R/F         eye forward/back, left/right, up/down 1 cm (Shift: 10)\n"
+        "Home or H           back to the design eye point\n"
+        "1 2 3 4             mode pvrr, envmap, impostor, raster\n"
+        "Tab                 hide or show this panel\n"
+        "F12 / V             screenshot / save view (out/view-N.png, .json)\n"
+        "Esc                 quit");
+  }
+  ImGui::End();
+}
+
+void Viewer::onKey(int key, int action, int mods) {
+  if (action == GLFW_RELEASE || ImGui::GetIO().WantCaptureKeyboard) return;
+  const double k = (mods & GLFW_MOD_SHIFT) ? kFast : 1.0;
+  const double step = kEyeStepM * k, turn = radians(kTurnStepDeg * k);
+  switch (key) {
+    case GLFW_KEY_W: moveEye(pose_, design_, {0, 0, -step}); break;
+    case GLFW_KEY_S: moveEye(pose_, design_, {0, 0, step}); break;
+    case GLFW_KEY_A: moveEye(pose_, design_, {-step, 0, 0}); break;
+    case GLFW_KEY_D: moveEye(pose_, design_, {step, 0, 0}); break;
+    case GLFW_KEY_R: moveEye(pose_, design_, {0, step, 0}); break;
+    case GLFW_KEY_F: moveEye(pose_, design_, {0, -step, 0}); break;
+    case GLFW_KEY_LEFT: turnHead(pose_, turn, 0); break;
+    case GLFW_KEY_RIGHT: turnHead(pose_, -turn, 0); break;
+    case GLFW_KEY_UP: turnHead(pose_, 0, turn); break;
+    case GLFW_KEY_DOWN: turnHead(pose_, 0, -turn); break;
+    case GLFW_KEY_HOME:
+    case GLFW_KEY_H: pose_ = HeadPose{}; break;
+    case GLFW_KEY_1: setMode(RenderMode::Pvrr); break;
+    case GLFW_KEY_2: setMode(RenderMode::Envmap); break;
+    case GLFW_KEY_3: setMode(RenderMode::Impostor); break;
+    case GLFW_KEY_4: setMode(RenderMode::Raster); break;
+    case GLFW_KEY_TAB: show_panel_ = !show_panel_; break;
+    case GLFW_KEY_F12: pending_screenshots_.push_back("out/view-" + std::to_string(++saved_) + ".png"); break;
+    case GLFW_KEY_V: saveViewTo("out/view-" + std::to_string(++saved_) + ".json"); break;
+    case GLFW_KEY_ESCAPE: quit_ = true; break;
+    default: break;
+  }
+}
+
+void Viewer::saveViewTo(const std::string& file) {
+  saveView(file, scene_path_, overrides_, ls_.scene.observer, ls_.desc.unit_m);
+  std::printf("%s\n", file.c_str());
+}
+
+void Viewer::run() {
+  while (!quit_) {
+    runEvents();
+    if (quit_ || window_.closeRequested()) break;
+    frame();
+  }
+  if (!pending_screenshots_.empty() || !panel_screenshots_.empty()) frame();  // asked for on the last frame
+}
+
+json Viewer::stats() const {
+  std::vector<double> t = frame_ms_;
+  const double med = t.empty() ? 0.0 : median(t);
+  return {{"frames", frames_},
+          {"fps_median", med > 0 ? 1000.0 / med : 0.0},
+          {"frame_ms_median", med},
+          {"frame_ms_max", t.empty() ? 0.0 : *std::max_element(t.begin(), t.end())},
+          {"mode", nameOf(mode_)},
+          // Medians of the frame's parts (ms): the renderer's frame (as pvrr render times it, plus the head's
+          // update), presenting it, the panel (with any screenshot), and the swap with the input.
+          {"parts_ms_median",
+           {{"render", t.empty() ? 0.0 : median(render_ms_)},
+            {"present", t.empty() ? 0.0 : median(present_ms_)},
+            {"panel", t.empty() ? 0.0 : median(panel_ms_)},
+            {"swap", t.empty() ? 0.0 : median(swap_ms_)}}},
+          {"size", {design_.width, design_.height}},
+          {"gl", glName()}};
+}
+
+}  // namespace
+}  // namespace view
+
+int cmdView(const std::vector<std::string>& argv) {
+  Args a("view", argv, {"gl", "size", "script", "stats", "set", "mode"}, {}, {"set"});
+  if (a.positional().size() > 1) usageError("view", "expected at most one scene file");
+  const std::string scene_path = a.positional().empty() ? kDefaultScene : a.positional()[0];
+  const view::WindowGl api = view::parseWindowGl(a.get("gl", "auto"));
+  const std::optional<RenderMode> mode =
+      a.get("mode") ? std::optional<RenderMode>(parseModeOption(*a.get("mode"), false)) : std::nullopt;
+  // Everything is validated before the window opens: the script, the scene, each "set" the script makes.
+  const std::string script_path = a.get("script", "");
+  view::Script script = script_path.empty() ? view::Script{} : view::loadScript(script_path);
+  std::vector<std::string> overrides = a.all("set");
+  {
+    std::vector<std::string> checked = overrides;
+    for (const view::ScriptEvent& e : script.events) {
+      if (e.kind != view::EventKind::Set) continue;
+      checked.push_back(e.path + "=" + e.value_json);
+      try {
+        pvrr::loadScene(scene_path, checked);
+      } catch (const Error& err) {
+        throw Error(script_path + ": " + e.where + ": " + err.what());
+      }
+    }
+  }
+  const SceneDesc desc = pvrr::loadScene(scene_path, overrides);
+  const auto size = a.getSize("size");
+  const int width = size ? size->first : script.width ? script.width : desc.observer.image_width;
+  const int height = size ? size->second : script.height ? script.height : desc.observer.image_height;
+
+  view::Window window(width, height, api, /*vsync=*/script_path.empty(), "pvrr view: " + scene_path);
+  nlohmann::json stats;
+  {
+    view::Viewer viewer(window, scene_path, overrides, mode, width, height, script_path, std::move(script));
+    viewer.run();
+    stats = viewer.stats();
+  }
+  if (auto file = a.get("stats")) writeFileAtomic(*file, stats.dump(2) + "\n");
+  return 0;
+}
+
+}  // namespace pvrr::app

@@ -1,0 +1,224 @@
+#include "app/view/window.h"
+
+#include "pvrr/gl/gl.h"  // glad first: GLFW is told to include no GL header
+
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
+
+#include <cstdint>
+#include <cstdlib>
+#include <vector>
+
+#include "pvrr/base/error.h"
+
+namespace pvrr::app::view {
+namespace {
+
+std::string g_glfw_error;  // the last GLFW error, for the messages
+void onGlfwError(int code, const char* text) { g_glfw_error = std::string(text) + " (GLFW error " + std::to_string(code) + ")"; }
+
+// A full-screen triangle; each fragment copies its texel, encoded to sRGB through a table of linearToSrgb8
+// (pvrr/base/image.h) over the 65536 values of the renderer's 16-bit target (a float target is rounded to them
+// first: at most 1/131070 off, under 0.03 of a code). The table is exact where pow() in the shader was not, and
+// cheaper: three pow() a pixel cost llvmpipe about 10 ms at 1280 x 720 (docs/performance.md).
+constexpr const char* kPresentVs = R"(#version 330 core
+void main() {
+  vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
+  gl_Position = vec4(2.0 * p - 1.0, 0.0, 1.0);
+})";
+constexpr const char* kPresentFs = R"(#version 330 core
+uniform sampler2D u_frame;
+uniform sampler2D u_srgb;  // 256 x 256 R8: texel (k & 255, k >> 8) holds the code of k / 65535
+out vec4 out_color;
+float encode(float c) {
+  int k = int(clamp(c, 0.0, 1.0) * 65535.0 + 0.5);
+  return texelFetch(u_srgb, ivec2(k & 255, k >> 8), 0).r;
+}
+void main() {
+  vec3 c = texelFetch(u_frame, ivec2(gl_FragCoord.xy), 0).rgb;
+  out_color = vec4(encode(c.r), encode(c.g), encode(c.b), 1.0);
+})";
+
+GLuint compile(GLenum kind, const char* source) {
+  const GLuint s = glCreateShader(kind);
+  glShaderSource(s, 1, &source, nullptr);
+  glCompileShader(s);
+  GLint ok = 0;
+  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    char log[1024] = {};
+    glGetShaderInfoLog(s, sizeof log, nullptr, log);
+    throw Error(std::string("pvrr view: the present shader does not compile: ") + log);
+  }
+  return s;
+}
+
+GLFWwindow* openWindow(int width, int height, int api, const std::string& title) {
+  glfwDefaultWindowHints();
+  glfwWindowHint(GLFW_CLIENT_API, GLFW_OPENGL_API);
+  glfwWindowHint(GLFW_CONTEXT_CREATION_API, api);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  glfwWindowHint(GLFW_DEPTH_BITS, 0);  // the renderer draws into its own framebuffer
+  for (const auto& [major, minor] : {std::pair{4, 5}, std::pair{gl::kGlFloorMajor, gl::kGlFloorMinor}}) {
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, major);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, minor);
+    if (GLFWwindow* w = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr)) return w;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+WindowGl parseWindowGl(const std::string& name) {
+  if (name == "auto") return WindowGl::Auto;
+  if (name == "glx") return WindowGl::Glx;
+  if (name == "egl") return WindowGl::Egl;
+  throw Error("pvrr view: --gl: expected one of auto, glx, egl; got \"" + name + "\"");
+}
+
+Window::Window(int width, int height, WindowGl api, bool vsync, const std::string& title) {
+  glfwSetErrorCallback(onGlfwError);
+  if (!glfwInit()) {
+    const char* display = std::getenv("DISPLAY");
+    throw Error("pvrr view: cannot open a window: " + g_glfw_error +
+                (display && *display ? "" : "; DISPLAY is not set (run under xvfb-run -a for a virtual display)"));
+  }
+  std::string tried;
+  std::string name;
+  for (const auto& [kind, api_hint, label] : {std::tuple{WindowGl::Glx, GLFW_NATIVE_CONTEXT_API, "glx"},
+                                              std::tuple{WindowGl::Egl, GLFW_EGL_CONTEXT_API, "egl"}}) {
+    if (api != WindowGl::Auto && api != kind) continue;
+    g_glfw_error.clear();
+    window_ = openWindow(width, height, api_hint, title);
+    if (window_) {
+      name = std::string("glfw-") + label;
+      break;
+    }
+    tried += std::string("\n  ") + label + ": " + g_glfw_error;
+  }
+  if (!window_) {
+    glfwTerminate();
+    throw Error("pvrr view: could not open a window with a GL 3.3+ core context; tried:" + tried);
+  }
+  glfwMakeContextCurrent(window_);
+  glfwSwapInterval(vsync ? 1 : 0);
+  GLFWwindow* w = window_;
+  gl::ForeignContext fc;
+  fc.backend_name = name;
+  fc.make_current = [w] { glfwMakeContextCurrent(w); };
+  fc.release_current = [w] {
+    if (glfwGetCurrentContext() == w) glfwMakeContextCurrent(nullptr);
+  };
+  fc.get_proc_address = glfwGetProcAddress;
+  context_ = gl::GlContext::adopt(std::move(fc));
+
+  const GLuint vs = compile(GL_VERTEX_SHADER, kPresentVs), fs = compile(GL_FRAGMENT_SHADER, kPresentFs);
+  program_ = glCreateProgram();
+  glAttachShader(program_, vs);
+  glAttachShader(program_, fs);
+  glLinkProgram(program_);
+  glDeleteShader(vs);
+  glDeleteShader(fs);
+  GLint ok = 0;
+  glGetProgramiv(program_, GL_LINK_STATUS, &ok);
+  if (!ok) throw Error("pvrr view: the present program does not link");
+  glGenVertexArrays(1, &vao_);
+  std::vector<std::uint8_t> table(65536);
+  for (size_t k = 0; k < table.size(); ++k) table[k] = linearToSrgb8(double(float(k) / 65535.0f));
+  glGenTextures(1, &srgb_table_);
+  glBindTexture(GL_TEXTURE_2D, srgb_table_);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_R8, 256, 256, 0, GL_RED, GL_UNSIGNED_BYTE, table.data());
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  gl::checkGlError("creating the present program");
+
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini: a run writes only the files it is asked for
+  ImGui::StyleColorsDark();
+  ImGui_ImplGlfw_InitForOpenGL(window_, true);  // chains the callbacks installed before it
+  ImGui_ImplOpenGL3_Init("#version 330 core");
+  imgui_ = true;
+}
+
+Window::~Window() {
+  if (imgui_) {
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+  }
+  if (context_) {
+    context_->makeCurrent();
+    if (program_) glDeleteProgram(program_);
+    if (vao_) glDeleteVertexArrays(1, &vao_);
+    if (srgb_table_) glDeleteTextures(1, &srgb_table_);
+    context_.reset();
+  }
+  if (window_) glfwDestroyWindow(window_);
+  glfwTerminate();
+}
+
+bool Window::closeRequested() const { return glfwWindowShouldClose(window_); }
+
+void Window::framebufferSize(int* width, int* height) const { glfwGetFramebufferSize(window_, width, height); }
+
+void Window::present(unsigned texture, int width, int height) {
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glViewport(0, 0, width, height);
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_BLEND);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_SCISSOR_TEST);
+  glDisable(GL_FRAMEBUFFER_SRGB);
+  glUseProgram(program_);
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D, texture);
+  glUniform1i(glGetUniformLocation(program_, "u_frame"), 0);
+  glActiveTexture(GL_TEXTURE1);
+  glBindTexture(GL_TEXTURE_2D, srgb_table_);
+  glUniform1i(glGetUniformLocation(program_, "u_srgb"), 1);
+  glActiveTexture(GL_TEXTURE0);
+  glBindVertexArray(vao_);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glBindVertexArray(0);
+  gl::checkGlError("presenting the frame");
+}
+
+void Window::beginPanel() {
+  ImGui_ImplOpenGL3_NewFrame();
+  ImGui_ImplGlfw_NewFrame();
+  ImGui::NewFrame();
+}
+
+void Window::endPanel() {
+  ImGui::Render();
+  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+}
+
+ImageRGB8 Window::readBackBuffer(int width, int height) const {
+  std::vector<std::uint8_t> rgba(size_t(width) * size_t(height) * 4);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+  glReadBuffer(GL_BACK);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+  gl::checkGlError("reading the window's pixels");
+  // GL's rows are bottom-up.
+  std::vector<std::uint8_t> flipped(rgba.size());
+  const size_t row = size_t(width) * 4;
+  for (int y = 0; y < height; ++y)
+    std::copy_n(rgba.begin() + std::ptrdiff_t(size_t(height - 1 - y) * row), row, flipped.begin() + std::ptrdiff_t(size_t(y) * row));
+  return rgbFromRgba(width, height, flipped);
+}
+
+void Window::swapAndPoll() {
+  glfwSwapBuffers(window_);
+  glfwPollEvents();
+}
+
+}  // namespace pvrr::app::view

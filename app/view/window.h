@@ -1,0 +1,51 @@
+// The viewer's window: GLFW 3 with a GL 4.5 core context (3.3 at least) adopted as a pvrr::gl::GlContext, so the
+// same Renderer draws in it; Dear ImGui for the panel; the renderer's frame presented sRGB-encoded into the
+// default framebuffer. The only place that includes GLFW; GL through glad (pvrr/gl/gl.h).
+#pragma once
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "pvrr/base/image.h"
+#include "pvrr/gl/context.h"
+
+struct GLFWwindow;
+
+namespace pvrr::app::view {
+
+// Which GLFW context API: Auto (GLX, then EGL), Glx, Egl.
+enum class WindowGl { Auto, Glx, Egl };
+// "auto" | "glx" | "egl"; throws pvrr::Error listing the choices otherwise.
+WindowGl parseWindowGl(const std::string& name);
+
+class Window {
+ public:
+  // Opens a width x height window (framebuffer pixels). `vsync`: swap interval 1, else 0 (scripted runs, which
+  // measure). Throws pvrr::Error saying why (no display: "run under xvfb-run"; no GL context of the kind).
+  Window(int width, int height, WindowGl api, bool vsync, const std::string& title);
+  ~Window();
+  Window(const Window&) = delete;
+  Window& operator=(const Window&) = delete;
+
+  gl::GlContext& context() { return *context_; }
+  GLFWwindow* handle() { return window_; }
+  bool closeRequested() const;
+  void framebufferSize(int* width, int* height) const;
+  // Draws `texture` (a linear colour texture of the framebuffer's size, Renderer::colorTexture) into the default
+  // framebuffer, encoded to sRGB as pvrr::srgbPicture encodes a picture.
+  void present(unsigned texture, int width, int height);
+  // ImGui frame: begin before building the panel, end to draw it over the presented frame.
+  void beginPanel();
+  void endPanel();
+  // The back buffer's pixels (after present and before swap), rows top-down.
+  ImageRGB8 readBackBuffer(int width, int height) const;
+  void swapAndPoll();
+
+ private:
+  GLFWwindow* window_ = nullptr;
+  std::unique_ptr<gl::GlContext> context_;
+  unsigned program_ = 0, vao_ = 0, srgb_table_ = 0;
+  bool imgui_ = false;
+};
+
+}  // namespace pvrr::app::view

@@ -1,0 +1,169 @@
+// `pvrr view` in a window (label `window`): scripted runs under a virtual X display (xvfb-run, installed by
+// scripts/setup), checked against `pvrr render` of the same view. Skipped, saying why, only where no X server
+// can be started.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "pvrr/base/image.h"
+#include "app/run_pvrr.h"
+
+namespace pvrr::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The window and pvrr render both draw with the renderer into a linear target; the window encodes sRGB in a
+// shader (float), render on the CPU (double): a value on a rounding boundary may land one code apart.
+constexpr double kWindowVsRenderCodes = 1;
+
+// Runs `pvrr view ARGS` with an X display: under xvfb-run where it is installed, else on $DISPLAY. Sets `why`
+// and returns false when neither can start an X server.
+bool runView(const std::string& args, CliResult* r, std::string* why) {
+  const bool xvfb = std::system("command -v xvfb-run >/dev/null 2>&1") == 0;
+  const char* display = std::getenv("DISPLAY");
+  if (!xvfb && !(display && *display)) {
+    *why = "no X server: xvfb-run is not installed (scripts/setup installs it) and DISPLAY is not set";
+    return false;
+  }
+  if (!xvfb) {
+    *r = runPvrr("view " + args);
+    return true;
+  }
+  // Parallel tests may race for a display number (xvfb-run -a): a few tries before giving up.
+  for (int attempt = 0; attempt < 3; ++attempt) {  // the virtual screen is larger than any window the tests open
+    const std::string cmd = "cd '" PVRR_SOURCE_DIR "' && xvfb-run -a -s '-screen 0 1600x1000x24' '" PVRR_BINARY
+                            "' view " + args;
+    static int n = 0;
+    const fs::path out = fs::temp_directory_path() / ("pvrr-window-" + std::to_string(::getpid()) + "-" + std::to_string(n++));
+    const int status = std::system((cmd + " >'" + out.string() + ".out' 2>'" + out.string() + ".err'").c_str());
+    r->code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    std::ifstream o(out.string() + ".out"), e(out.string() + ".err");
+    std::stringstream so, se;
+    so << o.rdbuf();
+    se << e.rdbuf();
+    r->out = so.str();
+    r->err = se.str();
+    fs::remove(out.string() + ".out");
+    fs::remove(out.string() + ".err");
+    if (r->err.find("Xvfb failed to start") == std::string::npos) return true;
+  }
+  *why = "xvfb-run could not start Xvfb (3 tries): " + r->err;
+  return false;
+}
+
+void writeText(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
+
+#define RUN_VIEW_OR_SKIP(args, result)                    \
+  do {                                                   \
+    std::string why_;                                    \
+    if (!runView(args, result, &why_)) GTEST_SKIP() << why_; \
+  } while (0)
+
+// A scripted run's screenshot equals pvrr render of the view it saved; the saved view reloads to the same pixels.
+void checkScreenshotMatchesRender(const std::string& name, const std::string& scene, const std::string& moves) {
+  const fs::path dir = freshTestDir(name);
+  const fs::path script = dir / "script.json", shot = dir / "window.png", view = dir / "view.json",
+                 rendered = dir / "render.png", again = dir / "again.png", stats = dir / "stats.json";
+  writeText(script, R"({"size": [320, 240], "events": [)" + moves + R"(,
+      {"at_frame": 6, "do": "screenshot", "file": ")" + shot.string() + R"("},
+      {"at_frame": 6, "do": "save_view", "file": ")" + view.string() + R"("},
+      {"at_frame": 7, "do": "quit"}]})");
+  CliResult r;
+  RUN_VIEW_OR_SKIP(scene + " --script '" + script.string() + "' --stats '" + stats.string() + "'", &r);
+  ASSERT_EQ(r.code, 0) << r.err;
+  ASSERT_TRUE(fs::exists(shot));
+  ASSERT_TRUE(fs::exists(view));
+
+  const CliResult rr = runPvrr("render '" + view.string() + "' --out '" + rendered.string() + "'");
+  ASSERT_EQ(rr.code, 0) << rr.err;
+  const ImageRGB8 a = readPng(shot.string()), b = readPng(rendered.string());
+  const ImageDiff d = compareImages(a, b, kWindowVsRenderCodes);
+  EXPECT_EQ(d.failing_pixels, 0) << describe(d);
+
+  // The saved view in the window again: the same picture.
+  writeText(script, R"({"events": [{"at_frame": 1, "do": "screenshot", "file": ")" + again.string() +
+                        R"("}, {"at_frame": 2, "do": "quit"}]})");
+  CliResult r2;
+  RUN_VIEW_OR_SKIP("'" + view.string() + "' --script '" + script.string() + "'", &r2);
+  ASSERT_EQ(r2.code, 0) << r2.err;
+  const ImageDiff d2 = compareImages(a, readPng(again.string()), kWindowVsRenderCodes);
+  EXPECT_EQ(d2.failing_pixels, 0) << describe(d2);
+
+  const nlohmann::json st = nlohmann::json::parse(std::ifstream(stats));
+  EXPECT_EQ(st["frames"], 7);
+  EXPECT_GT(st["fps_median"].get<double>(), 0);
+  EXPECT_GE(st["frame_ms_max"].get<double>(), st["frame_ms_median"].get<double>());
+  EXPECT_EQ(st["mode"], "pvrr");
+  EXPECT_EQ(st["gl"].get<std::string>().rfind("glfw-", 0), 0u) << st["gl"];
+  fs::remove_all(dir);
+}
+
+TEST(ViewWindow, CarMirrorHeadTurnedMatchesRender) {
+  checkScreenshotMatchesRender("view-car", "models/car-mirror.json",
+                               R"({"at_frame": 2, "do": "turn_head", "yaw_deg": 4, "pitch_deg": -2},
+                                  {"at_frame": 3, "do": "move_eye", "by": [0.02, 0.01, -0.03]},
+                                  {"at_frame": 4, "do": "turn_head", "yaw_deg": 1})");
+}
+
+// Spectacles move with the head: the lens is re-posed every frame the head turns.
+TEST(ViewWindow, SpectacleLensTurnsWithTheHeadAndMatchesRender) {
+  checkScreenshotMatchesRender("view-lens", "models/spectacle-lens.json",
+                               R"({"at_frame": 2, "do": "turn_head", "yaw_deg": 6, "pitch_deg": 3},
+                                  {"at_frame": 4, "do": "move_eye", "by": [0.01, 0, 0]})");
+}
+
+// Keys go through the keyboard's path: Left turns the head 1 degree, as turn_head does; H returns to the design
+// eye point.
+TEST(ViewWindow, KeysTurnTheHeadAndReturnToTheDesignEye) {
+  const fs::path dir = freshTestDir("view-keys");
+  const fs::path script = dir / "script.json", by_key = dir / "key.png", by_turn = dir / "turn.png",
+                 home = dir / "home.png", start = dir / "start.png";
+  writeText(script, R"({"size": [256, 192], "events": [
+      {"at_frame": 1, "do": "screenshot", "file": ")" + start.string() + R"("},
+      {"at_frame": 2, "do": "key", "key": "LEFT"},
+      {"at_frame": 3, "do": "screenshot", "file": ")" + by_key.string() + R"("},
+      {"at_frame": 4, "do": "key", "key": "W", "shift": true},
+      {"at_frame": 4, "do": "key", "key": "UP"},
+      {"at_frame": 5, "do": "key", "key": "H"},
+      {"at_frame": 6, "do": "screenshot", "file": ")" + home.string() + R"("},
+      {"at_frame": 7, "do": "quit"}]})");
+  CliResult r;
+  RUN_VIEW_OR_SKIP("models/plane-mirror.json --script '" + script.string() + "'", &r);
+  ASSERT_EQ(r.code, 0) << r.err;
+  writeText(script, R"({"size": [256, 192], "events": [
+      {"at_frame": 2, "do": "turn_head", "yaw_deg": 1},
+      {"at_frame": 3, "do": "screenshot", "file": ")" + by_turn.string() + R"("},
+      {"at_frame": 4, "do": "quit"}]})");
+  RUN_VIEW_OR_SKIP("models/plane-mirror.json --script '" + script.string() + "'", &r);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(compareImages(readPng(by_key.string()), readPng(by_turn.string()), 0).failing_pixels, 0);
+  EXPECT_GT(compareImages(readPng(by_key.string()), readPng(start.string()), 0).failing_pixels, 0);  // it turned
+  EXPECT_EQ(compareImages(readPng(home.string()), readPng(start.string()), 0).failing_pixels, 0);
+  fs::remove_all(dir);
+}
+
+// "set" rebuilds the scene: a mode change by script shows that mode's picture.
+TEST(ViewWindow, SetChangesTheModeLive) {
+  const fs::path dir = freshTestDir("view-set");
+  const fs::path script = dir / "script.json", shot = dir / "window.png", rendered = dir / "render.png";
+  writeText(script, R"({"size": [256, 192], "events": [
+      {"at_frame": 1, "do": "set", "path": "render.mode", "value": "envmap"},
+      {"at_frame": 3, "do": "screenshot", "file": ")" + shot.string() + R"("},
+      {"at_frame": 3, "do": "quit"}]})");
+  CliResult r;
+  RUN_VIEW_OR_SKIP("models/concave-mirror.json --script '" + script.string() + "'", &r);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const CliResult rr =
+      runPvrr("render models/concave-mirror.json --mode envmap --size 256x192 --out '" + rendered.string() + "'");
+  ASSERT_EQ(rr.code, 0) << rr.err;
+  const ImageDiff d = compareImages(readPng(shot.string()), readPng(rendered.string()), kWindowVsRenderCodes);
+  EXPECT_EQ(d.failing_pixels, 0) << describe(d);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace pvrr::test
