@@ -9,8 +9,8 @@
 
 namespace pvrr {
 
-// Each patch's view volume is narrower, so its texels cover a smaller angle. At least 128. An automatic split
-// into 16 x 16 patches at full size took 3.3 GB and 14 s a frame.
+// Each patch's view volume is narrower, so its texels cover a smaller angle. At least 128: full-size maps for
+// many patches cost memory and time without a visible gain (docs/method.md "Measurements behind the design").
 int patchMapSize(int map_size, size_t patches) {
   if (patches <= 4 || map_size <= 128) return map_size;
   const double shrink = std::ceil(std::sqrt(double(patches) / 4.0));
@@ -30,9 +30,8 @@ int topLevelMapSide(const Scene& scene, const ElementFrame& f, const PatchView& 
 }
 
 // A nested element covers part of its parent's map, which covers part of the image, so half the parent's
-// texels still exceed the pixels it covers in the shipped scenes; full-size nested maps (28 MB each at 1024^2
-// then: RGBA16F colour, RGBA32F seen points, 32-bit depth) took the mirror pair's render at 1280 x 720 to
-// 460 MB.
+// texels still exceed the pixels it covers in the shipped scenes (full-size nested maps: docs/method.md
+// "Measurements behind the design").
 int nestedMapSize(int parent) { return parent <= 128 ? parent : std::max(128, parent / 2); }
 
 bool mayBeInVolume(const std::vector<Vec3>& points, const Mat4& m) {

@@ -25,12 +25,8 @@
 //     rho' plus the clamped second-order term of the loss along each residual, which takes 6-11 iterations
 //     where plain IRLS, and Ceres, need 16-24), one pass over the rays per step. Ceres (autodiff, DENSE_QR)
 //     runs only when the quick solve fails a check (below), or always with ViewpointSolver::kCeres.
-//     Measured (tests/bench/viewpoint.cpp, convex cap, 2-core EPYC shared with other builds, CPU time):
-//       rays      closed form   default (closed form + own solver)   Ceres
-//       49          4.5 us          21 us (9 iterations)             0.21 ms (20 iterations)
-//       2000        0.15 ms        0.61 ms (7 iterations)            6.4 ms (18 iterations)
-//       10000       0.77 ms         3.2 ms (7 iterations)             32 ms (18 iterations)
-//     Ceres costs ~3 us per ray, more than the ~1 ms budget for 2000 rays, hence not the default.
+//     Ceres costs about ten times the default per ray, over the vertex stages' budget, hence not the default
+//     (measured: tests/bench/viewpoint.cpp; figures in docs/method.md "Measurements behind the design").
 //  3. Conditioning fallback: when cond(A) > max_condition_number (nearly parallel lines: a nearly flat
 //     mirror seen from afar) or the closed-form point is farther than max_eye_distance_m from the patch
 //     centroid, the eye is placed at the nominal point
