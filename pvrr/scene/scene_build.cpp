@@ -159,6 +159,137 @@ PrescriptionRadii prescriptionRadii(double sphere_d, double cylinder_d, double b
   return r;
 }
 
+namespace {
+
+// An environment mesh from a file (MeshLoader), posed by the object's position, rotation and scale, with
+// normals from the file or, without them, from the faces. `what` names the object in messages.
+EnvMesh loadedMesh(const EnvObjectDesc& o, const MeshLoader& load_mesh, const std::string& what) {
+  EnvMesh mesh;
+  if (!load_mesh) throw Error(what + ": no mesh reader is available in this program");
+  MeshData md;
+  try {
+    md = load_mesh(o.file);
+  } catch (const Error& e) {
+    throw Error(what + ": " + e.what());  // the reader names the file and the place in it
+  }
+  if (md.positions.empty() || md.triangles.empty()) throw Error(what + ": " + o.file + " holds no triangles");
+  // The loader is a callback: what it returns is checked before anything indexes with it.
+  for (size_t v = 0; v < md.positions.size(); ++v)
+    if (!isFinite(md.positions[v]))
+      throw Error(what + ": " + o.file + ": vertex " + std::to_string(v) + " is not finite");
+  for (size_t t = 0; t < md.triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k)
+      if (md.triangles[t][k] >= md.positions.size())
+        throw Error(what + ": " + o.file + ": triangle " + std::to_string(t) + ": vertex index " +
+                    std::to_string(md.triangles[t][k]) + " is out of range (the mesh has " +
+                    std::to_string(md.positions.size()) + " vertices)");
+  mesh.anchor = o.position;
+  for (size_t v = 0; v < md.positions.size(); ++v) {
+    const Vec3 p = o.rotation * (o.scale * md.positions[v]);
+    mesh.positions.push_back(glm::vec3(p));
+    mesh.uvs.push_back(v < md.uvs.size() ? glm::vec2(md.uvs[v]) : glm::vec2(0));
+  }
+  mesh.triangles = md.triangles;
+  // Normals: transformed by the inverse transpose, or from the faces when the file has none.
+  std::vector<Vec3> normals(md.positions.size(), Vec3(0));
+  if (md.normals.size() == md.positions.size()) {
+    const Mat3 nt = glm::transpose(glm::inverse(o.rotation * Mat3(glm::scale(Mat4(1.0), o.scale))));
+    for (size_t v = 0; v < normals.size(); ++v) normals[v] = nt * md.normals[v];
+  } else {
+    for (const auto& t : mesh.triangles) {
+      const Vec3 a(mesh.positions[t.x]), b(mesh.positions[t.y]), c(mesh.positions[t.z]);
+      const Vec3 fn = glm::cross(b - a, c - a);
+      normals[t.x] += fn;
+      normals[t.y] += fn;
+      normals[t.z] += fn;
+    }
+  }
+  for (const Vec3& n : normals) {
+    const double len = glm::length(n);
+    mesh.normals.push_back(glm::vec3(len > 0 ? n / len : Vec3(0, 1, 0)));
+  }
+  return mesh;
+}
+
+// A mirror's surface (a sag surface, a CAD face with its trim as the outline, or a subdivision surface) and
+// its material.
+void buildMirror(Element& el, const ElementDesc& e) {
+  const SurfaceDesc& s = e.surface;
+  if (s.isSag()) {
+    if (!e.outline) throw Error("a " + std::string(nameOf(s.type)) + " mirror needs an outline");
+    el.surface = makeSag(s, el.outline, 0.0);
+  } else if (s.type == SurfaceDesc::Type::Cad) {
+    cad::ImportedModel model = cad::importCadFile(s.file);
+    if (s.face < 0 || size_t(s.face) >= model.faces.size())
+      throw Error(s.file + ": face " + std::to_string(s.face) + " requested, the file has " +
+                  std::to_string(model.faces.size()));
+    const cad::ImportedFace& face = model.faces[size_t(s.face)];
+    el.surface = std::make_shared<cad::NurbsSurface>(cad::scaled(*face.surface, model.unit_to_metres));
+    // The trim loop (in parameter space) is the outline; an explicit outline cannot apply to (u, v).
+    el.has_outline = face.trim.has_value();
+    if (face.trim) el.outline = *face.trim;
+  } else {
+    el.surface = std::make_shared<ScaledSurface>(cad::loadSubdivisionCage(s.file), s.file_unit_m);
+    el.has_outline = false;
+  }
+  switch (e.mirror_material.kind) {
+    case MirrorMaterialDesc::Kind::Reflectance:
+      el.mirror.reflectance = Vec3(e.mirror_material.reflectance);
+      break;
+    case MirrorMaterialDesc::Kind::Metal: {
+      Metal m = lookupMetal(e.mirror_material.metal);
+      el.mirror.metal = true;
+      el.mirror.n = m.n_rgb();
+      el.mirror.k = m.k_rgb();
+      el.mirror.metal_table = std::make_shared<const Metal>(m);
+      break;
+    }
+    case MirrorMaterialDesc::Kind::Conductor:
+      el.mirror.metal = true;
+      el.mirror.n = e.mirror_material.n;
+      el.mirror.k = e.mirror_material.k;
+      break;
+  }
+}
+
+// A lens's glass and its two surfaces, from a prescription or given: element i of `file`, named `what` in
+// messages.
+void buildLens(Element& el, const ElementDesc& e, const std::string& file, size_t i, const std::string& what) {
+  const LensMaterialDesc& lm = e.lens_material;
+  Dispersion disp;
+  switch (lm.kind) {
+    case LensMaterialDesc::Kind::Named: disp = lookupLensMaterial(lm.name).dispersion; break;
+    case LensMaterialDesc::Kind::Abbe: disp = Dispersion::fromAbbe(lm.n_d, lm.V_d); break;
+    case LensMaterialDesc::Kind::Sellmeier: disp = Dispersion::sellmeier(lm.sellmeier_b, lm.sellmeier_c_um2); break;
+  }
+  if (!lm.dispersion) disp = Dispersion::constant(disp.n_d());
+  el.dispersion = disp;
+  el.dispersion_on = lm.dispersion;
+  if (!e.outline) throw Error("a lens needs an outline");
+  cad::SagSurfacePtr front, back;
+  double t = e.centre_thickness_m;
+  if (e.prescription) {
+    const PrescriptionDesc& p = *e.prescription;
+    if (t <= 0) t = p.sphere_d < 0 ? 2e-3 : 1.5e-3;
+    const double base = p.base_curve_d ? *p.base_curve_d : defaultBaseCurve(p.sphere_d);
+    const PrescriptionRadii r = prescriptionRadii(p.sphere_d, p.cylinder_d, base, disp.n_d(), t);
+    back = std::isfinite(r.back_radius_m) ? cad::makeSphere(r.back_radius_m, el.outline)
+                                          : cad::makePlane(el.outline);
+    if (p.cylinder_d == 0)
+      front = std::isfinite(r.front_radius_a_m) ? cad::makeSphere(r.front_radius_a_m, el.outline)
+                                                : cad::makePlane(el.outline);
+    else
+      front = cad::makeToric(r.front_radius_a_m, r.front_radius_b_m, radians(p.axis_deg), el.outline);
+  } else {
+    const std::string where = file + ": elements[" + std::to_string(i) + "]";
+    front = makeLensSurface(e.front, el.outline, where + ".front");
+    back = makeLensSurface(e.back, el.outline, where + ".back");
+  }
+  el.lens = cad::makeLens(front, back, el.outline, t, e.min_edge_thickness_m, what);
+}
+
+}  // namespace
+
 Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
   Scene scene;
   scene.source_path = desc.source;
@@ -191,52 +322,7 @@ Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
       case EnvObjectDesc::Type::Quad:
         mesh = makeQuadMesh(o.position, o.normal, o.v_axis, o.size.x, o.size.y, uv_scale);
         break;
-      case EnvObjectDesc::Type::Mesh: {
-        if (!load_mesh) throw Error(what + ": no mesh reader is available in this program");
-        MeshData md;
-        try {
-          md = load_mesh(o.file);
-        } catch (const Error& e) {
-          throw Error(what + ": " + e.what());  // the reader names the file and the place in it
-        }
-        if (md.positions.empty() || md.triangles.empty()) throw Error(what + ": " + o.file + " holds no triangles");
-        // The loader is a callback: what it returns is checked before anything indexes with it.
-        for (size_t v = 0; v < md.positions.size(); ++v)
-          if (!isFinite(md.positions[v]))
-            throw Error(what + ": " + o.file + ": vertex " + std::to_string(v) + " is not finite");
-        for (size_t t = 0; t < md.triangles.size(); ++t)
-          for (int k = 0; k < 3; ++k)
-            if (md.triangles[t][k] >= md.positions.size())
-              throw Error(what + ": " + o.file + ": triangle " + std::to_string(t) + ": vertex index " +
-                          std::to_string(md.triangles[t][k]) + " is out of range (the mesh has " +
-                          std::to_string(md.positions.size()) + " vertices)");
-        mesh.anchor = o.position;
-        for (size_t v = 0; v < md.positions.size(); ++v) {
-          const Vec3 p = o.rotation * (o.scale * md.positions[v]);
-          mesh.positions.push_back(glm::vec3(p));
-          mesh.uvs.push_back(v < md.uvs.size() ? glm::vec2(md.uvs[v]) : glm::vec2(0));
-        }
-        mesh.triangles = md.triangles;
-        // Normals: transformed by the inverse transpose, or from the faces when the file has none.
-        std::vector<Vec3> normals(md.positions.size(), Vec3(0));
-        if (md.normals.size() == md.positions.size()) {
-          const Mat3 nt = glm::transpose(glm::inverse(o.rotation * Mat3(glm::scale(Mat4(1.0), o.scale))));
-          for (size_t v = 0; v < normals.size(); ++v) normals[v] = nt * md.normals[v];
-        } else {
-          for (const auto& t : mesh.triangles) {
-            const Vec3 a(mesh.positions[t.x]), b(mesh.positions[t.y]), c(mesh.positions[t.z]);
-            const Vec3 fn = glm::cross(b - a, c - a);
-            normals[t.x] += fn;
-            normals[t.y] += fn;
-            normals[t.z] += fn;
-          }
-        }
-        for (const Vec3& n : normals) {
-          const double len = glm::length(n);
-          mesh.normals.push_back(glm::vec3(len > 0 ? n / len : Vec3(0, 1, 0)));
-        }
-        break;
-      }
+      case EnvObjectDesc::Type::Mesh: mesh = loadedMesh(o, load_mesh, what); break;
     }
     mesh.name = o.name.empty() ? std::string(nameOf(o.type)) + std::to_string(i) : o.name;
     mesh.material = int(scene.materials.size());
@@ -275,76 +361,8 @@ Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
     el.has_outline = e.outline.has_value();
     if (e.outline) el.outline = toOutline(*e.outline);
     try {
-      if (el.type == ElementType::Mirror) {
-        const SurfaceDesc& s = e.surface;
-        if (s.isSag()) {
-          if (!e.outline) throw Error("a " + std::string(nameOf(s.type)) + " mirror needs an outline");
-          el.surface = makeSag(s, el.outline, 0.0);
-        } else if (s.type == SurfaceDesc::Type::Cad) {
-          cad::ImportedModel model = cad::importCadFile(s.file);
-          if (s.face < 0 || size_t(s.face) >= model.faces.size())
-            throw Error(s.file + ": face " + std::to_string(s.face) + " requested, the file has " +
-                        std::to_string(model.faces.size()));
-          const cad::ImportedFace& face = model.faces[size_t(s.face)];
-          el.surface = std::make_shared<cad::NurbsSurface>(cad::scaled(*face.surface, model.unit_to_metres));
-          // The trim loop (in parameter space) is the outline; an explicit outline cannot apply to (u, v).
-          el.has_outline = face.trim.has_value();
-          if (face.trim) el.outline = *face.trim;
-        } else {
-          el.surface = std::make_shared<ScaledSurface>(cad::loadSubdivisionCage(s.file), s.file_unit_m);
-          el.has_outline = false;
-        }
-        switch (e.mirror_material.kind) {
-          case MirrorMaterialDesc::Kind::Reflectance:
-            el.mirror.reflectance = Vec3(e.mirror_material.reflectance);
-            break;
-          case MirrorMaterialDesc::Kind::Metal: {
-            Metal m = lookupMetal(e.mirror_material.metal);
-            el.mirror.metal = true;
-            el.mirror.n = m.n_rgb();
-            el.mirror.k = m.k_rgb();
-            el.mirror.metal_table = std::make_shared<const Metal>(m);
-            break;
-          }
-          case MirrorMaterialDesc::Kind::Conductor:
-            el.mirror.metal = true;
-            el.mirror.n = e.mirror_material.n;
-            el.mirror.k = e.mirror_material.k;
-            break;
-        }
-      } else {
-        const LensMaterialDesc& lm = e.lens_material;
-        Dispersion disp;
-        switch (lm.kind) {
-          case LensMaterialDesc::Kind::Named: disp = lookupLensMaterial(lm.name).dispersion; break;
-          case LensMaterialDesc::Kind::Abbe: disp = Dispersion::fromAbbe(lm.n_d, lm.V_d); break;
-          case LensMaterialDesc::Kind::Sellmeier: disp = Dispersion::sellmeier(lm.sellmeier_b, lm.sellmeier_c_um2); break;
-        }
-        if (!lm.dispersion) disp = Dispersion::constant(disp.n_d());
-        el.dispersion = disp;
-        el.dispersion_on = lm.dispersion;
-        if (!e.outline) throw Error("a lens needs an outline");
-        cad::SagSurfacePtr front, back;
-        double t = e.centre_thickness_m;
-        if (e.prescription) {
-          const PrescriptionDesc& p = *e.prescription;
-          if (t <= 0) t = p.sphere_d < 0 ? 2e-3 : 1.5e-3;
-          const double base = p.base_curve_d ? *p.base_curve_d : defaultBaseCurve(p.sphere_d);
-          const PrescriptionRadii r = prescriptionRadii(p.sphere_d, p.cylinder_d, base, disp.n_d(), t);
-          back = std::isfinite(r.back_radius_m) ? cad::makeSphere(r.back_radius_m, el.outline)
-                                                : cad::makePlane(el.outline);
-          if (p.cylinder_d == 0)
-            front = std::isfinite(r.front_radius_a_m) ? cad::makeSphere(r.front_radius_a_m, el.outline)
-                                                      : cad::makePlane(el.outline);
-          else
-            front = cad::makeToric(r.front_radius_a_m, r.front_radius_b_m, radians(p.axis_deg), el.outline);
-        } else {
-          const std::string where = file + ": elements[" + std::to_string(i) + "]";
-          front = makeLensSurface(e.front, el.outline, where + ".front");
-          back = makeLensSurface(e.back, el.outline, where + ".back");
-        }
-        el.lens = cad::makeLens(front, back, el.outline, t, e.min_edge_thickness_m, what);
-      }
+      if (el.type == ElementType::Mirror) buildMirror(el, e);
+      else buildLens(el, e, file, i, what);
     } catch (const Error& err) {
       const std::string msg = err.what();
       throw Error(msg.rfind(file, 0) == 0 ? msg : what + ": " + msg);
