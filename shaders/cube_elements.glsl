@@ -64,8 +64,9 @@ uniform mat3 u_lens_to_local;     // world directions -> the lens's local frame 
 vec3 followCubes(int cur, vec3 x, vec3 R, int depth, int channel, out vec4 seen, out bool refracted) {
   vec3 throughput = vec3(1.0);
   refracted = false;
-  seen = vec4(x, 1.0);  // 64 passes past the lens's outline without an event: no seen point of its own
-  for (int bounce = 0; bounce < 64; ++bounce) {
+  // MAX_DEPTH_LIMIT passes past the lens's outline without an event: no seen point of its own
+  seen = vec4(x, 1.0);
+  for (int bounce = 0; bounce < MAX_DEPTH_LIMIT; ++bounce) {
     vec3 centre = vec3(0.0), l = R, c = vec3(0.0);
     vec4 s = vec4(0.0), nid = vec4(0.0);
     CUBE_LOOKUP(0)

@@ -2,6 +2,7 @@
 // the view ray enters, the march to where it meets a surface again, and the whole path through the lens.
 #include "bilinear.glsl"
 #include "optics.glsl"
+#include "cpp_constants.glsl"
 // A lens's maps: this element's (LENS), or those of the scene's one lens, which other elements' cubes show
 // (LENS_IN_CUBES: followCubes refracts through it).
 uniform sampler2D u_lens_front;   // refractor height maps (pvrr/impostor/lens_height_map.h): z, outward unit normal
@@ -107,8 +108,8 @@ vec3 entryPoint(vec3 x, vec3 v, bool back) {
 
 // One wavelength's path through the lens (local frame) from the entry point x, where the view direction v
 // meets the surface with outward normal n. It refracts in, then follows the events inside the glass as the
-// tracer does up to its depth limit (max_events; render.max_depth is at most 64): each is an exit
-// (refraction, exact Fresnel) or a total internal reflection. Returns the exit point and sets the exit
+// tracer does up to its depth limit (max_events; render.max_depth is at most MAX_DEPTH_LIMIT): each is an
+// exit (refraction, exact Fresnel) or a total internal reflection. Returns the exit point and sets the exit
 // direction, the transmittance and the tracer's events spent on the way (entry, inside, exit);
 // transmittance 0: absorbed, at the returned point (the depth limit) or, with `rim`, where the ray left the
 // outline (the tracer's lens has no rim surface: its seen point lies u_far along `dir`, the ray inside).
@@ -119,7 +120,7 @@ vec3 throughLens(vec3 x, vec3 v, vec3 n, float eta, int max_events, out vec3 dir
   transmittance = 1.0 - fresnelDielectric(cos_i, 1.0, eta);
   rim = false;
   vec3 p = x;
-  for (int event = 0; event < 64; ++event) {
+  for (int event = 0; event < MAX_DEPTH_LIMIT; ++event) {
     bool back;
     float t = glassExit(p, d, back);
     if (t < 0.0 || !inOutline((p + t * d).xy)) {

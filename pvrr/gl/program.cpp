@@ -10,6 +10,7 @@
 
 #include "pvrr/base/error.h"
 #include "pvrr/gl/gl.h"
+#include "pvrr/scene/render_desc.h"
 #include "pvrr/trace/shading.h"
 
 namespace pvrr::gl {
@@ -213,7 +214,8 @@ std::string glslFloat(double value) {
 
 std::string cppConstantsSource() {
   return "// Values owned by C++ (pvrr/gl/program.cpp cppConstantsSource), not retyped in shaders.\n"
-         "#define MIRROR_BACK_ALBEDO " + glslFloat(kMirrorBackAlbedo) + "  // pvrr/trace/shading.h kMirrorBackAlbedo\n";
+         "#define MIRROR_BACK_ALBEDO " + glslFloat(kMirrorBackAlbedo) + "  // pvrr/trace/shading.h kMirrorBackAlbedo\n" +
+         "#define MAX_DEPTH_LIMIT " + std::to_string(kMaxDepthLimit) + "  // pvrr/scene/render_desc.h kMaxDepthLimit\n";
 }
 
 std::string insertDefines(const std::string& source, const std::vector<std::string>& defines) {

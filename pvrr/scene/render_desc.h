@@ -45,6 +45,10 @@ inline constexpr NameTable<ViewpointSolver, 4> kViewpointSolverNames = {{{Viewpo
 constexpr const NameTable<ViewpointSolver, 4>& nameTable(ViewpointSolver) { return kViewpointSolverNames; }
 static_assert(namesAreUnique(kViewpointSolverNames));
 
+// The largest render.max_depth the format accepts: the shaders' event loops are bounded by it
+// (MAX_DEPTH_LIMIT, injected by pvrr/gl/program.cpp).
+inline constexpr int kMaxDepthLimit = 64;
+
 // The settings of the "render" section with their defaults: the defaults of the scene format.
 struct RenderDesc {
   RenderMode mode = RenderMode::Pvrr;

@@ -572,7 +572,7 @@ RenderDesc readRender(const Ctx& c, const json* j, const std::string& source) {
     r.output = o.string("output");
     if (!endsWithAny(r.output, {".png"})) o.expected("output", "a file name ending in \".png\"");
   }
-  r.max_depth = o.integer("max_depth", 1, 64, r.max_depth);
+  r.max_depth = o.integer("max_depth", 1, kMaxDepthLimit, r.max_depth);
   r.dispersion = o.choice<DispersionMode>("dispersion", r.dispersion);
   r.spectral_samples = o.integer("spectral_samples", 3, 256, r.spectral_samples);
   r.background = o.vec3("background", VecKind::ColourNonNegative, r.background);
