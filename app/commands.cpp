@@ -285,8 +285,8 @@ int cmdRender(const std::vector<std::string>& argv) {
       ls.scene.observer.eye = eye0;
       ls.scene.observer.target = eye0 + Vec3(rot * Vec4(target0 - eye0, 0.0));
       updateAttachedElements(ls.scene, ls.desc);
-      // Re-committing the Embree scene rebuilds its BVH (~25 ms for the car mirror's scene): only when some
-      // element moves with the head.
+      // Re-committing the Embree scene rebuilds its BVH (tens of milliseconds): only when some element moves
+      // with the head.
       if (session.rays && any_attached) session.rays->updateElementPoses();
       session.cache.environment_changed = false;
     }

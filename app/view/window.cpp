@@ -23,7 +23,7 @@ void onGlfwError(int code, const char* text) { g_glfw_error = std::string(text) 
 // A full-screen triangle; each fragment copies its texel, encoded to sRGB through a table of linearToSrgb8
 // (pvrr/base/image.h) over the 65536 values of the renderer's 16-bit target (a float target is rounded to them
 // first: at most 1/131070 off, under 0.03 of a code). The table is exact where pow() in the shader was not, and
-// cheaper: three pow() a pixel cost llvmpipe about 10 ms at 1280 x 720 (docs/performance.md).
+// cheaper on llvmpipe (docs/method.md "Measurements behind the design").
 constexpr const char* kPresentVs = R"(#version 330 core
 void main() {
   vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));

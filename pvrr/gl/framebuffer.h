@@ -76,13 +76,13 @@ class Framebuffer {
   // Clears every colour attachment to `rgba` and the depth attachment to `depth`. Binds the framebuffer.
   void clear(const std::array<float, 4>& rgba, float depth = 1.0f) const;
   // Clears only the depth attachment (a pass that writes every pixel, e.g. one ending with a full-screen sky,
-  // needs no colour clear: a 1280 x 720 RGBA32F colour clear costs llvmpipe about 2 ms). Binds the framebuffer.
+  // needs no colour clear, which costs llvmpipe a full pass over the target). Binds the framebuffer.
   void clearDepth(float depth = 1.0f) const;
   // Binds like bind(), with the viewport on the lower-left width x height pixels only (a map rendered into part
   // of its texture). Throws pvrr::Error when the region does not fit.
   void bindRegion(int width, int height) const;
   // bindRegion, then clears the depth of that region only (a scissored clear): a map drawn into part of its
-  // texture need not clear the rest (llvmpipe clears every tile of a full clear: ~1 ms for 1024^2).
+  // texture need not clear the rest (llvmpipe clears every tile of a full clear).
   void bindRegionClearDepth(int width, int height, float depth) const;
 
   int width() const { return width_; }

@@ -222,8 +222,8 @@ Framebuffer& PvrrPass::mapTarget(size_t i, int size, bool planes) {
   if (maps.size() <= i) maps.resize(i + 1);
   const bool is_planes = maps[i] && maps[i]->colorFormat(0) == ColorFormat::R32F;
   if (!maps[i] || maps[i]->width() != size || is_planes != planes) {
-    // RGBA32F colour: llvmpipe filters it faster than RGBA16F (three bilinear reads of a 1024^2 map over
-    // 1280 x 720: 14.9 against 18.2 ms), and it keeps values above 1 exactly. Planes: one float a read.
+    // RGBA32F colour: llvmpipe filters it faster than RGBA16F (docs/method.md "Measurements behind the
+    // design"), and it keeps values above 1 exactly. Planes: one float a read.
     std::vector<ColorFormat> formats = planes ? std::vector<ColorFormat>{ColorFormat::R32F, ColorFormat::R32F, ColorFormat::R32F}
                                               : std::vector<ColorFormat>{ColorFormat::RGBA32F};
     if (ctx.options.seen_points) formats.push_back(ColorFormat::RGBA32F);

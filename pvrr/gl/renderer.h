@@ -45,9 +45,9 @@ struct RendererOptions : PassPlanOptions {
   // false: colour only, for viewing (pvrr render): no seen-point and surface attachments in any pass and
   // RasterFrame::seen / element / element_point left empty; the accuracy reports need them on. Stage
   // "seen-points" reports which. The picture is then drawn into a 16-bit linear target (GL_RGBA16: colours
-  // clamped to [0, 1], as the 8-bit sRGB encode of a picture clamps them, and rounded to 1/65535), about
-  // 1.2 ms faster than the float target at 1280 x 720 on llvmpipe; its 8-bit picture is within one code of
-  // the float frame's (docs/method.md). Not when an element has more than three channels (spectral
+  // clamped to [0, 1], as the 8-bit sRGB encode of a picture clamps them, and rounded to 1/65535), faster
+  // than the float target on llvmpipe; its 8-bit picture is within one code of the float frame's
+  // (docs/method.md). Not when an element has more than three channels (spectral
   // dispersion): its additive draws' partial sums must not be clamped. A non-finite colour cannot reach a
   // 16-bit target (it is written as some value in [0, 1], usually 0), so `pvrr render`'s warning about
   // non-finite pixels needs the float target (seen points on).

@@ -167,8 +167,8 @@ struct ElementFrame {
 ElementFrame prepareElement(const Scene& scene, int element, const cad::Tessellation* grid = nullptr);
 
 // The elements' tessellations, kept while each element's front surface, grid size and outline stay the
-// same: prepareElement's costly part (the car mirror's 15 x 15 NURBS grid with curvatures: 0.2 ms; 45 x 45:
-// 1.5 ms), which a rigid element needs once, whatever its pose.
+// same: prepareElement's costly part (evaluating a NURBS grid with curvatures), which a rigid element needs
+// once, whatever its pose.
 class ElementGridCache {
  public:
   // The element's tessellation: its own grid, or the one refine() chose, kept until the element's surface,

@@ -31,8 +31,9 @@ struct RayHit {
 struct RaySceneOptions {
   int element_tessellation = 96;  // grid used only to find candidate element hits
   // Elements attached to the observer will move every frame (updateElementPoses during a head turn): build
-  // a two-level dynamic scene whose pose update refits the moved elements (~1.5 ms for the spectacle-lens
-  // scene, against ~30 ms for a full rebuild), at the price of ~15% slower queries (low-quality top level).
+  // a two-level dynamic scene whose pose update refits the moved elements (far cheaper than a full rebuild),
+  // at the price of slower queries (low-quality top level); figures: docs/method.md "Measurements behind the
+  // design".
   bool moving_elements = false;
 };
 
