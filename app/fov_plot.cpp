@@ -77,13 +77,17 @@ std::vector<std::string> writeFovPlot(const std::string& dir, const std::string&
   a.y_out = frame.outermost(left).y;
   const double x1 = a.left + a.width, y1 = a.top + a.height;
 
-  bool all_pass = !zones.empty();
-  for (const FovPlotZone& z : zones) all_pass = all_pass && z.result->pass;
+  bool all_pass = !zones.empty(), all_verified = true;
+  for (const FovPlotZone& z : zones)
+    all_pass = all_pass && z.result->pass, all_verified = all_verified && z.zone->verified;
+  // A verdict on values not confirmed in the regulation's text says so, on the plot as in fov.json.
+  const std::string unverified = all_verified ? "" : " (regulation values unverified: fov.json \"verified\")";
   k.texts.push_back({k.width / 2.0, 28, title, 17, 1, kBlack});
   k.texts.push_back({k.width / 2.0, 52,
                      zones.empty()
                          ? "no regulation zones"
-                         : (all_pass ? "PASS: every zone covered" : "FAIL: see the red zones and the marked points"),
+                         : (all_pass ? "PASS: every zone covered" : "FAIL: see the red zones and the marked points") +
+                               unverified,
                      15, 1,
                      zones.empty() ? kDark
                      : all_pass    ? kPass
@@ -184,7 +188,8 @@ std::vector<std::string> writeFovPlot(const std::string& dir, const std::string&
     const Rgb c = z.result->pass ? kPass : kFail;
     k.texts.push_back({a.left, ly,
                        (z.result->pass ? "PASS  " : "FAIL  ") + z.zone->name + ": covered " +
-                           pct(z.result->covered_fraction) + ", obstructed " + pct(z.result->obstructed_fraction),
+                           pct(z.result->covered_fraction) + ", obstructed " + pct(z.result->obstructed_fraction) +
+                           (z.zone->verified ? "" : " (values unverified)"),
                        12, 0, c});
     ly += 18;
   }
