@@ -49,28 +49,6 @@ const char* eyesName(FovZone::Eyes e) {
   return "";
 }
 
-// The element `--element` names, else the scene's one mirror; refuses an unknown name (with the nearest) and a
-// choice among several mirrors left open.
-int mirrorIndex(const Scene& scene, const Args& a, const std::string& scene_path) {
-  int index = -1, mirrors = 0;
-  for (size_t i = 0; i < scene.elements.size(); ++i) {
-    const Element& e = scene.elements[i];
-    if (a.has("element") ? e.name == *a.get("element") : (e.type == ElementType::Mirror && index < 0)) index = int(i);
-    mirrors += e.type == ElementType::Mirror;
-  }
-  if (a.has("element") && index < 0) {
-    std::vector<std::string> names;
-    for (const Element& e : scene.elements) names.push_back(e.name);
-    const std::string hint = nearest(*a.get("element"), names);
-    throw Error(scene_path + ": elements: no element named \"" + *a.get("element") + "\"" +
-                (hint.empty() ? "" : "; did you mean \"" + hint + "\"?"));
-  }
-  if (index < 0) throw Error(scene_path + ": elements: no mirror");
-  if (!a.has("element") && mirrors > 1)
-    throw Error(scene_path + ": elements: " + std::to_string(mirrors) + " mirrors; choose one with --element");
-  return index;
-}
-
 // Each eye's footprint (polygon and ray counts) and the union of the eyes' footprints: its outer loops (and any
 // holes, clockwise).
 json footprintJson(const std::vector<EyeFootprint>& feet) {
@@ -114,7 +92,7 @@ int cmdFov(const std::vector<std::string>& argv) {
     throw Error(scene_path + ": vehicle: missing; pvrr fov needs the vehicle frame (docs/scene-format.md \"vehicle\")");
   const VehicleDesc& vehicle = *ls.desc.vehicle;
   const Scene& scene = ls.scene;
-  const int index = mirrorIndex(scene, a, scene_path);
+  const int index = chooseElement(scene, a, scene_path, ElementType::Mirror, "no mirror", "mirrors");
   const Element& el = scene.elements[size_t(index)];
   const std::string el_path = scene_path + ": elements[" + std::to_string(index) + "] (" + el.name + ")";
   if (el.type != ElementType::Mirror) throw Error(el_path + ": pvrr fov maps a mirror, not a lens");

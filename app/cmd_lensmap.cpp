@@ -232,26 +232,11 @@ int cmdLensmap(const std::vector<std::string>& argv) {
 
   LoadedScene ls = loadScene(scene_path, a.all("set"));
   const Scene& scene = ls.scene;
-  int index = -1;
-  std::vector<std::string> lenses;
-  for (size_t i = 0; i < scene.elements.size(); ++i) {
-    const Element& e = scene.elements[i];
-    if (e.type != ElementType::Lens) continue;
-    lenses.push_back(e.name);
-    if (a.has("element") ? e.name == *a.get("element") : index < 0) index = int(i);
-  }
-  if (a.has("element") && index < 0) {
-    std::vector<std::string> names;
-    for (const Element& e : scene.elements) names.push_back(e.name);
-    const std::string hint = nearest(*a.get("element"), names);
-    throw Error(scene_path + ": elements: no element named \"" + *a.get("element") + "\"" +
-                (hint.empty() ? "" : "; did you mean \"" + hint + "\"?"));
-  }
-  if (index < 0) throw Error(scene_path + ": elements: no lens to map");
-  if (!a.has("element") && lenses.size() > 1)
-    throw Error(scene_path + ": elements: " + std::to_string(lenses.size()) + " lenses; choose one with --element");
+  const int index = chooseElement(scene, a, scene_path, ElementType::Lens, "no lens to map", "lenses");
   const Element& el = scene.elements[size_t(index)];
   const std::string el_path = "elements[" + std::to_string(index) + "] (" + el.name + ")";
+  if (el.type != ElementType::Lens)
+    throw Error(scene_path + ": " + el_path + ": pvrr lensmap maps a lens, not a mirror");
   options.rotation_centre_m = el.eye_rotation_centre_m;
   if (!(options.object_distance_m > options.rotation_centre_m))
     usageError("lensmap", "--object-distance: must exceed the rotation centre's distance, " +

@@ -40,6 +40,28 @@ LoadedScene loadScene(const std::string& path, const std::vector<std::string>& o
   return ls;
 }
 
+int chooseElement(const Scene& scene, const Args& a, const std::string& scene_path, ElementType type,
+                  const std::string& none, const std::string& plural) {
+  const std::optional<std::string> asked = a.get("element");
+  int index = -1, of_type = 0;
+  for (size_t i = 0; i < scene.elements.size(); ++i) {
+    const Element& e = scene.elements[i];
+    if (asked ? e.name == *asked : (e.type == type && index < 0)) index = int(i);
+    of_type += e.type == type;
+  }
+  if (asked && index < 0) {
+    std::vector<std::string> names;
+    for (const Element& e : scene.elements) names.push_back(e.name);
+    const std::string hint = nearest(*asked, names);
+    throw Error(scene_path + ": elements: no element named \"" + *asked + "\"" +
+                (hint.empty() ? "" : "; did you mean \"" + hint + "\"?"));
+  }
+  if (index < 0) throw Error(scene_path + ": elements: " + none);
+  if (!asked && of_type > 1)
+    throw Error(scene_path + ": elements: " + std::to_string(of_type) + " " + plural + "; choose one with --element");
+  return index;
+}
+
 size_t writeLinearPng(const std::string& path, int width, int height, const std::vector<Vec3>& linear) {
   size_t bad = 0;
   const ImageRGB8 img = srgbPicture(width, height, linear, &bad);

@@ -12,6 +12,14 @@
 
 namespace pvrr::app {
 
+class Args;
+
+// The element a command works on: the one --element names (of any type: the caller checks it), else the scene's
+// one element of `type`. Refuses an unknown name (naming the nearest), a scene without such an element (`none`,
+// e.g. "no mirror") and several of them left to choose (`plural`, e.g. "mirrors"), each naming the scene file.
+int chooseElement(const Scene& scene, const Args& a, const std::string& scene_path, ElementType type,
+                  const std::string& none, const std::string& plural);
+
 int cmdRender(const std::vector<std::string>& args);
 int cmdGlInfo(const std::vector<std::string>& args);
 int cmdTrace(const std::vector<std::string>& args);

@@ -115,6 +115,8 @@ TEST(LensmapCli, ErrorsAreOneLineAndLeaveNothing) {
                      "models/spectacle-lens.json: elements: no element named \"lens\"");
   expectOneLineError(runPvrr("lensmap models/car-mirror.json --out '" + out + "'"),
                      "models/car-mirror.json: elements: no lens to map");
+  expectOneLineError(runPvrr("lensmap models/car-mirror.json --element door-mirror --out '" + out + "'"),
+                     "models/car-mirror.json: elements[0] (door-mirror): pvrr lensmap maps a lens, not a mirror");
   expectOneLineError(
       runPvrr("lensmap models/spectacle-lens.json --set 'elements[0].eye={\"rotation_centre\": -1}' --out '" + out +
               "'"),
