@@ -47,6 +47,14 @@ bool inTriangle(Vec2 p, Vec2 a, Vec2 b, Vec2 c) {
   return !(neg && pos);
 }
 
+// The parameters of sample (i, j) of an n x n grid over the mirror: uniform over its outline's square (the
+// outline's own map), or over the surface's domain where it has no outline.
+Vec2 sampleParameters(const Element& el, const cad::ParamDomain& dom, int i, int j, int n) {
+  const Vec2 s(-1 + 2.0 * i / (n - 1), -1 + 2.0 * j / (n - 1));
+  return el.has_outline ? el.outline.fromSquare(s)
+                        : Vec2(dom.u0 + (dom.u1 - dom.u0) * 0.5 * (s.x + 1), dom.v0 + (dom.v1 - dom.v0) * 0.5 * (s.y + 1));
+}
+
 }  // namespace
 
 VehicleFrame::VehicleFrame(const VehicleDesc& v) : v_(v) {
@@ -86,10 +94,7 @@ EyeFootprint traceFootprint(const RayScene& rays, int element, const VehicleFram
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) {
       const size_t k = size_t(j) * size_t(n) + size_t(i);
-      const Vec2 s(-1 + 2.0 * i / (n - 1), -1 + 2.0 * j / (n - 1));
-      const Vec2 uv = el.has_outline ? el.outline.fromSquare(s)
-                                     : Vec2(dom.u0 + (dom.u1 - dom.u0) * 0.5 * (s.x + 1),
-                                            dom.v0 + (dom.v1 - dom.v0) * 0.5 * (s.y + 1));
+      const Vec2 uv = sampleParameters(el, dom, i, j, n);
       const cad::SurfacePoint sp = surface.sample(uv.x, uv.y, false);
       Vec3 p = el.toWorldPoint(sp.p), nrm = glm::normalize(el.toWorldDir(sp.n));
       f.mirror_point[k] = p;
@@ -313,10 +318,7 @@ SurfaceFigures surfaceFigures(const RayScene& rays, int element, const Vec3& eye
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) {
       const size_t k = size_t(j) * size_t(n) + size_t(i);
-      const Vec2 s(-1 + 2.0 * i / (n - 1), -1 + 2.0 * j / (n - 1));
-      const Vec2 uv = el.has_outline ? el.outline.fromSquare(s)
-                                     : Vec2(dom.u0 + (dom.u1 - dom.u0) * 0.5 * (s.x + 1),
-                                            dom.v0 + (dom.v1 - dom.v0) * 0.5 * (s.y + 1));
+      const Vec2 uv = sampleParameters(el, dom, i, j, n);
       const cad::SurfacePoint sp = surface.sample(uv.x, uv.y, true);
       const Vec3 p = el.toWorldPoint(sp.p), nrm = glm::normalize(el.toWorldDir(sp.n));
       d[k] = glm::normalize(p - eye_world);
