@@ -51,8 +51,9 @@ bool inTriangle(Vec2 p, Vec2 a, Vec2 b, Vec2 c) {
 // outline's own map), or over the surface's domain where it has no outline.
 Vec2 sampleParameters(const Element& el, const cad::ParamDomain& dom, int i, int j, int n) {
   const Vec2 s(-1 + 2.0 * i / (n - 1), -1 + 2.0 * j / (n - 1));
-  return el.has_outline ? el.outline.fromSquare(s)
-                        : Vec2(dom.u0 + (dom.u1 - dom.u0) * 0.5 * (s.x + 1), dom.v0 + (dom.v1 - dom.v0) * 0.5 * (s.y + 1));
+  return el.has_outline
+             ? el.outline.fromSquare(s)
+             : Vec2(dom.u0 + (dom.u1 - dom.u0) * 0.5 * (s.x + 1), dom.v0 + (dom.v1 - dom.v0) * 0.5 * (s.y + 1));
 }
 
 }  // namespace
