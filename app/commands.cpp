@@ -18,6 +18,7 @@
 #include "pvrr/base/error.h"
 #include "pvrr/gl/context.h"
 #include "pvrr/gl/gl.h"
+#include "pvrr/gl/stage_notes.h"
 #include "pvrr/base/format.h"
 #include "pvrr/base/image.h"
 #include "pvrr/scene/scene_json.h"
@@ -213,7 +214,7 @@ RenderedFrame timedFrame(LoadedScene& ls, RenderMode mode, const std::string& gl
   RenderedFrame f = renderFrame(ls, mode, gl_backend_name, &accuracy);
   f.stages = std::move(timed.stages);
   for (StageTiming& t : f.stages.stages)
-    if (t.name == "seen-points")
+    if (t.name == gl::stage::kSeenPoints)
       t.reason = "timed colour-only, as pvrr render draws; the errors come from one more frame drawn with them";
   f.frame_ms = timed.frame_ms;
   return f;
