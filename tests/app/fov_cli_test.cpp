@@ -14,14 +14,10 @@ namespace {
 
 namespace fs = std::filesystem;
 using pvrr::test::CliResult;
+using pvrr::test::expectOneLineError;
 using pvrr::test::runPvrr;
+using pvrr::test::slurp;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 TEST(FovCli, CarMirrorAgainstR46ClassIII) {
   const fs::path dir = pvrr::test::freshTestDir("fov-ok");
@@ -73,11 +69,6 @@ TEST(FovCli, OneEyeAndAnExplicitRegulation) {
   fs::remove_all(dir);
 }
 
-void expectOneLineError(const CliResult& r, const std::string& what) {
-  EXPECT_EQ(r.code, 1) << r.err;
-  EXPECT_NE(r.err.find(what), std::string::npos) << r.err;
-  EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << r.err;
-}
 
 TEST(FovCli, ErrorsAreOneLineAndLeaveNothing) {
   const fs::path dir = pvrr::test::freshTestDir("fov-err");

@@ -18,14 +18,10 @@ namespace {
 
 namespace fs = std::filesystem;
 using pvrr::test::CliResult;
+using pvrr::test::expectOneLineError;
 using pvrr::test::runPvrr;
+using pvrr::test::slurp;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 std::vector<std::string> split(const std::string& s, char sep) {
   std::vector<std::string> out;
@@ -102,11 +98,6 @@ TEST(LensmapCli, ProgressiveLensReportsItsReferencePoints) {
   fs::remove_all(dir);
 }
 
-void expectOneLineError(const CliResult& r, const std::string& what) {
-  EXPECT_EQ(r.code, 1) << r.err;
-  EXPECT_NE(r.err.find(what), std::string::npos) << r.err;
-  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-}
 
 TEST(LensmapCli, ErrorsAreOneLineAndLeaveNothing) {
   const fs::path dir = pvrr::test::freshTestDir("lensmap-err");

@@ -13,6 +13,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using pvrr::test::CliResult;
+using pvrr::test::expectOneLineError;
 using pvrr::test::runPvrr;
 
 class Outputs : public ::testing::Test {
@@ -36,11 +37,6 @@ class Outputs : public ::testing::Test {
     std::sort(out.begin(), out.end());
     return out;
   }
-  static void expectOneLineNaming(const CliResult& r, const std::string& what) {
-    EXPECT_EQ(r.code, 1) << r.err;
-    EXPECT_NE(r.err.find(what), std::string::npos) << r.err;
-    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-  }
   fs::path dir_;
 };
 
@@ -49,7 +45,7 @@ TEST_F(Outputs, RenderWhoseStatsCannotBeWrittenLeavesNoPicture) {
   const std::string stats = occupy("stats.json");
   const CliResult r = runPvrr("render models/plane-mirror.json --size 32x24 --gl osmesa --out '" + path("new/sub/a.png") +
                               "' --stats '" + stats + "'");
-  expectOneLineNaming(r, stats);
+  expectOneLineError(r, stats);
   // Only what was there before: no picture, no temporary, no folder made for the picture.
   EXPECT_EQ(entries(), (std::vector<std::string>{"old.png", "stats.json", "stats.json/keep.txt"}));
   // The same command with a free stats path writes both.
@@ -64,14 +60,14 @@ TEST_F(Outputs, CompareWhoseMetricsCannotBeWrittenLeavesNoImages) {
   const std::string metrics = occupy("cmp/metrics.json");
   const CliResult r = runPvrr("compare models/plane-mirror.json --modes raster --size 24x18 --gl osmesa --out '" +
                               path("cmp") + "'");
-  expectOneLineNaming(r, metrics);
+  expectOneLineError(r, metrics);
   EXPECT_EQ(entries(), (std::vector<std::string>{"cmp", "cmp/metrics.json", "cmp/metrics.json/keep.txt"}));
 }
 
 TEST_F(Outputs, VerticesWhoseCamerasCannotBeWrittenLeavesNoCsv) {
   const std::string cameras = occupy("v.json");
   const CliResult r = runPvrr("vertices models/plane-mirror.json --out '" + path("v.csv") + "'");
-  expectOneLineNaming(r, cameras);
+  expectOneLineError(r, cameras);
   EXPECT_EQ(entries(), (std::vector<std::string>{"v.json", "v.json/keep.txt"}));
 }
 

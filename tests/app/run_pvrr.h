@@ -1,5 +1,6 @@
 // Runs the built pvrr command from the source tree, as a user does, for the tests of tests/app.
 #pragma once
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -37,6 +38,22 @@ inline CliResult runPvrr(const std::string& args) {
   fs::remove(tmp.string() + ".out");
   fs::remove(tmp.string() + ".err");
   return r;
+}
+
+// The whole content of a file (empty when it cannot be read).
+inline std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// A refusal as the CLI's contract has it: exit code 1 and exactly one line on stderr, which contains `what`
+// (the file and the place in it).
+inline void expectOneLineError(const CliResult& r, const std::string& what) {
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find(what), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << r.err;
 }
 
 // A fresh temporary folder per test, removed afterwards.
