@@ -1,0 +1,187 @@
+// The reference's caustics (pvrr/trace/light_tracer.h) against paraxial optics and energy conservation:
+// a thin lens in a directional light focuses at its paraxial focal distance, the power through its aperture is
+// conserved up to the Fresnel losses, a concave mirror's spot lies at R/2. Figures: docs/caustics.md.
+#include "pvrr/trace/light_tracer.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "cad/lens.h"
+#include "pvrr/optics/optics.h"
+#include "pvrr/optics/spectrum.h"
+#include "support/test_scenes.h"
+
+namespace pvrr {
+namespace {
+
+// The lens: symmetric biconvex, R = 0.5 m, n = 1.5 (constant), 3 mm thick, 40 mm round, vertex at the origin
+// facing +z; the sun travels along -z. Thin-lens (lensmaker) focal length (n - 1)(2/R) = 1/0.5 m.
+constexpr double kLensR = 0.5, kLensN = 1.5, kLensT = 0.003, kLensD = 0.04;
+// The mirror: concave sphere R = -1 m (centre 1 m in front), 100 mm round, reflectance 0.9; focus at R/2.
+constexpr double kMirrorR = 1.0, kMirrorD = 0.1, kMirrorRefl = 0.9;
+
+// A scene with only the element and, far off to the side, one small quad (the scene needs an environment).
+Scene bareScene() {
+  Scene s;
+  s.name = "caustic-test";
+  s.observer.eye = Vec3(0, 0, 2);
+  s.observer.target = Vec3(0);
+  EnvMesh far = makeQuadMesh(Vec3(5, 0, -5), Vec3(0, 0, 1), Vec3(0, 1, 0), 0.1, 0.1);
+  s.meshes.push_back(far);
+  s.materials.push_back(DiffuseMaterial{});
+  Light sun;
+  sun.type = Light::Type::Directional;
+  sun.direction = Vec3(0, 0, -1);
+  sun.radiance = Vec3(1.0);  // 1 W/m^2 facing the light
+  s.lights = {sun};
+  return s;
+}
+
+Scene lensScene(const Dispersion& glass = Dispersion::constant(kLensN)) {
+  Scene s = bareScene();
+  const cad::Outline disc = cad::Outline::circle(kLensD);
+  Element e;
+  e.name = "lens";
+  e.type = ElementType::Lens;
+  e.lens = cad::makeLens(cad::makeSphere(kLensR, disc), cad::makeSphere(-kLensR, disc), disc, kLensT, 0.0, "lens");
+  e.outline = disc;
+  e.local_to_world = test::pose(Vec3(0), Vec3(0, 0, 1));
+  e.world_to_local = glm::inverse(e.local_to_world);
+  e.dispersion = glass;
+  e.tess_u = e.tess_v = 24;
+  s.elements.push_back(e);
+  s.updateBounds();
+  return s;
+}
+
+Scene mirrorScene() {
+  Scene s = bareScene();
+  const cad::Outline disc = cad::Outline::circle(kMirrorD);
+  test::addMirror(s, cad::makeSphere(-kMirrorR, disc), disc, test::pose(Vec3(0), Vec3(0, 0, 1)), 7, kMirrorRefl);
+  s.updateBounds();
+  return s;
+}
+
+// The back focal distance of a thick lens in air (paraxial; light entering the R1 surface): with surface powers
+// F1 = (n - 1)/R1, F2 = (1 - n)/R2 and F = F1 + F2 - (t/n) F1 F2, BFD = (1 - (t/n) F1)/F.
+double backFocalDistance(double n, double r1, double r2, double t) {
+  const double f1 = (n - 1) / r1, f2 = (1 - n) / r2;
+  const double f = f1 + f2 - t / n * f1 * f2;
+  return (1 - t / n * f1) / f;
+}
+
+// A small receiver square in the plane z = z, on the axis, facing +z.
+ReceiverRect axialReceiver(double z, double size_m, int cells) {
+  ReceiverRect r;
+  r.centre = Vec3(0, 0, z);
+  r.u_axis = Vec3(1, 0, 0);
+  r.v_axis = Vec3(0, 1, 0);
+  r.width_m = r.height_m = size_m;
+  r.cells_u = r.cells_v = cells;
+  return r;
+}
+
+double peakOf(const IrradianceGrid& g) {
+  double peak = 0;
+  for (double v : g.scalars()) peak = std::max(peak, v);
+  return peak;
+}
+
+// The plane z in [z0, z1] (steps of dz) whose brightest cell is brightest.
+double sweepPeak(const PhotonBundle& b, double z0, double z1, double dz, double size_m, int cells) {
+  DepositOptions plane;
+  plane.mode = DepositOptions::Mode::Plane;
+  double best_z = z0, best = -1;
+  for (double z = z0; z <= z1 + 0.5 * dz; z += dz) {
+    const double p = peakOf(depositPhotons(b, axialReceiver(z, size_m, cells), plane).grid);
+    if (p > best) best = p, best_z = z;
+  }
+  return best_z;
+}
+
+// Receiver cells of 0.1 mm: the blur diameter the sweep resolves.
+constexpr double kCell = 1e-4;
+constexpr int kCells = 60;
+
+TEST(LightTracer, ThinLensFocusesAtItsParaxialFocalDistance) {
+  Scene s = lensScene();
+  RayScene rays(s);
+  CausticOptions o;
+  o.photons_per_side = 200;
+  const PhotonBundle b = shootCausticPhotons(rays, o);
+  ASSERT_GT(b.photons.size(), 0u);
+  const double bfd = backFocalDistance(kLensN, kLensR, -kLensR, kLensT);
+  const double z_paraxial = -kLensT - bfd;
+  // The lensmaker's thin-lens focal length for scale: the thick lens's BFD differs from it by t-terms only.
+  const double f_thin = 1.0 / ((kLensN - 1) * (2.0 / kLensR));
+  EXPECT_NEAR(bfd, f_thin, 0.01 * f_thin);
+  const double z_peak = sweepPeak(b, z_paraxial - 0.01, z_paraxial + 0.01, 2.5e-4, kCells * kCell, kCells);
+  // Depth of focus: the axial range over which the geometric blur of an aberration-free cone of f-number
+  // N = f/D stays below the receiver's cell (its resolution), +-N c, widened by the lens's longitudinal
+  // spherical aberration (the axial caustic from the paraxial to the marginal focus lies before the paraxial
+  // focus; third order for an equiconvex n = 1.5 lens: 1.67 h^2/f at marginal height h = D/2, ~1.3 mm here).
+  const double n_number = bfd / kLensD;
+  const double lsa = 1.67 * (0.5 * kLensD) * (0.5 * kLensD) / bfd;
+  const double depth_of_focus = n_number * kCell + lsa;
+  std::printf(
+      "lens: paraxial BFD %.4f m, peak %.4f m behind the back vertex (error %.2f mm; depth of focus "
+      "%.2f mm), %lld photons, %.0f ms\n",
+      bfd, -kLensT - z_peak, 1e3 * (z_paraxial - z_peak), 1e3 * depth_of_focus, b.emitted, b.elapsed_ms);
+  EXPECT_LE(std::abs(z_peak - z_paraxial), depth_of_focus);
+}
+
+TEST(LightTracer, PowerThroughTheLensIsConservedUpToFresnelLosses) {
+  Scene s = lensScene();
+  RayScene rays(s);
+  CausticOptions o;
+  o.photons_per_side = 200;
+  const PhotonBundle b = shootCausticPhotons(rays, o);
+  // Accounting: the sun's irradiance (1 W/m^2) times the aperture's area facing it is what enters; what leaves
+  // is that times the two interfaces' transmittance (1 - R0)^2 at normal incidence (R0 = ((n-1)/(n+1))^2; the
+  // incidence angles stay under 2.5 deg over this aperture, where 1 - R changes by < 1e-5); nothing is absorbed
+  // (non-absorbing glass, no edge band crossed, no TIR). All of it lands on a large enough screen.
+  const double area = kPi * 0.25 * kLensD * kLensD;
+  const double t = 1 - normalIncidenceReflectance(1.0, kLensN);
+  // The bound on power conservation.
+  constexpr double kPowerTol = 0.02;
+  EXPECT_NEAR(b.entering_power.y / area, 1.0, kPowerTol);
+  EXPECT_EQ(b.absorbed, 0);
+  EXPECT_NEAR(b.leaving_power.y / (area * t * t), 1.0, kPowerTol);
+  DepositOptions plane;
+  plane.mode = DepositOptions::Mode::Plane;
+  const CausticResult r = depositPhotons(b, axialReceiver(-0.3, 0.05, 100), plane);
+  EXPECT_EQ(r.deposited, (long long)b.photons.size());
+  EXPECT_NEAR(r.grid.power().y / (area * t * t), 1.0, kPowerTol);
+  std::printf(
+      "lens power: entering %.5f of E A, leaving %.5f of E A (1-R0)^2, on the grid %.5f; rel. stderr at the "
+      "peak %.3f\n",
+      b.entering_power.y / area, b.leaving_power.y / (area * t * t), r.grid.power().y / (area * t * t),
+      r.peak_rel_stderr);
+}
+
+TEST(LightTracer, ConcaveMirrorSpotLiesAtHalfItsRadius) {
+  Scene s = mirrorScene();
+  RayScene rays(s);
+  CausticOptions o;
+  o.photons_per_side = 200;
+  const PhotonBundle b = shootCausticPhotons(rays, o);
+  const double z_paraxial = 0.5 * kMirrorR;
+  const double z_peak = sweepPeak(b, z_paraxial - 0.01, z_paraxial + 0.01, 2.5e-4, kCells * kCell, kCells);
+  // Depth of focus as for the lens: +-N c, widened by the mirror's longitudinal spherical aberration (exact:
+  // the marginal ray at h = D/2 crosses the axis R/2 (1/cos(theta) - 1) before the paraxial focus, sin = h/R).
+  const double h = 0.5 * kMirrorD;
+  const double lsa = 0.5 * kMirrorR * (1 / std::sqrt(1 - h * h / (kMirrorR * kMirrorR)) - 1);
+  const double depth_of_focus = z_paraxial / kMirrorD * kCell + lsa;
+  std::printf("mirror: R/2 %.4f m, peak %.4f m (error %.2f mm; depth of focus %.2f mm)\n", z_paraxial, z_peak,
+              1e3 * (z_peak - z_paraxial), 1e3 * depth_of_focus);
+  EXPECT_LE(std::abs(z_peak - z_paraxial), depth_of_focus);
+  // Power: the reflectance times the aperture facing the light.
+  constexpr double kPowerTol = 0.02;
+  const double area = kPi * 0.25 * kMirrorD * kMirrorD;
+  EXPECT_NEAR(b.leaving_power.y / (area * kMirrorRefl), 1.0, kPowerTol);
+}
+
+}  // namespace
+}  // namespace pvrr
