@@ -9,6 +9,7 @@
 #include <cstdio>
 
 #include "cad/lens.h"
+#include "pvrr/base/error.h"
 #include "pvrr/optics/optics.h"
 #include "pvrr/optics/spectrum.h"
 #include "support/test_scenes.h"
@@ -72,6 +73,15 @@ double backFocalDistance(double n, double r1, double r2, double t) {
   return (1 - t / n * f1) / f;
 }
 
+// The image distance behind the back vertex of an axial point `object_m` before the front vertex, by a paraxial
+// (y, n u) ray trace: refraction n'u' = n u - y F at each surface, transfer y += (t/n) n u.
+double imageDistance(double n, double r1, double r2, double t, double object_m) {
+  const double f1 = (n - 1) / r1, f2 = (1 - n) / r2;
+  const double u0 = 1e-3, y1 = object_m * u0;
+  const double w1 = u0 - y1 * f1, y2 = y1 + t / n * w1, w2 = w1 - y2 * f2;
+  return -y2 / w2;
+}
+
 // A small receiver square in the plane z = z, on the axis, facing +z.
 ReceiverRect axialReceiver(double z, double size_m, int cells) {
   ReceiverRect r;
@@ -83,19 +93,23 @@ ReceiverRect axialReceiver(double z, double size_m, int cells) {
   return r;
 }
 
-double peakOf(const IrradianceGrid& g) {
+// The brightest cell's irradiance: the scalar (channel < 0) or one channel.
+double peakOf(const IrradianceGrid& g, int channel = -1) {
   double peak = 0;
-  for (double v : g.scalars()) peak = std::max(peak, v);
+  for (size_t k = 0; k < g.irradiance.size(); ++k) {
+    const Vec3& e = g.irradiance[k];
+    peak = std::max(peak, channel < 0 ? (e.x + e.y + e.z) / 3 : e[channel]);
+  }
   return peak;
 }
 
 // The plane z in [z0, z1] (steps of dz) whose brightest cell is brightest.
-double sweepPeak(const PhotonBundle& b, double z0, double z1, double dz, double size_m, int cells) {
+double sweepPeak(const PhotonBundle& b, double z0, double z1, double dz, double size_m, int cells, int channel = -1) {
   DepositOptions plane;
   plane.mode = DepositOptions::Mode::Plane;
   double best_z = z0, best = -1;
   for (double z = z0; z <= z1 + 0.5 * dz; z += dz) {
-    const double p = peakOf(depositPhotons(b, axialReceiver(z, size_m, cells), plane).grid);
+    const double p = peakOf(depositPhotons(b, axialReceiver(z, size_m, cells), plane).grid, channel);
     if (p > best) best = p, best_z = z;
   }
   return best_z;
@@ -181,6 +195,128 @@ TEST(LightTracer, ConcaveMirrorSpotLiesAtHalfItsRadius) {
   constexpr double kPowerTol = 0.02;
   const double area = kPi * 0.25 * kMirrorD * kMirrorD;
   EXPECT_NEAR(b.leaving_power.y / (area * kMirrorRefl), 1.0, kPowerTol);
+}
+
+// Dispersion: in the rgb mode each channel focuses at the paraxial BFD of its own line's index (C, d, F), blue
+// nearest the lens: a coloured caustic. Abbe V_d = 20 (a strongly dispersing glass) spreads the foci by
+// f/V_d = 25 mm, far more than the depth of focus.
+TEST(LightTracer, DispersionFocusesEachChannelAtItsOwnIndex) {
+  const Dispersion glass = Dispersion::fromAbbe(kLensN, 20);
+  Scene s = lensScene(glass);
+  RayScene rays(s);
+  CausticOptions o;
+  o.photons_per_side = 160;
+  o.dispersion = DispersionMode::Rgb;
+  const PhotonBundle b = shootCausticPhotons(rays, o);
+  EXPECT_EQ(b.samples_per_photon, 3);
+  const double lsa = 1.67 * (0.5 * kLensD) * (0.5 * kLensD) / 0.5;
+  double z_peak[3];
+  for (int c = 0; c < 3; ++c) {
+    const double bfd = backFocalDistance(glass.index(kRgbWavelengths_nm[c]), kLensR, -kLensR, kLensT);
+    const double z_paraxial = -kLensT - bfd;
+    z_peak[c] = sweepPeak(b, z_paraxial - 0.006, z_paraxial + 0.006, 2.5e-4, kCells * kCell, kCells, c);
+    EXPECT_LE(std::abs(z_peak[c] - z_paraxial), bfd / kLensD * kCell + lsa) << "channel " << c;
+  }
+  EXPECT_LT(z_peak[0], z_peak[1]);  // red focuses farthest from the lens (z more negative)
+  EXPECT_LT(z_peak[1], z_peak[2]);
+  // Each channel's weight is 1 on its own sample: each channel's power is conserved on its own.
+  const double area = kPi * 0.25 * kLensD * kLensD;
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(b.entering_power[c] / area, 1.0, 0.02) << "channel " << c;
+}
+
+// A point light 1.5 m before the lens images at 1/(1/f - 1/s) behind it, and the lens intercepts the light's
+// intensity times the solid angle of its rim circle.
+TEST(LightTracer, PointLightImagesThroughTheLens) {
+  Scene s = lensScene();
+  const double dist = 1.5;
+  s.lights[0].type = Light::Type::Point;
+  s.lights[0].position = Vec3(0, 0, dist);
+  s.lights[0].radiance = Vec3(1.0);  // 1 W/sr
+  s.updateBounds();
+  RayScene rays(s);
+  CausticOptions o;
+  o.photons_per_side = 200;
+  const PhotonBundle b = shootCausticPhotons(rays, o);
+  const double s_img = imageDistance(kLensN, kLensR, -kLensR, kLensT, dist);
+  const double z_paraxial = -kLensT - s_img;
+  const double f = backFocalDistance(kLensN, kLensR, -kLensR, kLensT);
+  const double z_peak = sweepPeak(b, z_paraxial - 0.01, z_paraxial + 0.01, 2.5e-4, kCells * kCell, kCells);
+  // Depth of focus as above: the cone's N = s'/D times the cell, and the spherical aberration, whose
+  // longitudinal extent grows as the square of the image distance (third order, the same lens bending).
+  const double lsa = 1.67 * (0.5 * kLensD) * (0.5 * kLensD) / f * (s_img / f) * (s_img / f);
+  EXPECT_LE(std::abs(z_peak - z_paraxial), s_img / kLensD * kCell + lsa);
+  // The rim circle (radius D/2) lies the front sag below the vertex plane.
+  const double rim_z = -(kLensR - std::sqrt(kLensR * kLensR - 0.25 * kLensD * kLensD));
+  const double d_rim = dist - rim_z, r = 0.5 * kLensD;
+  const double solid_angle = 2 * kPi * (1 - d_rim / std::sqrt(d_rim * d_rim + r * r));
+  EXPECT_NEAR(b.entering_power.y / solid_angle, 1.0, 0.02);
+  std::printf("point light: image %.4f m behind the back vertex, peak at %.4f m; intercepted %.5f of I omega\n",
+              -kLensT - z_paraxial, -kLensT - z_peak, b.entering_power.y / solid_angle);
+}
+
+// Deposits on a real surface (a quad at the receiver's plane, the first thing the photons meet) and on the
+// virtual plane agree; an occluder upstream of half the lens takes half the power away.
+TEST(LightTracer, SurfaceReceiverMatchesThePlaneAndOccludersBlock) {
+  Scene s = lensScene();
+  const double z = -0.3;
+  EnvMesh screen = makeQuadMesh(Vec3(0, 0, z), Vec3(0, 0, 1), Vec3(0, 1, 0), 0.2, 0.2);
+  s.meshes.push_back(screen);
+  s.updateBounds();
+  {
+    RayScene rays(s);
+    CausticOptions o;
+    o.photons_per_side = 100;
+    const PhotonBundle b = shootCausticPhotons(rays, o);
+    DepositOptions plane, surfaces;
+    plane.mode = DepositOptions::Mode::Plane;
+    surfaces.mesh = 1;
+    const ReceiverRect rect = axialReceiver(z, 0.05, 50);
+    const CausticResult a = depositPhotons(b, rect, plane), c = depositPhotons(b, rect, surfaces);
+    EXPECT_EQ(a.deposited, c.deposited);
+    // The exact hit on the quad and the analytic plane agree to the exact-hit precision, far below a cell.
+    constexpr double kSameTol = 1e-9;
+    for (size_t k = 0; k < a.grid.irradiance.size(); ++k)
+      ASSERT_NEAR(a.grid.irradiance[k].y, c.grid.irradiance[k].y, kSameTol * (1 + a.grid.irradiance[k].y));
+  }
+  // A box above the lens covering x > 0 (upstream of the sun on that half).
+  s.meshes.push_back(makeBoxMesh(Vec3(0.05, 0, 0.2), Vec3(0.1, 0.1, 0.02), Mat3(1.0)));
+  s.updateBounds();
+  RayScene rays(s);
+  CausticOptions o;
+  o.photons_per_side = 100;
+  const PhotonBundle b = shootCausticPhotons(rays, o);
+  const double area = kPi * 0.25 * kLensD * kLensD;
+  EXPECT_NEAR(b.entering_power.y / (0.5 * area), 1.0, 0.02);
+}
+
+// The same seed gives the same photons; another seed other jitters with the same totals.
+TEST(LightTracer, SeedingIsDeterministic) {
+  Scene s = lensScene();
+  RayScene rays(s);
+  CausticOptions o;
+  o.photons_per_side = 64;
+  const PhotonBundle a = shootCausticPhotons(rays, o), b = shootCausticPhotons(rays, o);
+  ASSERT_EQ(a.photons.size(), b.photons.size());
+  for (size_t k = 0; k < a.photons.size(); ++k) ASSERT_EQ(a.photons[k].direction, b.photons[k].direction);
+  o.seed = 2;
+  const PhotonBundle c = shootCausticPhotons(rays, o);
+  ASSERT_FALSE(c.photons.empty());
+  EXPECT_NE(c.photons[0].origin, a.photons[0].origin);
+  EXPECT_NEAR(c.entering_power.y / a.entering_power.y, 1.0, 0.02);
+}
+
+TEST(LightTracer, RefusesBadOptions) {
+  Scene s = lensScene();
+  RayScene rays(s);
+  CausticOptions o;
+  o.photons_per_side = 0;
+  EXPECT_THROW(shootCausticPhotons(rays, o), Error);
+  o.photons_per_side = 8;
+  o.element = 3;
+  EXPECT_THROW(shootCausticPhotons(rays, o), Error);
+  ReceiverRect r;
+  r.cells_u = 0;
+  EXPECT_THROW(depositPhotons(PhotonBundle{}, r, DepositOptions{}), Error);
 }
 
 }  // namespace
