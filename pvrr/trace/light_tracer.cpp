@@ -313,9 +313,12 @@ CausticResult depositPhotons(const PhotonBundle& bundle, const ReceiverRect& rec
       if (std::abs(glm::dot(x - rect.centre, normal)) > opt.slab_m) continue;
     }
     const Vec2 uv = rect.toReceiver(x);
-    if (!rect.contains(uv)) continue;
-    ++res.deposited;
-    res.landed_power += p.power;
+    // Photons up to half a cell outside still reach the border cells through the kernel.
+    if (std::abs(uv.x) > 0.5 * (rect.width_m + cw) || std::abs(uv.y) > 0.5 * (rect.height_m + ch)) continue;
+    if (rect.contains(uv)) {
+      ++res.deposited;
+      res.landed_power += p.power;
+    }
     // Tent kernel: continuous cell coordinates with cell centres at integers.
     const double fx = (uv.x + 0.5 * rect.width_m) / cw - 0.5, fy = (uv.y + 0.5 * rect.height_m) / ch - 0.5;
     const int i0 = int(std::floor(fx)), j0 = int(std::floor(fy));

@@ -27,7 +27,8 @@
 //   scene's surfaces (the first environment hit, kept if it lies within `slab_m` of the receiver's plane and
 //   inside the rectangle) or the receiver's plane alone (a virtual screen: focus sweeps). Its power is splatted
 //   with a tent kernel one cell wide (bilinear weights to the four nearest cell centres; the weights sum to 1, so
-//   power is conserved except within half a cell of the rectangle's border) and divided by the cell area.
+//   the border cells also take their share of the photons up to half a cell outside, so that they are not
+//   biased low; power is conserved except within half a cell of the border) and divided by the cell area.
 #pragma once
 #include <cstdint>
 #include <string>
