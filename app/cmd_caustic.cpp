@@ -304,7 +304,8 @@ int cmdCaustic(const std::vector<std::string>& argv) {
   const std::string scene_path = a.positional()[0];
   CausticOptions o;
   o.photons_per_side = a.getInt("photons", kDefaultPhotonsPerSide, 1);
-  if (o.photons_per_side > 4096) usageError("caustic", "--photons: expected at most 4096 (per side)");
+  // Photons are kept until deposited (about 100 bytes each): 2048^2 x 3 samples is about 1.3 GB.
+  if (o.photons_per_side > 2048) usageError("caustic", "--photons: expected at most 2048 (per side)");
   o.seed = uint64_t(a.getInt("seed", 1, 0));
   const int cells = a.getInt("cells", kDefaultCells, 4);
   if (cells > 2000) usageError("caustic", "--cells: expected at most 2000");

@@ -77,6 +77,10 @@ TEST(CausticCli, RefusesWithOneLineAndWritesNothing) {
   expectOneLineError(runPvrr("caustic models/burning-lens.json --receiver wall" + out),
                      "environment (wall): no caustic light lands");
   expectOneLineError(runPvrr("caustic models/burning-lens.json"), "--out DIR is required");
+  expectOneLineError(runPvrr("caustic models/burning-lens.json --element lens" + out),
+                     "models/burning-lens.json: elements: no element named \"lens\"");
+  expectOneLineError(runPvrr("caustic models/burning-lens.json --photons 3000 --out '" + (dir / "out").string() + "'"),
+                     "--photons: expected at most 2048");
   EXPECT_FALSE(fs::exists(dir / "out"));
   fs::remove_all(dir);
 }
