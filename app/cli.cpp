@@ -110,6 +110,18 @@ const std::map<std::string, Command>& commands() {
         "  covered_fraction, obstructed_fraction, pass, verified; surface: mean and principal radii, magnification\n"
         "  range), the plan view DIR/fov.png and .svg, and the magnification map DIR/magnification.png and .svg.\n"
         "  Conventions: docs/fov.md."}},
+      {"caustic",
+       {cmdCaustic, "the reference's caustic of mirrors and lenses on a receiving surface: irradiance map and figures",
+        "pvrr caustic SCENE [--receiver NAME] [--window CU,CV,W,H] [--cells N] [--photons N] [--seed N]\n"
+        "         [--element NAME] [--set PATH=VALUE]... --out DIR\n"
+        "  Light tracing from the directional and point lights through the elements (N x N photons per light,\n"
+        "  element and wavelength sample, default 512, at most 2048; render.dispersion sets the samples) onto the\n"
+        "  receiver: a quad or ground of the scene (default: the one receiving the most caustic power). The map\n"
+        "  covers the window (receiver coordinates in metres about its centre; default: around the light that\n"
+        "  lands) in N cells along its longer side (default 160). Writes DIR/caustic.png (false colour, colour bar\n"
+        "  in W/m^2), DIR/caustic-colour.png (the irradiance in colour), DIR/caustic.csv (per cell:\n"
+        "  i,j,u_m,v_m,x_m,y_m,z_m,irradiance_r,irradiance_g,irradiance_b,irradiance,stderr) and DIR/caustic.json\n"
+        "  (peak, spot, power, photon counts). Method and accuracy: docs/caustics.md."}},
       {"mesh",
        {cmdMesh, "tessellate a surface and write it as OBJ, PLY or VTP",
         "pvrr mesh (SURFACE_FILE | SCENE --element NAME) [--tessellation N | --tolerance T] --out FILE.obj|.ply|.vtp"}},

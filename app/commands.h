@@ -30,6 +30,7 @@ int cmdSweep(const std::vector<std::string>& args);
 int cmdPlot(const std::vector<std::string>& args);
 int cmdLensmap(const std::vector<std::string>& args);
 int cmdFov(const std::vector<std::string>& args);
+int cmdCaustic(const std::vector<std::string>& args);
 
 // The default scene of `pvrr render` with no scene argument.
 constexpr const char* kDefaultScene = "models/car-mirror.json";

@@ -1,0 +1,361 @@
+#include "pvrr/trace/light_tracer.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "pvrr/base/error.h"
+#include "pvrr/optics/optics.h"
+#include "pvrr/optics/spectrum.h"
+
+namespace pvrr {
+
+namespace {
+
+// splitmix64 (Steele, Lea, Flood 2014): a portable hash of the stratum's identity, so that every photon's
+// jitter depends on nothing but (seed, light, element, sample, stratum), whatever the thread schedule.
+uint64_t mix64(uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+double unitFromBits(uint64_t x) { return double(x >> 11) * 0x1.0p-53; }
+
+// An orthonormal pair perpendicular to unit w.
+void perpendicularPair(const Vec3& w, Vec3& a, Vec3& b) {
+  const Vec3 h = std::abs(w.x) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
+  a = glm::normalize(glm::cross(w, h));
+  b = glm::cross(w, a);
+}
+
+// Points of an element's surfaces in world, on a grid over their parameter domains (its silhouette's support).
+std::vector<Vec3> elementPoints(const Element& el) {
+  constexpr int kGrid = 25;
+  std::vector<const cad::Surface*> surfaces;
+  if (el.type == ElementType::Lens) {
+    surfaces = {el.lens.front.get(), el.lens.back.get()};
+  } else {
+    surfaces = {el.surface.get()};
+  }
+  std::vector<Vec3> pts;
+  for (const cad::Surface* s : surfaces) {
+    if (!s) continue;
+    const cad::ParamDomain d = s->domain();
+    for (int i = 0; i < kGrid; ++i)
+      for (int j = 0; j < kGrid; ++j) {
+        const double u = d.u0 + (d.u1 - d.u0) * i / (kGrid - 1), v = d.v0 + (d.v1 - d.v0) * j / (kGrid - 1);
+        const Vec3 p = s->evaluate(u, v).p;
+        if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) pts.push_back(el.toWorldPoint(p));
+      }
+  }
+  return pts;
+}
+
+// Where the photons of one (light, element) pair come from: origin + x a + y b (+ along the axis) over the
+// rectangle [x0, x1] x [y0, y1]. Directional: positions on a plane normal to the light; point: tangents about
+// the axis light -> element.
+struct Aperture {
+  bool point = false;
+  Vec3 origin{0}, axis{0}, a{0}, b{0};
+  double x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+};
+
+bool apertureFor(const Scene& scene, const Light& light, const Element& el, Aperture& ap, std::string& why) {
+  const std::vector<Vec3> pts = elementPoints(el);
+  if (pts.empty()) {
+    why = "no finite point on its surfaces";
+    return false;
+  }
+  Vec3 centre(0);
+  for (const Vec3& p : pts) centre += p;
+  centre /= double(pts.size());
+  ap.point = light.type == Light::Type::Point;
+  if (ap.point) {
+    ap.origin = light.position;
+    const Vec3 w = centre - light.position;
+    if (glm::length(w) <= 0) {
+      why = "the light sits inside the element";
+      return false;
+    }
+    ap.axis = glm::normalize(w);
+  } else {
+    ap.axis = glm::normalize(light.direction);
+  }
+  perpendicularPair(ap.axis, ap.a, ap.b);
+  ap.x0 = ap.y0 = kInf;
+  ap.x1 = ap.y1 = -kInf;
+  double along_min = kInf;
+  for (const Vec3& p : pts) {
+    const Vec3 r = p - (ap.point ? light.position : centre);
+    double x = glm::dot(r, ap.a), y = glm::dot(r, ap.b);
+    const double s = glm::dot(r, ap.axis);
+    if (ap.point) {
+      if (s <= 1e-9 * glm::length(r)) {
+        why = "the light lies within the element's extent (not all of it is ahead of the light)";
+        return false;
+      }
+      x /= s;
+      y /= s;
+    }
+    along_min = std::min(along_min, glm::dot(p, ap.axis));
+    ap.x0 = std::min(ap.x0, x), ap.x1 = std::max(ap.x1, x);
+    ap.y0 = std::min(ap.y0, y), ap.y1 = std::max(ap.y1, y);
+  }
+  const double pad = kAperturePad * std::max(ap.x1 - ap.x0, ap.y1 - ap.y0);
+  ap.x0 -= pad, ap.x1 += pad, ap.y0 -= pad, ap.y1 += pad;
+  if (!ap.point) {
+    // Start upstream of everything in the scene, so that what lies between the light and the element blocks it.
+    for (int k = 0; k < 8; ++k) {
+      const Vec3 c((k & 1) ? scene.bounds_max.x : scene.bounds_min.x, (k & 2) ? scene.bounds_max.y : scene.bounds_min.y,
+                   (k & 4) ? scene.bounds_max.z : scene.bounds_min.z);
+      along_min = std::min(along_min, glm::dot(c, ap.axis));
+    }
+    const double margin = 1e-2 + 1e-3 * glm::length(scene.bounds_max - scene.bounds_min);
+    ap.origin = centre + (along_min - margin - glm::dot(centre, ap.axis)) * ap.axis;
+  }
+  return true;
+}
+
+// The wavelength samples to trace: one when nothing in the scene depends on the wavelength.
+std::vector<SpectralSample> samplesFor(const Scene& scene, const CausticOptions& o) {
+  bool depends = false;
+  for (const Element& e : scene.elements) {
+    if (e.type == ElementType::Lens && e.dispersion.abbe() < kInf) depends = true;
+    if (o.dispersion == DispersionMode::Spectral && e.type == ElementType::Mirror && e.mirror.metal_table)
+      depends = true;
+  }
+  if (!depends || o.dispersion == DispersionMode::Off) return {SpectralSample{0, Vec3(1.0)}};
+  return o.dispersion == DispersionMode::Rgb ? rgbSamples() : spectralSamples(o.spectral_samples);
+}
+
+enum class Fate { Missed, Absorbed, Left };
+
+// Follows one photon from its first element to the ray it leaves on. `p` holds origin, direction and power on
+// entry. Returns Missed when its first hit is not `element`.
+Fate tracePhoton(const RayScene& rays, int element, double wavelength_nm, bool spectral, int max_depth,
+                 CausticPhoton& p) {
+  const Scene& scene = rays.scene();
+  Vec3 o = p.origin, d = p.direction;
+  int inside = -1;
+  double t_min = 0;
+  for (int depth = 0;; ++depth) {
+    RayHit hit;
+    if (inside < 0) {
+      hit = rays.intersect(o, d, t_min);
+    } else {
+      const RayHit back = rays.intersectElementSurface(inside, 1, o, d, t_min);
+      const RayHit front = rays.intersectElementSurface(inside, 0, o, d, t_min);
+      hit = back.t <= front.t ? back : front;
+      if (!hit.hit()) return Fate::Absorbed;  // out through the lens's edge band, not modelled as a surface
+    }
+    if (depth == 0 && (hit.kind != HitKind::Element || hit.element != element)) return Fate::Missed;
+    if (hit.kind != HitKind::Element) {
+      p.origin = o;
+      p.direction = d;
+      p.t_hit = hit.hit() ? hit.t : kInf;
+      p.mesh = hit.hit() ? hit.mesh : -1;
+      return Fate::Left;
+    }
+    if (depth >= max_depth) return Fate::Absorbed;
+    const Element& el = scene.elements[size_t(hit.element)];
+    const double cos_i = -glm::dot(d, hit.normal);
+    ++p.bounces;
+    if (el.type == ElementType::Mirror) {
+      if (cos_i <= 0) return Fate::Absorbed;  // the mirror's back
+      Vec3 refl = el.mirror.reflectance;
+      if (el.mirror.metal) {
+        if (spectral && el.mirror.metal_table) {
+          const ComplexIndex nk = el.mirror.metal_table->index(wavelength_nm > 0 ? wavelength_nm : kLineD_nm);
+          refl = Vec3(fresnelConductor(cos_i, 1.0, nk.n, nk.k));
+        } else {
+          for (int c = 0; c < 3; ++c) refl[c] = fresnelConductor(cos_i, 1.0, el.mirror.n[c], el.mirror.k[c]);
+        }
+      }
+      p.power *= refl;
+      o = hit.point;
+      d = reflect(d, hit.normal);
+      t_min = rays.epsilon();
+      continue;
+    }
+    const double n_glass = el.dispersion.index(wavelength_nm > 0 ? wavelength_nm : kLineD_nm);
+    const bool entering = inside < 0;
+    const double n1 = entering ? 1.0 : n_glass, n2 = entering ? n_glass : 1.0;
+    const Refraction rf = refract(d, hit.normal, n1, n2);
+    o = hit.point;
+    t_min = rays.epsilon();
+    if (rf.tir) {
+      d = reflect(d, hit.normal);
+      continue;
+    }
+    p.power *= 1.0 - fresnelDielectric(std::abs(cos_i), n1, n2);
+    d = rf.direction;
+    inside = entering ? hit.element : -1;
+  }
+}
+
+// Counts and photons of one row of strata.
+struct RowOut {
+  std::vector<CausticPhoton> photons;
+  long long entered = 0, absorbed = 0;
+  Vec3 entering_power{0}, leaving_power{0};
+};
+
+void shootRow(const RayScene& rays, const Light& light, const Aperture& ap, int light_index, int element,
+              int sample_index, const SpectralSample& sample, bool spectral, const CausticOptions& o, int row,
+              RowOut& out) {
+  const int side = o.photons_per_side;
+  const double dx = (ap.x1 - ap.x0) / side, dy = (ap.y1 - ap.y0) / side;
+  for (int col = 0; col < side; ++col) {
+    uint64_t h = mix64(o.seed);
+    for (uint64_t k : {uint64_t(light_index), uint64_t(element), uint64_t(sample_index), uint64_t(row), uint64_t(col)})
+      h = mix64(h ^ k);
+    const double x = ap.x0 + (col + unitFromBits(h)) * dx;
+    const double y = ap.y0 + (row + unitFromBits(mix64(h))) * dy;
+    CausticPhoton p;
+    p.light = light_index;
+    p.element = element;
+    if (ap.point) {
+      p.origin = ap.origin;
+      p.direction = glm::normalize(ap.axis + x * ap.a + y * ap.b);
+      const double q = 1.0 + x * x + y * y;
+      p.power = light.radiance * sample.rgb_weight * (dx * dy / (q * std::sqrt(q)));
+    } else {
+      p.origin = ap.origin + x * ap.a + y * ap.b;
+      p.direction = ap.axis;
+      p.power = light.radiance * sample.rgb_weight * (dx * dy);
+    }
+    const Vec3 entering = p.power;
+    const Fate fate = tracePhoton(rays, element, sample.wavelength_nm, spectral, o.max_depth, p);
+    if (fate == Fate::Missed) continue;
+    ++out.entered;
+    out.entering_power += entering;
+    if (fate == Fate::Absorbed) {
+      ++out.absorbed;
+      continue;
+    }
+    out.leaving_power += p.power;
+    out.photons.push_back(p);
+  }
+}
+
+}  // namespace
+
+PhotonBundle shootCausticPhotons(const RayScene& rays, const CausticOptions& o) {
+  const auto start = std::chrono::steady_clock::now();
+  const Scene& scene = rays.scene();
+  if (o.photons_per_side < 1 || o.photons_per_side > 8192)
+    throw Error("caustics: photons per side must be in [1, 8192], got " + std::to_string(o.photons_per_side));
+  if (o.element >= int(scene.elements.size()))
+    throw Error("caustics: element " + std::to_string(o.element) + " out of range");
+  const std::vector<SpectralSample> samples = samplesFor(scene, o);
+  const bool spectral = o.dispersion == DispersionMode::Spectral;
+  PhotonBundle b;
+  b.samples_per_photon = int(samples.size());
+  const int side = o.photons_per_side;
+  for (size_t li = 0; li < scene.lights.size(); ++li) {
+    const Light& light = scene.lights[li];
+    if (light.type == Light::Type::Ambient) continue;  // no direction: it makes no caustic
+    for (size_t ei = 0; ei < scene.elements.size(); ++ei) {
+      if (o.element >= 0 && int(ei) != o.element) continue;
+      Aperture ap;
+      std::string why;
+      if (!apertureFor(scene, light, scene.elements[ei], ap, why)) {
+        b.notes.push_back("light " + std::to_string(li) + ", element \"" + scene.elements[ei].name + "\": skipped, " +
+                          why);
+        continue;
+      }
+      for (size_t si = 0; si < samples.size(); ++si) {
+        std::vector<RowOut> rows(static_cast<size_t>(side));
+        tbb::parallel_for(tbb::blocked_range<int>(0, side, 1), [&](const tbb::blocked_range<int>& r) {
+          for (int row = r.begin(); row < r.end(); ++row)
+            shootRow(rays, light, ap, int(li), int(ei), int(si), samples[si], spectral, o, row, rows[size_t(row)]);
+        });
+        b.emitted += (long long)side * side;
+        for (RowOut& r : rows) {
+          b.entered += r.entered;
+          b.absorbed += r.absorbed;
+          b.entering_power += r.entering_power;
+          b.leaving_power += r.leaving_power;
+          b.photons.insert(b.photons.end(), r.photons.begin(), r.photons.end());
+        }
+      }
+    }
+  }
+  b.elapsed_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return b;
+}
+
+CausticResult depositPhotons(const PhotonBundle& bundle, const ReceiverRect& rect, const DepositOptions& opt) {
+  if (rect.cells_u < 1 || rect.cells_v < 1 || !(rect.width_m > 0) || !(rect.height_m > 0))
+    throw Error("caustics: the receiver needs positive cells and size");
+  CausticResult res;
+  res.emitted = bundle.emitted;
+  res.grid = IrradianceGrid::zeros(rect);
+  const size_t n = res.grid.irradiance.size();
+  std::vector<double> sum_sq(n, 0.0);  // per cell: sum of (w P_scalar)^2
+  const Vec3 normal = rect.normal();
+  const double cw = rect.cellWidth(), ch = rect.cellHeight(), inv_area = 1.0 / rect.cellArea();
+  for (const CausticPhoton& p : bundle.photons) {
+    Vec3 x;
+    if (opt.mode == DepositOptions::Mode::Plane) {
+      const double dn = glm::dot(p.direction, normal);
+      if (dn == 0) continue;
+      const double t = glm::dot(rect.centre - p.origin, normal) / dn;
+      if (!(t > 0)) continue;
+      x = p.origin + t * p.direction;
+    } else {
+      if (!std::isfinite(p.t_hit) || (opt.mesh >= 0 && p.mesh != opt.mesh)) continue;
+      x = p.origin + p.t_hit * p.direction;
+      if (std::abs(glm::dot(x - rect.centre, normal)) > opt.slab_m) continue;
+    }
+    const Vec2 uv = rect.toReceiver(x);
+    // Photons up to half a cell outside still reach the border cells through the kernel.
+    if (std::abs(uv.x) > 0.5 * (rect.width_m + cw) || std::abs(uv.y) > 0.5 * (rect.height_m + ch)) continue;
+    if (rect.contains(uv)) {
+      ++res.deposited;
+      res.landed_power += p.power;
+    }
+    // Tent kernel: continuous cell coordinates with cell centres at integers.
+    const double fx = (uv.x + 0.5 * rect.width_m) / cw - 0.5, fy = (uv.y + 0.5 * rect.height_m) / ch - 0.5;
+    const int i0 = int(std::floor(fx)), j0 = int(std::floor(fy));
+    const double ax = fx - i0, ay = fy - j0;
+    const double scalar = (p.power.x + p.power.y + p.power.z) / 3.0;
+    for (int dj = 0; dj < 2; ++dj)
+      for (int di = 0; di < 2; ++di) {
+        const int i = i0 + di, j = j0 + dj;
+        if (i < 0 || j < 0 || i >= rect.cells_u || j >= rect.cells_v) continue;
+        const double w = (di ? ax : 1 - ax) * (dj ? ay : 1 - ay);
+        const size_t k = res.grid.index(i, j);
+        res.grid.irradiance[k] += w * inv_area * p.power;
+        sum_sq[k] += (w * scalar) * (w * scalar);
+      }
+  }
+  res.grid.variance.resize(n);
+  double peak = 0;
+  size_t peak_k = 0;
+  for (size_t k = 0; k < n; ++k) {
+    res.grid.variance[k] = sum_sq[k] * inv_area * inv_area;
+    const Vec3& e = res.grid.irradiance[k];
+    const double s = (e.x + e.y + e.z) / 3.0;
+    if (s > peak) peak = s, peak_k = k;
+  }
+  if (peak > 0) {
+    res.peak_rel_stderr = std::sqrt(res.grid.variance[peak_k]) / peak;
+    double wsum = 0, acc = 0;
+    for (size_t k = 0; k < n; ++k) {
+      const Vec3& e = res.grid.irradiance[k];
+      const double s = (e.x + e.y + e.z) / 3.0;
+      if (s < 0.5 * peak) continue;
+      wsum += s;
+      acc += s * (std::sqrt(res.grid.variance[k]) / s);
+    }
+    res.spot_rel_stderr = acc / wsum;
+  }
+  return res;
+}
+
+}  // namespace pvrr

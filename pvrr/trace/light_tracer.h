@@ -1,0 +1,102 @@
+// Caustics in the reference: light tracing from the lights through the optical elements (docs/caustics.md).
+//
+// What it computes: the irradiance that reaches diffuse surfaces along purely specular paths light -> element
+// (reflections off mirrors, refractions through lenses, total internal reflections inside them) -> diffuse
+// surface, the "L S+ D" part of the light. Direct light (L D) is the shading's (pvrr/trace/shading.h), not
+// counted here; light reflected by a lens surface is not followed (the tracer's lens model).
+//
+// Method (per directional or point light, per element, per wavelength sample):
+// - Aperture: the element's surfaces, sampled on their parameter domains, are projected along the light
+//   (directional: onto the plane normal to its direction; point: as tangents of the angle about the axis
+//   light -> element centre); their bounding rectangle, padded by kAperturePad of its size, is the aperture.
+// - Photons: side x side strata over the aperture, one photon jittered uniformly in each (a deterministic hash of
+//   seed, light, element, sample and stratum: the same photons at any thread count). A directional light's
+//   photon carries its irradiance x the stratum's area, and starts upstream of everything in the scene; a point
+//   light's carries its intensity x the stratum's solid angle (d(tan a) d(tan b) / (1 + tan^2 a + tan^2 b)^3/2)
+//   and starts at the light. A photon counts only if the first thing it meets is that element (what meets
+//   something else first is direct light, or another element's photon); so occluders upstream are honoured.
+// - Transport: mirrors multiply by their reflectance (a metal's conductor Fresnel reflectance per channel, or at
+//   the sample's wavelength in the spectral mode), lens interfaces by the exact unpolarised Fresnel
+//   transmittance 1 - R at the sample's index n(lambda) (pvrr/optics/optics.h); TIR is followed; a mirror's back,
+//   a lens's edge band and the depth limit absorb. The lens glass itself is taken as non-absorbing (the scene
+//   format has no absorption coefficient); so is the air.
+// - Dispersion (TraceOptions' modes): off: one sample at the d line, weight (1, 1, 1); rgb: three samples at the
+//   C, d, F lines, each keeping its channel; spectral: N samples with the colour-matching weights of
+//   pvrr/optics/spectrum.h. Scenes without a dispersing lens (or, spectral, a tabulated metal) trace one sample.
+// - Deposit (depositPhotons): the photon's ray after its last specular event meets the receiver: either the
+//   scene's surfaces (the first environment hit, kept if it lies within `slab_m` of the receiver's plane and
+//   inside the rectangle) or the receiver's plane alone (a virtual screen: focus sweeps). Its power is splatted
+//   with a tent kernel one cell wide (bilinear weights to the four nearest cell centres; the weights sum to 1, so
+//   the border cells also take their share of the photons up to half a cell outside, so that they are not
+//   biased low; power is conserved except within half a cell of the border) and divided by the cell area.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "pvrr/scene/render_desc.h"
+#include "pvrr/trace/irradiance_grid.h"
+#include "pvrr/trace/ray_scene.h"
+
+namespace pvrr {
+
+struct CausticOptions {
+  int photons_per_side = 256;  // strata per side of each aperture: side^2 photons per (light, element, sample)
+  int max_depth = 8;           // specular events before a photon is absorbed
+  DispersionMode dispersion = DispersionMode::Off;
+  int spectral_samples = 16;
+  uint64_t seed = 1;
+  int element = -1;  // only this element's photons (-1: every element)
+};
+
+// A photon after its last specular event: the ray it leaves on, its power, and where that ray meets the scene.
+struct CausticPhoton {
+  Vec3 origin{0}, direction{0};  // direction unit
+  Vec3 power{0};                 // per channel (W in the scene's light units)
+  double t_hit = kInf;           // distance along the ray to the first environment surface (kInf: escapes)
+  int mesh = -1;                 // that surface's mesh index, or -1
+  int light = -1, element = -1;  // where it came from: light index, first element
+  int bounces = 0;               // specular events
+};
+
+struct PhotonBundle {
+  std::vector<CausticPhoton> photons;  // the photons that left their last element (absorbed ones are not kept)
+  long long emitted = 0;               // photons shot over the apertures (every stratum of every sample)
+  long long entered = 0;               // of them, those whose first hit was the aperture's element
+  long long absorbed = 0;              // of those, absorbed (mirror back, lens edge band, depth limit)
+  Vec3 entering_power{0};              // power of the entering photons (per channel): what the elements intercept
+  Vec3 leaving_power{0};               // power of `photons` after Fresnel and reflectance losses
+  int samples_per_photon = 1;          // wavelength samples traced per stratum
+  std::vector<std::string> notes;      // (light, element) pairs skipped, with the reason
+  double elapsed_ms = 0;
+};
+
+// Shoots and traces the photons of every directional and point light through every element (or
+// options.element). Multithreaded (TBB); deterministic for a given seed. Throws pvrr::Error for
+// photons_per_side outside [1, 8192] or an element index out of range.
+PhotonBundle shootCausticPhotons(const RayScene& rays, const CausticOptions& options);
+
+struct DepositOptions {
+  enum class Mode { Surfaces, Plane };
+  Mode mode = Mode::Surfaces;
+  double slab_m = 1e-3;  // Surfaces: how far from the rectangle's plane a hit may lie
+  int mesh = -1;         // Surfaces: only hits on this mesh (-1: any)
+};
+
+struct CausticResult {
+  IrradianceGrid grid;      // irradiance per cell, and the variance of its scalar estimate per cell
+  long long deposited = 0;  // photons that landed inside the rectangle
+  Vec3 landed_power{0};     // their power (per channel); grid.power() is this less what the kernel put outside
+  long long emitted = 0;    // the bundle's emitted photons (the sample count of the estimate)
+  // The relative standard error of the scalar irradiance at the brightest cell, and averaged (power-weighted)
+  // over the cells above half the peak: sqrt(sum (w P)^2) / (sum w P) per cell, the estimate as if the photons
+  // were independent (an upper bound for stratified photons).
+  double peak_rel_stderr = 0, spot_rel_stderr = 0;
+};
+
+CausticResult depositPhotons(const PhotonBundle& bundle, const ReceiverRect& receiver, const DepositOptions& options);
+
+// The padding of an aperture rectangle, relative to its size (covers the sampling of curved rims).
+constexpr double kAperturePad = 0.02;
+
+}  // namespace pvrr
