@@ -156,6 +156,93 @@ std::vector<std::string> poseOverrides(int index, const Mat4& m, double unit_m) 
 
 }  // namespace
 
+// --aim: the search (pvrr/analysis/fov_aim.h), the aimed scene written, loaded and built afresh and checked at the
+// command's own sampling; fov.json's "aim", DIR/aimed.json and the aimed plan view DIR/aimed/fov.png and .svg.
+struct AimReport {
+  json aim;
+  std::string summary;
+  std::vector<std::string> written;
+};
+
+AimReport runAim(const std::string& scene_path, const std::vector<std::string>& set_overrides, const LoadedScene& ls,
+                 int index, const VehicleFrame& frame, const std::string& eyes_opt, const std::vector<Regulation>& regs,
+                 const FovOptions& options, const FovRun& before, double aim_range_deg, const std::string& out) {
+  AimReport res;
+  const Scene& scene = ls.scene;
+  const std::string& name = scene.elements[size_t(index)].name;
+  AimOptions ao;
+  ao.fov = options;
+  ao.fov.samples = std::min(options.samples, kAimSamples);
+  ao.fov.zone_samples_x = kAimZoneSamplesX;
+  ao.fov.zone_samples_y = kAimZoneSamplesY;
+  ao.range_deg = aim_range_deg;
+  ao.left_eye = eyes_opt != "right";
+  ao.right_eye = eyes_opt != "left";
+  std::vector<FovZone> zones;
+  for (const Regulation& r : regs) zones.insert(zones.end(), r.zones.begin(), r.zones.end());
+  const AimResult ar = aimMirror(scene, index, frame, zones, ao);
+  // The answer checked the way the command checks any scene: the aimed file built afresh, evaluated at the
+  // command's own sampling.
+  std::vector<std::string> overrides = set_overrides;
+  for (const std::string& o : poseOverrides(index, ar.local_to_world, ls.desc.unit_m)) overrides.push_back(o);
+  const LoadedScene aimed = loadScene(scene_path, overrides);
+  const FovRun after = runFov(aimed.scene, index, frame, eyes_opt, regs, options);
+  json zones_after = json::array();
+  std::vector<FovPlotZone> plot_after;
+  size_t zi = 0;
+  std::string aim_summary;
+  for (const Regulation& r : regs)
+    for (const FovZone& z : r.zones) {
+      const ZoneResult& zr = after.results[zi++];
+      plot_after.push_back({&z, &zr});
+      zones_after.push_back(zoneJson(r, z, zr));
+      aim_summary += "  aimed " + zoneLine(r, z, zr);
+    }
+  double worst = 1;
+  for (size_t k = 0; k < zones.size(); ++k)
+    worst = std::min(worst, after.results[k].covered_fraction +
+                                std::min(after.results[k].obstructed_fraction, zones[k].allowed_obstructed_fraction));
+  res.aim = {{"pivot", {ar.pivot.x, ar.pivot.y, ar.pivot.z}},
+             {"yaw_axis", {ar.yaw_axis.x, ar.yaw_axis.y, ar.yaw_axis.z}},
+             {"pitch_axis", {ar.pitch_axis.x, ar.pitch_axis.y, ar.pitch_axis.z}},
+             {"yaw_deg", ar.angles.yaw_rad * 180 / kPi},
+             {"pitch_deg", ar.angles.pitch_rad * 180 / kPi},
+             {"range_deg", aim_range_deg},
+             {"pass_before", before.pass},
+             {"pass", after.pass},
+             {"search_pass", ar.after.pass},
+             {"score", worst},
+             {"shortfall", 1 - worst},
+             {"margin_deg", ar.margin_deg},
+             {"evaluations", ar.evaluations},
+             {"search_samples", ao.fov.samples},
+             {"polish", ar.polish_report},
+             {"zones", zones_after},
+             {"scene", (fs::path(out) / "aimed.json").string()},
+             {"definitions",
+              "rotation about the pivot (the element's vertex): yaw about the vehicle's up axis after pitch about "
+              "the horizontal axis in the mirror's plane; score: the smallest over the zones of the covered fraction "
+              "plus the obstructed fraction up to its allowance (1: every zone passes); zones: the aimed scene "
+              "checked afresh at the command's sampling (pvrr/analysis/fov_aim.h)"}};
+  res.summary +=
+      "aim: yaw " + fmt("%.2f", ar.angles.yaw_rad * 180 / kPi) + " deg, pitch " +
+      fmt("%.2f", ar.angles.pitch_rad * 180 / kPi) + " deg about " + name + "'s vertex: " +
+      (after.pass
+           ? "every zone passes"
+           : "no adjustment within " + fmt("%.0f", aim_range_deg) + " deg meets every zone; the best falls short by " +
+                 fmt("%.1f", 100 * (1 - worst)) + " % of a zone") +
+      (ar.after.pass != after.pass ? " (the search's coarser sampling said otherwise)" : "") + "\n" + aim_summary;
+  view::saveView((fs::path(out) / "aimed.json").string(), scene_path, overrides, aimed.scene.observer, ls.desc.unit_m);
+  res.written.push_back((fs::path(out) / "aimed.json").string());
+  std::string title = name + " aimed (yaw " + fmt("%.2f", ar.angles.yaw_rad * 180 / kPi) + " deg, pitch " +
+                      fmt("%.2f", ar.angles.pitch_rad * 180 / kPi) + " deg)";
+  const bool driver_side = regs.front().driver_side;
+  for (const std::string& p :
+       writeFovPlot((fs::path(out) / "aimed").string(), title, frame, driver_side, after.eyes, plot_after, options))
+    res.written.push_back(p);
+  return res;
+}
+
 int cmdFov(const std::vector<std::string>& argv) {
   Args a("fov", argv, {"element", "regulation", "eyes", "samples", "aim-range", "out", "set"}, {"aim"},
          {"set", "regulation"});
@@ -288,78 +375,11 @@ int cmdFov(const std::vector<std::string>& argv) {
 
   std::vector<std::string> written;
   if (aim) {
-    AimOptions ao;
-    ao.fov = options;
-    ao.fov.samples = std::min(options.samples, kAimSamples);
-    ao.fov.zone_samples_x = kAimZoneSamplesX;
-    ao.fov.zone_samples_y = kAimZoneSamplesY;
-    ao.range_deg = aim_range_deg;
-    ao.left_eye = eyes_opt != "right";
-    ao.right_eye = eyes_opt != "left";
-    std::vector<FovZone> zones;
-    for (const Regulation& r : regs) zones.insert(zones.end(), r.zones.begin(), r.zones.end());
-    const AimResult ar = aimMirror(scene, index, frame, zones, ao);
-    // The answer checked the way the command checks any scene: the aimed file built afresh, evaluated at the
-    // command's own sampling.
-    std::vector<std::string> overrides = a.all("set");
-    for (const std::string& o : poseOverrides(index, ar.local_to_world, ls.desc.unit_m)) overrides.push_back(o);
-    const LoadedScene aimed = loadScene(scene_path, overrides);
-    const FovRun after = runFov(aimed.scene, index, frame, eyes_opt, regs, options);
-    json zones_after = json::array();
-    std::vector<FovPlotZone> plot_after;
-    zi = 0;
-    std::string aim_summary;
-    for (const Regulation& r : regs)
-      for (const FovZone& z : r.zones) {
-        const ZoneResult& zr = after.results[zi++];
-        plot_after.push_back({&z, &zr});
-        zones_after.push_back(zoneJson(r, z, zr));
-        aim_summary += "  aimed " + zoneLine(r, z, zr);
-      }
-    double worst = 1;
-    for (size_t k = 0; k < zones.size(); ++k)
-      worst = std::min(worst, after.results[k].covered_fraction +
-                                  std::min(after.results[k].obstructed_fraction, zones[k].allowed_obstructed_fraction));
-    j["aim"] = {
-        {"pivot", {ar.pivot.x, ar.pivot.y, ar.pivot.z}},
-        {"yaw_axis", {ar.yaw_axis.x, ar.yaw_axis.y, ar.yaw_axis.z}},
-        {"pitch_axis", {ar.pitch_axis.x, ar.pitch_axis.y, ar.pitch_axis.z}},
-        {"yaw_deg", ar.angles.yaw_rad * 180 / kPi},
-        {"pitch_deg", ar.angles.pitch_rad * 180 / kPi},
-        {"range_deg", aim_range_deg},
-        {"pass_before", run.pass},
-        {"pass", after.pass},
-        {"search_pass", ar.after.pass},
-        {"score", worst},
-        {"shortfall", 1 - worst},
-        {"margin_deg", ar.margin_deg},
-        {"evaluations", ar.evaluations},
-        {"search_samples", ao.fov.samples},
-        {"polish", ar.polish_report},
-        {"zones", zones_after},
-        {"scene", (fs::path(*out) / "aimed.json").string()},
-        {"definitions",
-         "rotation about the pivot (the element's vertex): yaw about the vehicle's up axis after pitch about "
-         "the horizontal axis in the mirror's plane; score: the smallest over the zones of the covered fraction "
-         "plus the obstructed fraction up to its allowance (1: every zone passes); zones: the aimed scene "
-         "checked afresh at the command's sampling (pvrr/analysis/fov_aim.h)"}};
-    summary += "aim: yaw " + fmt("%.2f", ar.angles.yaw_rad * 180 / kPi) + " deg, pitch " +
-               fmt("%.2f", ar.angles.pitch_rad * 180 / kPi) + " deg about " + el.name + "'s vertex: " +
-               (after.pass ? "every zone passes"
-                           : "no adjustment within " + fmt("%.0f", aim_range_deg) +
-                                 " deg meets every zone; the best falls short by " + fmt("%.1f", 100 * (1 - worst)) +
-                                 " % of a zone") +
-               (ar.after.pass != after.pass ? " (the search's coarser sampling said otherwise)" : "") + "\n" +
-               aim_summary;
-    view::saveView((fs::path(*out) / "aimed.json").string(), scene_path, overrides, aimed.scene.observer,
-                   ls.desc.unit_m);
-    written.push_back((fs::path(*out) / "aimed.json").string());
-    std::string title = el.name + " aimed (yaw " + fmt("%.2f", ar.angles.yaw_rad * 180 / kPi) + " deg, pitch " +
-                        fmt("%.2f", ar.angles.pitch_rad * 180 / kPi) + " deg)";
-    const bool driver_side = regs.front().driver_side;
-    for (const std::string& p :
-         writeFovPlot((fs::path(*out) / "aimed").string(), title, frame, driver_side, after.eyes, plot_after, options))
-      written.push_back(p);
+    const AimReport ar =
+        runAim(scene_path, a.all("set"), ls, index, frame, eyes_opt, regs, options, run, aim_range_deg, *out);
+    j["aim"] = ar.aim;
+    summary += ar.summary;
+    written = ar.written;
   }
 
   writeFileAtomic((fs::path(*out) / "fov.json").string(), j.dump(2) + "\n");
