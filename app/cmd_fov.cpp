@@ -142,6 +142,24 @@ json radiusJson(const Annex7Radius& a) {
            "(pvrr/analysis/fov_radius.h)"}};
 }
 
+// The ocular points in the vehicle frame, and where they come from.
+json ocularJson(const VehicleFrame& frame) {
+  const Vec3 l = frame.eye(true), r = frame.eye(false);
+  json o = {{"left", {l.x, l.y, l.z}}, {"right", {r.x, r.y, r.z}}, {"from", "vehicle.ocular_points"}};
+  if (const auto& seat = frame.desc().seat_reference) {
+    const Vec3 p = frame.toVehicle(seat->point);
+    o["from"] = "vehicle.seat_reference";
+    o["seat_reference"] = {{"point", {p.x, p.y, p.z}},
+                           {"eye_height_m", seat->eye_height_m},
+                           {"eye_separation_m", seat->eye_separation_m},
+                           {"source",
+                            "defaults: UN R46 para. 12.1, two points 65 mm apart and 635 mm vertically above point R "
+                            "(recalled, not confirmed in the primary text)"},
+                           {"verified", false}};
+  }
+  return o;
+}
+
 // "[x, y, z]" with round-trip precision, for a --set override.
 std::string vecText(const Vec3& v) {
   return "[" + fmt("%.17g", v.x) + ", " + fmt("%.17g", v.y) + ", " + fmt("%.17g", v.z) + "]";
@@ -299,6 +317,7 @@ int cmdFov(const std::vector<std::string>& argv) {
   j["element"] = el.name;
   j["eyes"] = json::array();
   for (const EyeFootprint& f : run.feet) j["eyes"].push_back(f.eye);
+  j["ocular_points"] = ocularJson(frame);
   j["conventions"] = {
       {"frame",
        "vehicle frame: metres, origin on the road below the midpoint of the ocular points, x forward, y to "

@@ -28,6 +28,8 @@ TEST(FovCli, CarMirrorAgainstR46ClassIII) {
   const nlohmann::json j = nlohmann::json::parse(slurp(dir / "out" / "fov.json"));
   EXPECT_EQ(j["element"], "door-mirror");
   EXPECT_EQ(j["eyes"], (nlohmann::json{"left", "right"}));
+  EXPECT_EQ(j["ocular_points"]["from"], "vehicle.ocular_points");
+  EXPECT_NEAR(j["ocular_points"]["left"][1].get<double>(), 0.0325, 1e-12);  // vehicle frame: y to the left
   for (const char* eye : {"left", "right"}) {
     EXPECT_GT(j["footprint"][eye]["polygon"].size(), 100u);
     EXPECT_GT(j["footprint"][eye]["road"].get<int>(), 0);
