@@ -102,14 +102,16 @@ const std::map<std::string, Command>& commands() {
       {"fov",
        {cmdFov, "a mirror's field of view on the road, checked against regulation zones",
         "pvrr fov SCENE [--element NAME] [--regulation ID]... [--eyes both|left|right] [--samples N]\n"
-        "         [--set PATH=VALUE]... --out DIR\n"
+        "         [--aim [--aim-range DEG]] [--set PATH=VALUE]... --out DIR\n"
         "  From each of the vehicle's ocular points (the scene's \"vehicle\" block), N x N rays (default 121) through\n"
         "  the mirror, reflected exactly and continued to the road; the footprint per eye and the share of each\n"
         "  regulation zone (models/regulations/ID.json; default: vehicle.regulations) covered and obstructed.\n"
         "  Writes DIR/fov.json (element, eyes, footprint polygons in the vehicle frame, zones with\n"
         "  covered_fraction, obstructed_fraction, pass, verified; surface: mean and principal radii, magnification\n"
-        "  range), the plan view DIR/fov.png and .svg, and the magnification map DIR/magnification.png and .svg.\n"
-        "  Conventions: docs/fov.md."}},
+        "  range, R46 Annex 7's three-point mean radius), the plan view DIR/fov.png and .svg, and the magnification\n"
+        "  map DIR/magnification.png and .svg. --aim: the mirror's yaw and pitch about its vertex (within DEG, default\n"
+        "  10) that meets every zone with the largest margin, checked afresh: fov.json \"aim\", DIR/aimed.json (the\n"
+        "  scene with the new pose) and DIR/aimed/fov.png and .svg. Conventions: docs/fov.md."}},
       {"caustic",
        {cmdCaustic, "the reference's caustic of mirrors and lenses on a receiving surface: irradiance map and figures",
         "pvrr caustic SCENE [--receiver NAME] [--window CU,CV,W,H] [--cells N] [--photons N] [--seed N]\n"

@@ -47,16 +47,18 @@ bool inTriangle(Vec2 p, Vec2 a, Vec2 b, Vec2 c) {
   return !(neg && pos);
 }
 
-// The parameters of sample (i, j) of an n x n grid over the mirror: uniform over its outline's square (the
-// outline's own map), or over the surface's domain where it has no outline.
-Vec2 sampleParameters(const Element& el, const cad::ParamDomain& dom, int i, int j, int n) {
-  const Vec2 s(-1 + 2.0 * i / (n - 1), -1 + 2.0 * j / (n - 1));
-  return el.has_outline
-             ? el.outline.fromSquare(s)
-             : Vec2(dom.u0 + (dom.u1 - dom.u0) * 0.5 * (s.x + 1), dom.v0 + (dom.v1 - dom.v0) * 0.5 * (s.y + 1));
+// The parameters of sample (i, j) of an n x n grid over the mirror's parameter square.
+Vec2 sampleParameters(const Element& el, int i, int j, int n) {
+  return mirrorParameters(el, Vec2(-1 + 2.0 * i / (n - 1), -1 + 2.0 * j / (n - 1)));
 }
 
 }  // namespace
+
+Vec2 mirrorParameters(const Element& el, Vec2 s) {
+  if (el.has_outline) return el.outline.fromSquare(s);
+  const cad::ParamDomain dom = el.frontSurface().domain();
+  return Vec2(dom.u0 + (dom.u1 - dom.u0) * 0.5 * (s.x + 1), dom.v0 + (dom.v1 - dom.v0) * 0.5 * (s.y + 1));
+}
 
 VehicleFrame::VehicleFrame(const VehicleDesc& v) : v_(v) {
   z_ = glm::normalize(v.up);
@@ -79,7 +81,6 @@ EyeFootprint traceFootprint(const RayScene& rays, int element, const VehicleFram
   PVRR_CHECK(options.samples >= 2);
   const Element& el = scene.elements[size_t(element)];
   const cad::Surface& surface = el.frontSurface();
-  const cad::ParamDomain dom = surface.domain();
   std::vector<bool> obstructs(scene.meshes.size(), false);
   for (size_t i = 0; i < scene.meshes.size(); ++i)
     obstructs[i] = std::find(frame.desc().obstructions.begin(), frame.desc().obstructions.end(),
@@ -95,7 +96,7 @@ EyeFootprint traceFootprint(const RayScene& rays, int element, const VehicleFram
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) {
       const size_t k = size_t(j) * size_t(n) + size_t(i);
-      const Vec2 uv = sampleParameters(el, dom, i, j, n);
+      const Vec2 uv = sampleParameters(el, i, j, n);
       const cad::SurfacePoint sp = surface.sample(uv.x, uv.y, false);
       Vec3 p = el.toWorldPoint(sp.p), nrm = glm::normalize(el.toWorldDir(sp.n));
       f.mirror_point[k] = p;
@@ -308,7 +309,6 @@ ZoneResult evaluateZone(const FovZone& z, const VehicleFrame& frame, const std::
 SurfaceFigures surfaceFigures(const RayScene& rays, int element, const Vec3& eye_world, const FovOptions& options) {
   const Element& el = rays.scene().elements[size_t(element)];
   const cad::Surface& surface = el.frontSurface();
-  const cad::ParamDomain dom = surface.domain();
   SurfaceFigures out;
   const int n = out.n = options.samples;
   std::vector<Vec3> d(size_t(n) * size_t(n)), r(d.size());
@@ -319,7 +319,7 @@ SurfaceFigures surfaceFigures(const RayScene& rays, int element, const Vec3& eye
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) {
       const size_t k = size_t(j) * size_t(n) + size_t(i);
-      const Vec2 uv = sampleParameters(el, dom, i, j, n);
+      const Vec2 uv = sampleParameters(el, i, j, n);
       const cad::SurfacePoint sp = surface.sample(uv.x, uv.y, true);
       const Vec3 p = el.toWorldPoint(sp.p), nrm = glm::normalize(el.toWorldDir(sp.n));
       d[k] = glm::normalize(p - eye_world);

@@ -55,6 +55,10 @@ struct FovOptions {
   int zone_samples_x = 80, zone_samples_y = 24;
 };
 
+// The surface parameters (u, v) of point s of the mirror's parameter square [-1, 1]^2: the outline's fromSquare, or
+// the surface's domain mapped linearly where the element has no outline.
+Vec2 mirrorParameters(const Element& el, Vec2 s);
+
 // One eye's rays: samples x samples, row-major (v outer, u inner) over the mirror's parameter square
 // [-1, 1]^2 (the outline's fromSquare, or the surface's domain without an outline).
 struct EyeFootprint {

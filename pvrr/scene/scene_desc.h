@@ -253,6 +253,15 @@ struct VehicleDesc {
   // The outermost point of the vehicle on each side (world), and the driver's ocular points (world).
   Vec3 outermost_left{0}, outermost_right{0};
   Vec3 eye_left{0}, eye_right{0};
+  // Where the scene gives the seat reference point R instead of the ocular points: they are derived from it,
+  // eye_height_m above R (along up) and eye_separation_m apart (across forward), their midpoint above R. The
+  // defaults are UN R46 para. 12.1's "two points 65 mm apart and 635 mm vertically above point R", recalled, not
+  // confirmed in the primary text (docs/fov.md "Verification").
+  struct SeatReference {
+    Vec3 point{0};
+    double eye_height_m = 0.635, eye_separation_m = 0.065;
+  };
+  std::optional<SeatReference> seat_reference;  // absent: the ocular points were given
   Side driver_side = Side::Left;
   // Names of environment objects that obstruct the driver's view (the vehicle's own door, housing): a ray
   // stopped first by one of them is obstructed. Rays stopped by the other environment objects (a following

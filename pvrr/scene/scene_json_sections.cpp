@@ -584,9 +584,10 @@ RenderDesc readRender(const Ctx& c, const json* j, const std::string& source) {
 // points above the road, each left point to the left of its right one, obstructions naming environment objects.
 VehicleDesc readVehicle(const Ctx& c, const json* j, const std::vector<EnvObjectDesc>& environment) {
   Obj o(c, j, "vehicle",
-        "an object {\"forward\", \"up\", \"road_height\", \"outermost\", \"ocular_points\", \"driver_side\", "
-        "\"obstructions\", \"regulations\"}",
-        {"forward", "up", "road_height", "outermost", "ocular_points", "driver_side", "obstructions", "regulations"});
+        "an object {\"forward\", \"up\", \"road_height\", \"outermost\", \"ocular_points\" or \"seat_reference\", "
+        "\"driver_side\", \"obstructions\", \"regulations\"}",
+        {"forward", "up", "road_height", "outermost", "ocular_points", "seat_reference", "driver_side", "obstructions",
+         "regulations"});
   VehicleDesc v;
   v.up = o.vec3("up", VecKind::Direction);
   v.forward = o.vec3("forward", VecKind::Direction);
@@ -605,7 +606,26 @@ VehicleDesc readVehicle(const Ctx& c, const json* j, const std::vector<EnvObject
       p.expected("left", "a point to the left of " + p.at("right") + " (seen facing vehicle.forward)");
   };
   pair("outermost", v.outermost_left, v.outermost_right);
-  pair("ocular_points", v.eye_left, v.eye_right);
+  if (o.has("ocular_points") == o.has("seat_reference"))
+    c.fail(o.path(), "expected exactly one of \"ocular_points\" and \"seat_reference\"");
+  if (o.has("ocular_points")) {
+    pair("ocular_points", v.eye_left, v.eye_right);
+  } else {
+    // The ocular points from the seat reference point R (VehicleDesc::SeatReference).
+    Obj r(c, o.get("seat_reference"), o.at("seat_reference"),
+          "an object {\"point\": [x, y, z], \"eye_height\", \"eye_separation\"}",
+          {"point", "eye_height", "eye_separation"});
+    VehicleDesc::SeatReference seat;
+    seat.point = r.point("point");
+    if (glm::dot(seat.point, v.up) - v.road_height_m <= 0)
+      r.expected("point", "a point above the road (vehicle.road_height)");
+    seat.eye_height_m = r.length("eye_height", kPositive, seat.eye_height_m);
+    seat.eye_separation_m = r.length("eye_separation", kPositive, seat.eye_separation_m);
+    const Vec3 mid = seat.point + seat.eye_height_m * v.up;
+    v.eye_left = mid + 0.5 * seat.eye_separation_m * left;
+    v.eye_right = mid - 0.5 * seat.eye_separation_m * left;
+    v.seat_reference = seat;
+  }
   v.driver_side = o.choice<VehicleDesc::Side>("driver_side");
   if (const json* obs =
           arrayAt(c, o.get("obstructions"), o.at("obstructions"), "an array of environment object names")) {

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <string>
 
+#include "pvrr/base/error.h"
 #include "pvrr/scene/scene_build.h"
 #include "pvrr/scene/scene_json.h"
 
@@ -112,6 +113,42 @@ TEST(Fov, VehicleFrameAxes) {
   EXPECT_NEAR(e.z, 1.2, 1e-15);
   EXPECT_NEAR(fr.toVehicle(Vec3(0, 0, 10)).x, -10, 1e-12);  // behind the car: x < 0
   EXPECT_NEAR(fr.outermost(true).y, 0.45, 1e-12);
+}
+
+// The ocular points derived from a seat reference point: 635 mm above it, 65 mm apart (the defaults), or as given;
+// exactly one of ocular_points and seat_reference.
+TEST(Fov, SeatReferenceGivesTheOcularPoints) {
+  constexpr double kTol_m = 1e-15;  // one addition of metre-sized coordinates
+  const std::string base = sceneJson(R"({"type": "plane"})");
+  const std::string ocular = R"("ocular_points": {"left": [-0.0325, 1.2, 0], "right": [0.0325, 1.2, 0]})";
+  ASSERT_NE(base.find(ocular), std::string::npos);
+  auto with = [&](const std::string& replacement) {
+    std::string j = base;
+    j.replace(j.find(ocular), ocular.size(), replacement);
+    return j;
+  };
+  const SceneDesc d = parseScene(with(R"("seat_reference": {"point": [0.1, 0.5, 0.2]})"), "t.json", ".");
+  ASSERT_TRUE(d.vehicle && d.vehicle->seat_reference);
+  // The car faces -z with y up: its left is -x.
+  EXPECT_NEAR(glm::length(d.vehicle->eye_left - Vec3(0.1 - 0.0325, 0.5 + 0.635, 0.2)), 0, kTol_m);
+  EXPECT_NEAR(glm::length(d.vehicle->eye_right - Vec3(0.1 + 0.0325, 0.5 + 0.635, 0.2)), 0, kTol_m);
+  const SceneDesc e = parseScene(
+      with(R"("seat_reference": {"point": [0, 0.5, 0], "eye_height": 0.7, "eye_separation": 0.06})"), "t.json", ".");
+  EXPECT_NEAR(glm::length(e.vehicle->eye_left - Vec3(-0.03, 1.2, 0)), 0, kTol_m);
+  EXPECT_FALSE(parseScene(base, "t.json", ".").vehicle->seat_reference.has_value());
+  auto message = [&](const std::string& json) {
+    try {
+      parseScene(json, "t.json", ".");
+    } catch (const Error& err) {
+      return std::string(err.what());
+    }
+    return std::string("no error");
+  };
+  const std::string both = with(ocular + R"(, "seat_reference": {"point": [0, 0.5, 0]})");
+  EXPECT_EQ(message(both), "t.json: vehicle: expected exactly one of \"ocular_points\" and \"seat_reference\"");
+  EXPECT_EQ(message(with(R"("driver_side_x": 1)")).find("t.json: vehicle.driver_side_x: unknown key"), 0u);
+  EXPECT_NE(message(with(R"("seat_reference": {"point": [0, -0.5, 0]})")).find("vehicle.seat_reference.point"),
+            std::string::npos);
 }
 
 // Plane mirror: the footprint is the outline projected from the eye mirrored in the mirror plane.

@@ -1,0 +1,67 @@
+// Aiming a mirror (pvrr fov --aim, issue 21): the rotation about its pivot (yaw about the vehicle's up axis, pitch
+// about the horizontal axis in the mirror's plane) that meets the regulation zones with the largest margin.
+//
+// METHOD
+//  1. Score of an adjustment: the footprints traced exactly (traceFootprint, obstructions included) with the
+//     element turned, each zone evaluated (evaluateZone); a zone's score is its covered fraction plus its
+//     obstructed fraction up to the allowance (1 exactly when the zone passes), the adjustment's score the
+//     smallest over the zones. Piecewise constant in the angles, so searched, not differentiated:
+//  2. a coarse grid over +-range_deg in both angles, then a fine grid around the best coarse cell. The best
+//     cell has the highest score; among cells that pass, the one deepest inside the passing region (its
+//     Chebyshev distance in cells to the nearest failing or unsearched cell), then the one nearest the current
+//     adjustment.
+//  3. Polish with Ceres on a smooth objective: each zone's edge points (inner and outer edge, from the near end to
+//     the horizon end, uniform in the angle of depression) located on the mirror's parameter square by inverting
+//     the reflection (Newton on the exact surface), their margin 1 - max(|s_x|, |s_y|) inside the square, the
+//     residuals exp(-margin / 0.05) (a soft minimum of the margins: centres the zones in the mirror). Ceres' result
+//     is kept only if its exact score (step 1) is no worse than the grid's and it passes whenever the grid's did:
+//     its "converged" is never taken on trust.
+#pragma once
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "pvrr/analysis/fov.h"
+
+namespace pvrr {
+
+struct AimOptions {
+  FovOptions fov;  // the sampling of the search's evaluations (the caller re-checks its answer with its own)
+  double range_deg = 10;
+  double coarse_step_deg = 2, fine_step_deg = 0.5;
+  bool polish = true;
+  std::optional<Vec3> pivot;  // world; default the element's pose position (its vertex)
+  bool left_eye = true, right_eye = true;
+};
+
+struct AimAngles {
+  double yaw_rad = 0, pitch_rad = 0;
+};
+
+struct AimScore {
+  double score = 0;  // the smallest zone score (1: every zone passes)
+  bool pass = false;
+  std::vector<ZoneResult> zones;
+};
+
+struct AimResult {
+  Vec3 pivot{0}, yaw_axis{0}, pitch_axis{0};  // world
+  AimAngles angles;                           // the answer
+  AimScore before, after;                     // at the search's sampling
+  Mat4 local_to_world{1.0};                   // the element's aimed pose
+  double margin_deg = 0;  // passing: the distance to the nearest failing or unsearched fine-grid cell
+  int evaluations = 0;
+  bool polished = false;  // Ceres' result kept
+  std::string polish_report;
+};
+
+// The element's pose `local_to_world` turned about `pivot` by R = Rot(yaw_axis, yaw) Rot(pitch_axis, pitch) (unit
+// axes, world): x -> pivot + R (x - pivot) after the pose.
+Mat4 aimedPose(const Mat4& local_to_world, const Vec3& pivot, const Vec3& yaw_axis, const Vec3& pitch_axis,
+               AimAngles a);
+
+// Searches the adjustment of mirror `element` of `scene` for `zones` (none: an error of the caller's).
+AimResult aimMirror(const Scene& scene, int element, const VehicleFrame& frame, const std::vector<FovZone>& zones,
+                    const AimOptions& options = {});
+
+}  // namespace pvrr
