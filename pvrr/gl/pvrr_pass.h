@@ -14,6 +14,8 @@
 
 namespace pvrr::gl {
 
+class ImpostorMaps;
+
 class PvrrPass : public ModePass {
  public:
   explicit PvrrPass(const RenderContext& c) : ctx(c) {}
@@ -44,6 +46,12 @@ class PvrrPass : public ModePass {
   void drawDarkElement(const ElementFrame& f, const PassCamera& cam);
   int64_t closeUnreadTexels(const MapPass& mp, const std::array<int, 2>& region);
   CullCount renderPasses(size_t whole_slots, int64_t* skipped, int64_t* texels);
+  // Per-fragment refinement (render.refine): which elements refine (refine_skip), their surface maps, the
+  // fragment counters zeroed; and what the counters say once the frame's draws are done.
+  void prepareRefinement();
+  void setRefinement(const Program& p, const ElementFrame& f) const;
+  void setRefinementView(const Program& p, const PatchView& pv, const Framebuffer& map) const;
+  std::string refinementNote() const;
 
   RenderContext ctx;
   std::vector<ElementFrame> frames;     // this frame's elements as seen from the eye
@@ -55,6 +63,9 @@ class PvrrPass : public ModePass {
   // process (nextFirstPassSerial), so a cache filled by another renderer never matches.
   uint64_t first_pass_serial = 0;
   unsigned mask_vao = 0, mask_vbo = 0;  // closeUnreadTexels' quads
+  std::vector<std::string> refine_skip;  // per element: why it is not refined, "" when it is
+  std::unique_ptr<ImpostorMaps> surface_maps;  // the refined mirrors' surface maps (pvrr/impostor/surface_map.h)
+  unsigned refine_counters = 0;  // refined, missed, failed fragments (shaders/pvrr_refine.glsl)
 };
 
 }  // namespace pvrr::gl
