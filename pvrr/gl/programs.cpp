@@ -61,8 +61,10 @@ const Program& Programs::pvrr(bool lens, size_t channels, bool rgb, bool planes,
   if (lens) d.push_back("#define LENS");
   if (rgb) d.push_back("#define RGB_CHANNELS");
   if (refine > 0) {
-    // Its counters (shaders/pvrr_refine.glsl): GL 4.2's atomic counters, in a GLSL 3.30 shader.
+    // Its counters and its depth edge test (shaders/pvrr_refine.glsl): GL 4.2's atomic counters and GL 4.0's
+    // textureGather, in a GLSL 3.30 shader.
     d.push_back("#extension GL_ARB_shader_atomic_counters : require");
+    d.push_back("#extension GL_ARB_texture_gather : require");
     d.push_back("#define REFINE " + std::to_string(refine));
   }
   return planes ? planesVariant("element.vert", "element_pvrr.frag", d) : built("element.vert", "element_pvrr.frag", d);

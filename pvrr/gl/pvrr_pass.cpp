@@ -38,6 +38,8 @@ bool usesTraced(const PatchView& pv, const VertexRay& r) {
 
 PvrrPass::~PvrrPass() {
   if (refine_counters) glDeleteBuffers(1, &refine_counters);
+  if (refine_sampler) glDeleteSamplers(1, &refine_sampler);
+  if (!refine_queries.empty()) glDeleteQueries(GLsizei(refine_queries.size()), refine_queries.data());
   if (mask_vbo) glDeleteBuffers(1, &mask_vbo);
   if (mask_vao) glDeleteVertexArrays(1, &mask_vao);
 }
@@ -381,6 +383,7 @@ void PvrrPass::drawPvrrElement(const ElementFrame& f, size_t first_slot, const P
       }
       draw(mb);
     }
+    if (refined) unsetRefinement();
     if (sets > 1) {
       glDisablei(GL_BLEND, 0);
       glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
@@ -496,12 +499,18 @@ bool PvrrPass::additiveDraws() const {
 
 std::string PvrrPass::drawElements(RenderMode, const PassCamera& eye, const Framebuffer& target) {
   size_t slot = 0;  // the map slot of frames[e].views[0]
-  for (const ElementFrame& f : frames) {
+  refine_counting = true;
+  for (size_t e = 0; e < frames.size(); ++e) {
+    const ElementFrame& f = frames[e];
     target.bind();
+    const bool refined = refine_skip.size() > e && refine_skip[e].empty();
+    if (refined) glBeginQuery(GL_SAMPLES_PASSED, refine_queries[e]);
     if (beyondDepth(ctx.scene, f)) drawDarkElement(f, eye);
     else drawPvrrElement(f, slot, eye, ctx.options.seen_channel);
+    if (refined) glEndQuery(GL_SAMPLES_PASSED);
     slot += f.views.size();
   }
+  refine_counting = false;
   return refinementNote();
 }
 
@@ -518,8 +527,20 @@ void PvrrPass::prepareRefinement() {
     surface_maps->updateMirrorMaps(e);
   }
   if (!any) return;
-  // The counters, zeroed before the first pass (nested draws count too).
-  const GLuint zeros[3] = {0, 0, 0};
+  if (!refine_sampler) {
+    glGenSamplers(1, &refine_sampler);
+    glSamplerParameteri(refine_sampler, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glSamplerParameteri(refine_sampler, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glSamplerParameteri(refine_sampler, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glSamplerParameteri(refine_sampler, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  }
+  if (refine_queries.size() < frames.size()) {
+    const size_t had = refine_queries.size();
+    refine_queries.resize(frames.size());
+    glGenQueries(GLsizei(frames.size() - had), refine_queries.data() + had);
+  }
+  // The counters, zeroed before the frame's draws.
+  const GLuint zeros[2] = {0, 0};
   if (!refine_counters) glGenBuffers(1, &refine_counters);
   glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, refine_counters);
   glBufferData(GL_ATOMIC_COUNTER_BUFFER, sizeof(zeros), zeros, GL_DYNAMIC_READ);
@@ -527,10 +548,16 @@ void PvrrPass::prepareRefinement() {
   checkGlError("zeroing the refinement's counters");
 }
 
-// Units 2 to 5: the mirror's surface maps (u_to_local, u_sm); 6: the depth of the patch view's map.
+// Units 2 to 5: the mirror's surface maps (u_to_local, u_sm), the derivatives (3, 4) filtered linearly; 6: the
+// depth of the patch view's map, filtered linearly.
 void PvrrPass::setRefinement(const Program& p, const ElementFrame& f) const {
   surface_maps->setMirrorMaps(p, size_t(f.element));
   p.set("u_map_depth", 6);
+  p.set("u_count", refine_counting ? 1 : 0);
+}
+
+void PvrrPass::unsetRefinement() const {
+  for (GLuint unit : {2u, 3u, 4u, 5u, 6u}) glBindSampler(unit, 0);
 }
 
 void PvrrPass::setRefinementView(const Program& p, const PatchView& pv, const Framebuffer& map) const {
@@ -539,6 +566,7 @@ void PvrrPass::setRefinementView(const Program& p, const PatchView& pv, const Fr
   if (!on) return;
   glActiveTexture(GL_TEXTURE6);
   glBindTexture(GL_TEXTURE_2D, map.depthTexture());
+  for (GLuint unit : {2u, 3u, 4u, 5u, 6u}) glBindSampler(unit, refine_sampler);
   p.set("u_map_vp", toFloat(relativeViewProj(pv.volume.projection, pv.volume.view, pv.volume.eye)));
   const Mat4& P = pv.volume.projection;
   p.set("u_depth_lin", glm::vec3(float(P[2][2]), float(P[3][2]), float(pv.volume.near_m)));
@@ -555,11 +583,18 @@ std::string PvrrPass::refinementNote() const {
     else skipped += (skipped.empty() ? " " : "; ") + ctx.scene.elements[e].name + " (" + refine_skip[e] + ")";
   }
   if (any) {
-    GLuint n[3] = {0, 0, 0};
+    GLuint n[2] = {0, 0};
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_ATOMIC_COUNTER_BARRIER_BIT);
     glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, refine_counters);
     glGetBufferSubData(GL_ATOMIC_COUNTER_BUFFER, 0, sizeof(n), n);
-    note += " " + std::to_string(n[0]) + " fragments refined, " + std::to_string(n[2]) +
+    uint64_t drawn = 0;
+    for (size_t e = 0; e < refine_skip.size(); ++e) {
+      if (!refine_skip[e].empty()) continue;
+      GLuint samples = 0;
+      glGetQueryObjectuiv(refine_queries[e], GL_QUERY_RESULT, &samples);
+      drawn += samples;
+    }
+    note += " " + std::to_string(drawn) + " fragments drawn, " + std::to_string(n[0]) +
             " kept the interpolated coordinate (search ended off the map's surface), " + std::to_string(n[1]) +
             " kept it where the view ray missed the exact surface";
   }

@@ -50,6 +50,7 @@ class PvrrPass : public ModePass {
   // fragment counters zeroed; and what the counters say once the frame's draws are done.
   void prepareRefinement();
   void setRefinement(const Program& p, const ElementFrame& f) const;
+  void unsetRefinement() const;
   void setRefinementView(const Program& p, const PatchView& pv, const Framebuffer& map) const;
   std::string refinementNote() const;
 
@@ -65,7 +66,10 @@ class PvrrPass : public ModePass {
   unsigned mask_vao = 0, mask_vbo = 0;  // closeUnreadTexels' quads
   std::vector<std::string> refine_skip;  // per element: why it is not refined, "" when it is
   std::unique_ptr<ImpostorMaps> surface_maps;  // the refined mirrors' surface maps (pvrr/impostor/surface_map.h)
-  unsigned refine_counters = 0;  // refined, missed, failed fragments (shaders/pvrr_refine.glsl)
+  unsigned refine_counters = 0;  // the second pass's failed and missed fragments (shaders/pvrr_refine.glsl)
+  unsigned refine_sampler = 0;   // linear filtering of the depth maps and the surface derivatives
+  std::vector<unsigned> refine_queries;  // per element: its second-pass fragments (refined elements)
+  bool refine_counting = false;  // drawing the second pass (counted), not a nested pass
 };
 
 }  // namespace pvrr::gl
