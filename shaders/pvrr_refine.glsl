@@ -23,6 +23,7 @@ uniform sampler2D u_map_depth;  // the map's depth attachment (window depth), wi
 uniform mat4 u_map_vp;          // the map's camera: positions relative to its viewpoint -> clip
 uniform vec3 u_depth_lin;       // P[2][2], P[3][2] of its projection, and its near depth: the depth along the map's
                                 // forward of NDC depth z is P[3][2] / (z + P[2][2])
+uniform float u_edge;           // across a depth edge: the four texels' depths differ by more than this (relative)
 uniform vec3 u_offset;          // the element's anchor - this pass's camera origin (element.vert)
 uniform mat3 u_to_local;        // world directions -> the element's local frame (surface_maps.glsl's)
 layout(binding = 0, offset = 0) uniform atomic_uint u_count_failed;
@@ -30,8 +31,6 @@ layout(binding = 0, offset = 4) uniform atomic_uint u_count_missed;
 
 const float REFINE_TOL = 2e-5;     // converged: |depth difference| <= this * depth (the depth's float resolution)
 const float REFINE_ACCEPT = 1e-3;  // on the map's surface: at most this, after the last step
-const float REFINE_EDGE = 0.05;    // across a depth edge: the four texels' depths differ by more than this
-                                   // (relative; a surface seen at 89 deg from a 1024 texel map differs by ~0.01)
 const float REFINE_MAX_STEP = 0.02;  // of the normalised parameters: the surface step from the triangle's point
 
 float linearDepth(float window_z) { return u_depth_lin.y / (2.0 * window_z - 1.0 + u_depth_lin.x); }
@@ -66,7 +65,7 @@ bool refineSearch(vec3 x, vec3 R, vec2 st0, out vec2 st) {
   vec4 z = textureGather(u_map_depth, mapTexST(st));
   vec4 dz = u_depth_lin.y / (2.0 * z - 1.0 + u_depth_lin.x);
   float lo = min(min(dz.x, dz.y), min(dz.z, dz.w)), hi = max(max(dz.x, dz.y), max(dz.z, dz.w));
-  return abs(f) <= REFINE_ACCEPT * d && hi <= lo * (1.0 + REFINE_EDGE) && lo > u_depth_lin.z * 1.001;
+  return abs(f) <= REFINE_ACCEPT * d && hi <= lo * (1.0 + u_edge) && lo > u_depth_lin.z * 1.001;
 }
 
 // This fragment's exact reflected ray: its origin relative to the map's viewpoint, and its direction, from the

@@ -368,7 +368,7 @@ void PvrrPass::drawPvrrElement(const ElementFrame& f, size_t first_slot, const P
     const glm::vec2 texels{float(region[0]), float(region[1])}, size{float(map.width()), float(map.height())};
     p.set("u_st_scale", texels / size);
     p.set("u_st_max", (texels - 0.5f) / size);
-    if (refined) setRefinementView(p, pv, map);
+    if (refined) setRefinementView(p, pv, map, map_side[first_slot + v]);
     for (size_t set = 0; set < sets; ++set) {
       MeshBuffers& mb = ctx.meshes.slot();
       uploadPatch(mb, f, pv, anchor, set, seen_c);
@@ -560,7 +560,7 @@ void PvrrPass::unsetRefinement() const {
   for (GLuint unit : {2u, 3u, 4u, 5u, 6u}) glBindSampler(unit, 0);
 }
 
-void PvrrPass::setRefinementView(const Program& p, const PatchView& pv, const Framebuffer& map) const {
+void PvrrPass::setRefinementView(const Program& p, const PatchView& pv, const Framebuffer& map, int side) const {
   const bool on = refineViewSkipReason(pv).empty();
   p.set("u_refine", on ? 1 : 0);
   if (!on) return;
@@ -570,6 +570,9 @@ void PvrrPass::setRefinementView(const Program& p, const PatchView& pv, const Fr
   p.set("u_map_vp", toFloat(relativeViewProj(pv.volume.projection, pv.volume.view, pv.volume.eye)));
   const Mat4& P = pv.volume.projection;
   p.set("u_depth_lin", glm::vec3(float(P[2][2]), float(P[3][2]), float(pv.volume.near_m)));
+  // A depth edge: neighbouring texels' depths differ more than a surface's at 89 deg incidence would
+  // (tan 89 deg ~ 57 times the texel's angle), and by at least 5 %.
+  p.set("u_edge", float(std::max(0.05, 57.0 * longerExtentTan(pv.volume) / std::max(side, 1))));
 }
 
 std::string PvrrPass::refinementNote() const {

@@ -51,7 +51,7 @@ class PvrrPass : public ModePass {
   void prepareRefinement();
   void setRefinement(const Program& p, const ElementFrame& f) const;
   void unsetRefinement() const;
-  void setRefinementView(const Program& p, const PatchView& pv, const Framebuffer& map) const;
+  void setRefinementView(const Program& p, const PatchView& pv, const Framebuffer& map, int side) const;
   std::string refinementNote() const;
 
   RenderContext ctx;

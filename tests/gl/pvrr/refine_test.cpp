@@ -13,7 +13,10 @@
 #include <vector>
 
 #include "pvrr/analysis/accuracy.h"
+#include "pvrr/base/error.h"
 #include "pvrr/gl/renderer.h"
+#include "pvrr/scene/scene_build.h"
+#include "pvrr/scene/scene_json.h"
 #include "pvrr/trace/tracer.h"
 #include "support/gl_backends.h"
 #include "support/test_scenes.h"
@@ -28,6 +31,10 @@ constexpr double kRefinedMedianArcmin = 0.05;
 // And its p95 at most this (the depth edges of the room's box are where the interpolation fails; the
 // refined search lands on one side of them or falls back; measured 0.02' to 0.06'); unrefined: 13' to 30'.
 constexpr double kRefinedP95Arcmin = 1.0;
+
+// The shipped car mirror at 160 x 120 (its map scaled to the image: map_texels_per_pixel), refined median at
+// most this; unrefined 0.77'.
+constexpr double kSmallMapMedianArcmin = 0.15;
 
 ErrorStats errorStats(const Frame& ref, const Frame& f) {
   const std::vector<double> e = angularErrors(ref, ref.seen, f.seen);
@@ -139,6 +146,57 @@ TEST_P(RefineTest, OffAndSkippedElementsDrawTheUnrefinedPixels) {
   EXPECT_EQ(plane_on.seen, plane_off.seen);
   const std::string note = refineNote(plane_on);
   EXPECT_NE(note.find("not refined: mirror0 (the vertex fit is exact"), std::string::npos) << note;
+}
+
+// The knob from a scene file (render.refine, through --set as `pvrr render` takes it), on the shipped car
+// mirror (a NURBS from STEP) and the mirror pair (the convex mirror seen in a plane one: nested maps; the
+// plane mirror skipped): refined against the reference, far below the unrefined frame.
+TEST_P(RefineTest, ShippedMirrorsFromTheirFiles) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  for (const std::string name : {"car-mirror", "mirror-pair"}) {
+    const std::string path = std::string(PVRR_SOURCE_DIR) + "/models/" + name + ".json";
+    const SceneDesc desc = loadScene(path, {"observer.image_size=[160,120]", "render.refine=2"});
+    ASSERT_EQ(desc.render.refine, 2);
+    Scene s = buildScene(desc);
+    RayScene rays(s);
+    const Frame ref = Tracer(rays, TraceOptions{}).render();
+    gl::Renderer r(s, rays, gl::RendererOptions{});
+    const gl::RasterFrame refined = r.render(RenderMode::Pvrr);
+    s.render.refine = 0;
+    const gl::RasterFrame plain = r.render(RenderMode::Pvrr);
+    const ErrorStats a = errorStats(ref, plain), b = errorStats(ref, refined);
+    const std::string note = refineNote(refined);
+    std::cout << "[ measured ] " << name << " 160x120: unrefined median " << a.median_arcmin << "' p95 " << a.p95_arcmin
+              << "', refined median " << b.median_arcmin << "' p95 " << b.p95_arcmin << "'; " << note << "\n";
+    EXPECT_LE(b.median_arcmin, a.median_arcmin / 5) << name;
+    EXPECT_LE(b.p95_arcmin, a.p95_arcmin) << name;
+    if (name == "car-mirror") {
+      // At 160 x 120 the map has ~6 times fewer texels across than at 640 x 480 (0.0078' there): measured
+      // 0.073' / 0.61'.
+      EXPECT_LE(b.median_arcmin, kSmallMapMedianArcmin);
+      EXPECT_LE(b.p95_arcmin, kRefinedP95Arcmin);
+    } else {
+      EXPECT_NE(note.find("not refined: back-wall-mirror (the vertex fit is exact"), std::string::npos) << note;
+    }
+  }
+}
+
+// render.refine: "off" or a step count in [1, kMaxRefineSteps]; anything else is refused naming the path.
+TEST(RefineKnob, ParsesOffOrAStepCount) {
+  const std::string path = std::string(PVRR_SOURCE_DIR) + "/models/car-mirror.json";
+  EXPECT_EQ(loadScene(path).render.refine, 0);  // the shipped scene leaves the default: off
+  EXPECT_EQ(loadScene(path, {"render.refine=off"}).render.refine, 0);
+  EXPECT_EQ(loadScene(path, {"render.refine=16"}).render.refine, 16);
+  for (const std::string bad : {"render.refine=0", "render.refine=17", "render.refine=on", "render.refine=2.5"}) {
+    try {
+      loadScene(path, {bad});
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const Error& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("render.refine: expected \"off\" or an integer in [1, 16]"), std::string::npos) << m;
+    }
+  }
 }
 
 PVRR_GL_BACKENDS(RefineTest);
