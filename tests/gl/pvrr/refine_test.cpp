@@ -182,6 +182,24 @@ TEST_P(RefineTest, ShippedMirrorsFromTheirFiles) {
   }
 }
 
+// A lens is not refined (its exit rays are not): the note names it and why, and its pixels are the unrefined
+// ones.
+TEST_P(RefineTest, LensIsSkippedWithItsReason) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  const std::string path = std::string(PVRR_SOURCE_DIR) + "/models/spectacle-lens.json";
+  Scene s = buildScene(loadScene(path, {"observer.image_size=[96,72]", "render.map_size=256"}));
+  RayScene rays(s);
+  gl::Renderer r(s, rays, gl::RendererOptions{});
+  const gl::RasterFrame off = r.render(RenderMode::Pvrr);
+  s.render.refine = 2;
+  const gl::RasterFrame on = r.render(RenderMode::Pvrr);
+  EXPECT_EQ(on.color, off.color);
+  EXPECT_EQ(on.seen, off.seen);
+  const std::string note = refineNote(on);
+  EXPECT_NE(note.find("(a lens: its exit rays are not refined)"), std::string::npos) << note;
+}
+
 // render.refine: "off" or a step count in [1, kMaxRefineSteps]; anything else is refused naming the path.
 TEST(RefineKnob, ParsesOffOrAStepCount) {
   const std::string path = std::string(PVRR_SOURCE_DIR) + "/models/car-mirror.json";
