@@ -582,8 +582,10 @@ std::string PvrrPass::refinementNote() const {
   std::string skipped;
   bool any = false;
   for (size_t e = 0; e < refine_skip.size(); ++e) {
-    if (refine_skip[e].empty()) any = true;
-    else skipped += (skipped.empty() ? " " : "; ") + ctx.scene.elements[e].name + " (" + refine_skip[e] + ")";
+    if (refine_skip[e].empty())
+      any = true;
+    else
+      skipped += (skipped.empty() ? " " : "; ") + ctx.scene.elements[e].name + " (" + refine_skip[e] + ")";
   }
   if (any) {
     GLuint n[2] = {0, 0};

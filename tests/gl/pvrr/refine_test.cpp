@@ -101,8 +101,8 @@ TEST_P(RefineTest, MirrorsAndPatchesMatchTheReference) {
     const ErrorStats a = errorStats(ref, plain), b = errorStats(ref, refined);
     const std::string note = refineNote(refined);
     std::cout << "[ measured ] " << c.name << ": unrefined median " << a.median_arcmin << "' p95 " << a.p95_arcmin
-              << "', refined median " << b.median_arcmin << "' p95 " << b.p95_arcmin << "' (" << b.pixels
-              << " px); " << note << "\n";
+              << "', refined median " << b.median_arcmin << "' p95 " << b.p95_arcmin << "' (" << b.pixels << " px); "
+              << note << "\n";
     ASSERT_GT(b.pixels, 2000u) << c.name;
     EXPECT_LE(b.median_arcmin, kRefinedMedianArcmin) << c.name;
     EXPECT_LE(b.p95_arcmin, kRefinedP95Arcmin) << c.name;
