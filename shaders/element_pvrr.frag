@@ -9,6 +9,8 @@
 //                More than three channels: one additive draw per set of three (pvrr/gl/pvrr_pass.cpp).
 //   LENS         the element is a lens (transmission) rather than a mirror (reflection)
 //   NO_SEEN_POINTS  colour only: the seen-point maps are not read (RendererOptions::seen_points off)
+//   REFINE n     a mirror (CHANNELS 1) whose fragments search their exact reflected ray in the map, n secant
+//                steps (render.refine; pvrr_refine.glsl)
 #include "element_inputs.glsl"
 uniform sampler2D u_map;         // first pass colour (linear)
 uniform sampler2D u_seen_map;    // first pass seen points, relative to the map's camera origin (LINEAR)
@@ -23,6 +25,7 @@ vec2 mapST(vec3 stq) { return min(stq.xy / stq.z * u_st_scale, u_st_max); }
 #include "outputs.glsl"
 #include "shading.glsl"
 #include "optics.glsl"
+#include "pvrr_refine.glsl"
 
 void main() {
   vec3 n = normalize(v_normal);
@@ -45,7 +48,12 @@ void main() {
   vec3 c = vec3(v_w0.r * texture(u_map, mapST(v_st0)).r, v_w1.g * texture(u_map_g, mapST(v_st1)).r,
                 v_w2.b * texture(u_map_b, mapST(v_st2)).r);
 #else
-  vec3 c = v_w0 * texture(u_map, mapST(v_st0)).rgb;
+#if defined(REFINE)
+  vec2 st0 = refinedST(view, mapST(v_st0));  // the seen channel's too: a mirror has one
+#else
+  vec2 st0 = mapST(v_st0);
+#endif
+  vec3 c = v_w0 * texture(u_map, st0).rgb;
 #if CHANNELS == 3
   c += v_w1 * texture(u_map, mapST(v_st1)).rgb + v_w2 * texture(u_map, mapST(v_st2)).rgb;
 #endif
@@ -54,7 +62,11 @@ void main() {
 #if defined(NO_SEEN_POINTS)
   vec4 seen = vec4(0.0);
 #else
+#if defined(REFINE)
+  vec4 seen = texture(u_seen_map, st0);
+#else
   vec4 seen = texture(u_seen_map, mapST(v_st_seen));
+#endif
   // Nearer a totally reflected vertex than the others: its traced seen point (relative to this camera).
   if (v_tir.a > 0.5) seen = vec4(v_tir_seen / v_tir.a - u_seen_offset, 1.0);
 #endif

@@ -56,10 +56,17 @@ const Program& Programs::envmap(bool lens) const {
               : built("element.vert", "element_envmap.frag", {});
 }
 
-const Program& Programs::pvrr(bool lens, size_t channels, bool rgb, bool planes) const {
+const Program& Programs::pvrr(bool lens, size_t channels, bool rgb, bool planes, int refine) const {
   std::vector<std::string> d = {channels > 1 ? "#define CHANNELS 3" : "#define CHANNELS 1"};
   if (lens) d.push_back("#define LENS");
   if (rgb) d.push_back("#define RGB_CHANNELS");
+  if (refine > 0) {
+    // Its counters and its depth edge test (shaders/pvrr_refine.glsl): GL 4.2's atomic counters and GL 4.0's
+    // textureGather, in a GLSL 3.30 shader.
+    d.push_back("#extension GL_ARB_shader_atomic_counters : require");
+    d.push_back("#extension GL_ARB_texture_gather : require");
+    d.push_back("#define REFINE " + std::to_string(refine));
+  }
   return planes ? planesVariant("element.vert", "element_pvrr.frag", d) : built("element.vert", "element_pvrr.frag", d);
 }
 

@@ -38,8 +38,10 @@ class Programs {
   // Elements in envmap mode: a mirror, or a lens (LENS, the "refraction vectors" baseline).
   const Program& envmap(bool lens) const;
   // A pvrr element: its channels in one draw (1) or in sets of three (more: CHANNELS 3), a lens (LENS), with
-  // RGB dispersion (RGB_CHANNELS: its maps are planes); planes: drawn into a planes map.
-  const Program& pvrr(bool lens, size_t channels, bool rgb, bool planes) const;
+  // RGB dispersion (RGB_CHANNELS: its maps are planes); planes: drawn into a planes map. refine > 0: a mirror
+  // whose fragments search their exact rays in its maps with that many secant steps (REFINE,
+  // shaders/pvrr_refine.glsl).
+  const Program& pvrr(bool lens, size_t channels, bool rgb, bool planes, int refine = 0) const;
   // Distance-impostor elements (shaders/element_impostor.frag): a mirror, or a lens with one or three
   // wavelengths; cube_elements > 0: searches that meet a mirror in a cube go on in its cubes (CUBE_ELEMENTS).
   // lens_in_cubes: the scene's one lens is drawn in the other elements' cubes and refracted through there.

@@ -5,7 +5,9 @@
 
 #include "pvrr/base/error.h"
 #include "pvrr/gl/gl.h"
+#include "pvrr/gl/impostor_maps.h"
 #include "pvrr/method/map_footprint.h"
+#include "pvrr/method/refine_plan.h"
 #include "pvrr/optics/spectrum.h"
 
 namespace pvrr::gl {
@@ -35,6 +37,9 @@ bool usesTraced(const PatchView& pv, const VertexRay& r) {
 }  // namespace
 
 PvrrPass::~PvrrPass() {
+  if (refine_counters) glDeleteBuffers(1, &refine_counters);
+  if (refine_sampler) glDeleteSamplers(1, &refine_sampler);
+  if (!refine_queries.empty()) glDeleteQueries(GLsizei(refine_queries.size()), refine_queries.data());
   if (mask_vbo) glDeleteBuffers(1, &mask_vbo);
   if (mask_vao) glDeleteVertexArrays(1, &mask_vao);
 }
@@ -52,6 +57,7 @@ VertexStageOptions PvrrPass::optionsFor(size_t e) const {
 
 void PvrrPass::prepare(RenderMode, FrameStages& stages, FrameCache* cache) {
   const bool nothing_moved = cpuStages(stages, cache);
+  prepareRefinement();
   firstPass(stages, cache, nothing_moved, cache && cache->valid);
   // The cache takes this frame whole, once its maps are drawn: the poses, and the elements with the volumes
   // and texture coordinates of the maps now held.
@@ -249,6 +255,10 @@ Framebuffer& PvrrPass::mapTarget(size_t i, int size, bool planes) {
 void PvrrPass::uploadPatch(MeshBuffers& mb, const ElementFrame& f, const PatchView& pv, const Vec3& anchor, size_t set,
                            size_t seen_channel) const {
   const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
+  // A refined mirror (one channel) takes its vertices' surface parameters, normalised to the domain, in place
+  // of channel 1's coordinates (pvrr/impostor/surface_map.h, shaders/pvrr_refine.glsl).
+  const bool surface_params = refine_skip.size() > size_t(f.element) && refine_skip[size_t(f.element)].empty();
+  const cad::ParamDomain domain = ctx.scene.elements[size_t(f.element)].frontSurface().domain();
   const size_t channels = pv.st.size();
   std::vector<float> data;
   data.reserve(gp.vertices.size() * kElementFloats);
@@ -262,6 +272,12 @@ void PvrrPass::uploadPatch(MeshBuffers& mb, const ElementFrame& f, const PatchVi
     const double q = pv.q[k];
     for (size_t j = 0; j < 3; ++j) {
       const Vec2 st = pv.st[std::min(3 * set + j, channels - 1)][k];
+      if (j == 1 && surface_params) {
+        const Vec2 uv = f.grid.params[vi];
+        data.insert(data.end(), {float((uv.x - domain.u0) / (domain.u1 - domain.u0)),
+                                 float((uv.y - domain.v0) / (domain.v1 - domain.v0)), 1.0f});
+        continue;
+      }
       data.insert(data.end(), {float(st.x * q), float(st.y * q), float(q)});
     }
     for (size_t j = 0; j < 3; ++j) {
@@ -300,7 +316,8 @@ void PvrrPass::drawPvrrElement(const ElementFrame& f, size_t first_slot, const P
   // RGB dispersion: its maps are planes, read one component per channel. Drawn into a planes map (only RGB
   // scenes have them: never more than three channels), the planes variant.
   const bool rgb = rgbLens(el, f);
-  const Program& p = ctx.programs.pvrr(lens, channels, rgb, cam.planes);
+  const bool refined = refine_skip.size() > size_t(f.element) && refine_skip[size_t(f.element)].empty();
+  const Program& p = ctx.programs.pvrr(lens, channels, rgb, cam.planes, refined ? ctx.scene.render.refine : 0);
   p.use();
   p.set("u_view_proj", toFloat(cam.view_proj));
   p.set("u_offset", glm::vec3(anchor - cam.origin));
@@ -311,6 +328,7 @@ void PvrrPass::drawPvrrElement(const ElementFrame& f, size_t first_slot, const P
   p.set("u_map_b", 3);
   setLights(p, ctx.scene, cam.origin);
   setElementMaterial(p, el, f.element);
+  if (refined) setRefinement(p, f);
   // The seen point's channel: the one nearest the d line unless asked (the tracer's seen point is the d
   // line's ray; with RGB channels that is G exactly, with N spectral samples the nearest bin midpoint).
   size_t seen_c = channels / 2;
@@ -350,6 +368,7 @@ void PvrrPass::drawPvrrElement(const ElementFrame& f, size_t first_slot, const P
     const glm::vec2 texels{float(region[0]), float(region[1])}, size{float(map.width()), float(map.height())};
     p.set("u_st_scale", texels / size);
     p.set("u_st_max", (texels - 0.5f) / size);
+    if (refined) setRefinementView(p, pv, map, map_side[first_slot + v]);
     for (size_t set = 0; set < sets; ++set) {
       MeshBuffers& mb = ctx.meshes.slot();
       uploadPatch(mb, f, pv, anchor, set, seen_c);
@@ -364,6 +383,7 @@ void PvrrPass::drawPvrrElement(const ElementFrame& f, size_t first_slot, const P
       }
       draw(mb);
     }
+    if (refined) unsetRefinement();
     if (sets > 1) {
       glDisablei(GL_BLEND, 0);
       glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
@@ -479,13 +499,112 @@ bool PvrrPass::additiveDraws() const {
 
 std::string PvrrPass::drawElements(RenderMode, const PassCamera& eye, const Framebuffer& target) {
   size_t slot = 0;  // the map slot of frames[e].views[0]
-  for (const ElementFrame& f : frames) {
+  refine_counting = true;
+  for (size_t e = 0; e < frames.size(); ++e) {
+    const ElementFrame& f = frames[e];
     target.bind();
+    const bool refined = refine_skip.size() > e && refine_skip[e].empty();
+    if (refined) glBeginQuery(GL_SAMPLES_PASSED, refine_queries[e]);
     if (beyondDepth(ctx.scene, f)) drawDarkElement(f, eye);
     else drawPvrrElement(f, slot, eye, ctx.options.seen_channel);
+    if (refined) glEndQuery(GL_SAMPLES_PASSED);
     slot += f.views.size();
   }
-  return "";
+  refine_counting = false;
+  return refinementNote();
+}
+
+void PvrrPass::prepareRefinement() {
+  const int steps = ctx.scene.render.refine;
+  refine_skip.assign(frames.size(), "off");
+  if (steps <= 0) return;
+  bool any = false;
+  for (size_t e = 0; e < frames.size(); ++e) {
+    refine_skip[e] = refineSkipReason(ctx.scene, frames[e], steps);
+    if (!refine_skip[e].empty()) continue;
+    any = true;
+    if (!surface_maps) surface_maps = std::make_unique<ImpostorMaps>(ctx.scene, ctx.options, ctx.max_texture_units);
+    surface_maps->updateMirrorMaps(e);
+  }
+  if (!any) return;
+  if (!refine_sampler) {
+    glGenSamplers(1, &refine_sampler);
+    glSamplerParameteri(refine_sampler, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glSamplerParameteri(refine_sampler, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glSamplerParameteri(refine_sampler, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glSamplerParameteri(refine_sampler, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  }
+  if (refine_queries.size() < frames.size()) {
+    const size_t had = refine_queries.size();
+    refine_queries.resize(frames.size());
+    glGenQueries(GLsizei(frames.size() - had), refine_queries.data() + had);
+  }
+  // The counters, zeroed before the frame's draws.
+  const GLuint zeros[2] = {0, 0};
+  if (!refine_counters) glGenBuffers(1, &refine_counters);
+  glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, refine_counters);
+  glBufferData(GL_ATOMIC_COUNTER_BUFFER, sizeof(zeros), zeros, GL_DYNAMIC_READ);
+  glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, 0, refine_counters);
+  checkGlError("zeroing the refinement's counters");
+}
+
+// Units 2 to 5: the mirror's surface maps (u_to_local, u_sm), the derivatives (3, 4) filtered linearly; 6: the
+// depth of the patch view's map, filtered linearly.
+void PvrrPass::setRefinement(const Program& p, const ElementFrame& f) const {
+  surface_maps->setMirrorMaps(p, size_t(f.element));
+  p.set("u_map_depth", 6);
+  p.set("u_count", refine_counting ? 1 : 0);
+}
+
+void PvrrPass::unsetRefinement() const {
+  for (GLuint unit : {2u, 3u, 4u, 5u, 6u}) glBindSampler(unit, 0);
+}
+
+void PvrrPass::setRefinementView(const Program& p, const PatchView& pv, const Framebuffer& map, int side) const {
+  const bool on = refineViewSkipReason(pv).empty();
+  p.set("u_refine", on ? 1 : 0);
+  if (!on) return;
+  glActiveTexture(GL_TEXTURE6);
+  glBindTexture(GL_TEXTURE_2D, map.depthTexture());
+  for (GLuint unit : {2u, 3u, 4u, 5u, 6u}) glBindSampler(unit, refine_sampler);
+  p.set("u_map_vp", toFloat(relativeViewProj(pv.volume.projection, pv.volume.view, pv.volume.eye)));
+  const Mat4& P = pv.volume.projection;
+  p.set("u_depth_lin", glm::vec3(float(P[2][2]), float(P[3][2]), float(pv.volume.near_m)));
+  // A depth edge: neighbouring texels' depths differ more than a surface's at 89 deg incidence would
+  // (tan 89 deg ~ 57 times the texel's angle), and by at least 5 %.
+  p.set("u_edge", float(std::max(0.05, 57.0 * longerExtentTan(pv.volume) / std::max(side, 1))));
+}
+
+std::string PvrrPass::refinementNote() const {
+  const int steps = ctx.scene.render.refine;
+  if (steps <= 0) return "";
+  std::string note = "refine (" + std::to_string(steps) + " steps):";
+  std::string skipped;
+  bool any = false;
+  for (size_t e = 0; e < refine_skip.size(); ++e) {
+    if (refine_skip[e].empty())
+      any = true;
+    else
+      skipped += (skipped.empty() ? " " : "; ") + ctx.scene.elements[e].name + " (" + refine_skip[e] + ")";
+  }
+  if (any) {
+    GLuint n[2] = {0, 0};
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_ATOMIC_COUNTER_BARRIER_BIT);
+    glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, refine_counters);
+    glGetBufferSubData(GL_ATOMIC_COUNTER_BUFFER, 0, sizeof(n), n);
+    uint64_t drawn = 0;
+    for (size_t e = 0; e < refine_skip.size(); ++e) {
+      if (!refine_skip[e].empty()) continue;
+      GLuint samples = 0;
+      glGetQueryObjectuiv(refine_queries[e], GL_QUERY_RESULT, &samples);
+      drawn += samples;
+    }
+    note += " " + std::to_string(drawn) + " fragments drawn, " + std::to_string(n[0]) +
+            " kept the interpolated coordinate (search ended off the map's surface), " + std::to_string(n[1]) +
+            " kept it where the view ray missed the exact surface";
+  }
+  if (!skipped.empty()) note += std::string(any ? ";" : "") + " not refined:" + skipped;
+  return note;
 }
 
 }  // namespace pvrr::gl

@@ -14,6 +14,8 @@
 
 namespace pvrr::gl {
 
+class ImpostorMaps;
+
 class PvrrPass : public ModePass {
  public:
   explicit PvrrPass(const RenderContext& c) : ctx(c) {}
@@ -44,6 +46,13 @@ class PvrrPass : public ModePass {
   void drawDarkElement(const ElementFrame& f, const PassCamera& cam);
   int64_t closeUnreadTexels(const MapPass& mp, const std::array<int, 2>& region);
   CullCount renderPasses(size_t whole_slots, int64_t* skipped, int64_t* texels);
+  // Per-fragment refinement (render.refine): which elements refine (refine_skip), their surface maps, the
+  // fragment counters zeroed; and what the counters say once the frame's draws are done.
+  void prepareRefinement();
+  void setRefinement(const Program& p, const ElementFrame& f) const;
+  void unsetRefinement() const;
+  void setRefinementView(const Program& p, const PatchView& pv, const Framebuffer& map, int side) const;
+  std::string refinementNote() const;
 
   RenderContext ctx;
   std::vector<ElementFrame> frames;     // this frame's elements as seen from the eye
@@ -55,6 +64,12 @@ class PvrrPass : public ModePass {
   // process (nextFirstPassSerial), so a cache filled by another renderer never matches.
   uint64_t first_pass_serial = 0;
   unsigned mask_vao = 0, mask_vbo = 0;  // closeUnreadTexels' quads
+  std::vector<std::string> refine_skip;        // per element: why it is not refined, "" when it is
+  std::unique_ptr<ImpostorMaps> surface_maps;  // the refined mirrors' surface maps (pvrr/impostor/surface_map.h)
+  unsigned refine_counters = 0;          // the second pass's failed and missed fragments (shaders/pvrr_refine.glsl)
+  unsigned refine_sampler = 0;           // linear filtering of the depth maps and the surface derivatives
+  std::vector<unsigned> refine_queries;  // per element: its second-pass fragments (refined elements)
+  bool refine_counting = false;          // drawing the second pass (counted), not a nested pass
 };
 
 }  // namespace pvrr::gl

@@ -49,6 +49,9 @@ static_assert(namesAreUnique(kViewpointSolverNames));
 // (MAX_DEPTH_LIMIT, injected by pvrr/gl/program.cpp).
 inline constexpr int kMaxDepthLimit = 64;
 
+// The most secant steps render.refine accepts: the shader's search loop is unrolled by it.
+inline constexpr int kMaxRefineSteps = 16;
+
 // The settings of the "render" section with their defaults: the defaults of the scene format.
 struct RenderDesc {
   RenderMode mode = RenderMode::Pvrr;
@@ -57,6 +60,9 @@ struct RenderDesc {
   double map_reuse_margin_deg = 2;   // maps widened this much for reuse by later frames; 0: no reuse
   int impostor_iterations = 8;       // impostor mode: false-position steps of each fragment's search
   int impostor_layers = 2;           // impostor mode: layers of each distance map (2: the second depth-peeled)
+  // pvrr mode: the secant steps of each mirror fragment's search of its map along its exact reflected ray
+  // (docs/method.md "Per-fragment refinement"); 0: off, the paper's interpolated texture coordinates.
+  int refine = 0;
   // Relative to the current directory, as written. The parser and the build fill in out/<scene name>.png
   // when the file names none.
   std::string output;

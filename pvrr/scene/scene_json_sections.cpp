@@ -559,7 +559,7 @@ RenderDesc readRender(const Ctx& c, const json* j, const std::string& source) {
   r.output = (fs::path("out") / (fs::path(source).stem().string() + ".png")).string();
   if (!j) return r;
   Obj o(c, j, "render", "an object {\"mode\", \"map_size\", \"output\", ...}",
-        {"mode", "map_size", "map_texels_per_pixel", "map_reuse_margin_deg", "impostor_iterations", "impostor_layers", "output",
+        {"mode", "map_size", "map_texels_per_pixel", "map_reuse_margin_deg", "impostor_iterations", "impostor_layers", "refine", "output",
          "max_depth", "dispersion", "spectral_samples",
          "background", "viewpoint_solver"});
   r.mode = o.choice<RenderMode>("mode", r.mode);
@@ -568,6 +568,13 @@ RenderDesc readRender(const Ctx& c, const json* j, const std::string& source) {
   r.map_reuse_margin_deg = o.number("map_reuse_margin_deg", closed(0, 10), r.map_reuse_margin_deg);
   r.impostor_iterations = o.integer("impostor_iterations", 0, 64, r.impostor_iterations);
   r.impostor_layers = o.integer("impostor_layers", 1, 2, r.impostor_layers);
+  if (o.has("refine")) {
+    const json* v = o.get("refine");
+    const bool off = v->is_string() && v->get<std::string>() == "off";
+    const bool steps = v->is_number_integer() && v->get<int64_t>() >= 1 && v->get<int64_t>() <= kMaxRefineSteps;
+    if (!off && !steps) o.expected("refine", "\"off\" or an integer in [1, " + std::to_string(kMaxRefineSteps) + "]");
+    r.refine = off ? 0 : int(v->get<int64_t>());
+  }
   if (o.has("output")) {
     r.output = o.string("output");
     if (!endsWithAny(r.output, {".png"})) o.expected("output", "a file name ending in \".png\"");

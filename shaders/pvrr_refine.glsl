@@ -1,0 +1,115 @@
+// Per-fragment refinement of pvrr mode (render.refine; docs/method.md "Per-fragment refinement"), included by
+// element_pvrr.frag; everything here only with REFINE (the number of secant steps). A mirror fragment's exact
+// reflected ray, from the exact surface point its view ray meets and the exact normal there (the surface maps
+// of pvrr/impostor/surface_map.h, surface_maps.glsl), is searched in its patch's map: the map's depth gives,
+// for each direction from the map's viewpoint, the depth along the map's forward of what it shows; the search
+// takes secant steps on the difference between the ray point's depth and the map's depth in the ray point's
+// direction ([Szirmay-Kalos et al.]'s Hit(), with the map's perspective depth in place of a cube's distance),
+// starting from the ray point at the depth the interpolated texture coordinate shows. The map's viewpoint is
+// fitted to the element's rays, so the search starts next to the answer and has little parallax to cross.
+// Where it ends off the map's surface (no convergence, outside the map, a texel the pass left unread, or across
+// a depth edge) the fragment keeps the interpolated coordinate. Atomic counters count, in the second pass, the
+// fragments whose view ray missed the exact surface (the triangles' silhouette overhang, or beyond the
+// outline) and those whose search failed; pvrr/gl/pvrr_pass.cpp counts the fragments drawn with a query and
+// reads both into the second pass's note.
+#include "surface_maps.glsl"
+#if defined(REFINE) && (CHANNELS != 1 || defined(LENS))
+#error "REFINE: a mirror's one channel only"
+#endif
+#if defined(REFINE)
+uniform bool u_refine;          // this patch view is refined (else the interpolated coordinate, as without REFINE)
+uniform bool u_count;           // count the fallbacks (the second pass's draws, not the nested ones)
+uniform sampler2D u_map_depth;  // the map's depth attachment (window depth), with a linear sampler
+uniform mat4 u_map_vp;          // the map's camera: positions relative to its viewpoint -> clip
+uniform vec3 u_depth_lin;       // P[2][2], P[3][2] of its projection, and its near depth: the depth along the map's
+                                // forward of NDC depth z is P[3][2] / (z + P[2][2])
+uniform float u_edge;           // across a depth edge: the four texels' depths differ by more than this (relative)
+uniform vec3 u_offset;          // the element's anchor - this pass's camera origin (element.vert)
+uniform mat3 u_to_local;        // world directions -> the element's local frame (surface_maps.glsl's)
+layout(binding = 0, offset = 0) uniform atomic_uint u_count_failed;
+layout(binding = 0, offset = 4) uniform atomic_uint u_count_missed;
+
+const float REFINE_TOL = 2e-5;     // converged: |depth difference| <= this * depth (the depth's float resolution)
+const float REFINE_ACCEPT = 1e-3;  // on the map's surface: at most this, after the last step
+const float REFINE_MAX_STEP = 0.02;  // of the normalised parameters: the surface step from the triangle's point
+
+float linearDepth(float window_z) { return u_depth_lin.y / (2.0 * window_z - 1.0 + u_depth_lin.x); }
+// The map's texture coordinate of volume coordinate st, half a texel inside its region (as mapST).
+vec2 mapTexST(vec2 st) { return min(st * u_st_scale, u_st_max); }
+
+// The map's volume coordinate (s, t) in [0, 1]^2 where the ray x + t R (x relative to the map's viewpoint)
+// meets what the map shows, searched from the coordinate st0 that the interpolation gives; false where the
+// search ends off the map's surface. The steps read the filtered window depth (linear in the screen for a
+// plane, so exact between texels there); the last point is checked on its four texels: none left unread (at
+// the near plane), no depth edge between them.
+bool refineSearch(vec3 x, vec3 R, vec2 st0, out vec2 st) {
+  vec4 cx = u_map_vp * vec4(x, 1.0), cr = u_map_vp * vec4(R, 0.0);
+  // The ray must move along the map's forward (it does: the forward is its rays' mean direction).
+  if (cr.w <= 1e-3) return false;
+  float d = linearDepth(texture(u_map_depth, mapTexST(st0)).r);
+  float t = (d - cx.w) / cr.w, t_prev = 0.0, f_prev = 0.0, f = 0.0;
+  for (int i = 0; i <= REFINE; ++i) {
+    vec4 c = cx + t * cr;
+    if (c.w <= 0.0) return false;
+    st = c.xy / c.w * 0.5 + 0.5;
+    if (any(lessThan(st, vec2(0.0))) || any(greaterThan(st, vec2(1.0)))) return false;
+    d = linearDepth(texture(u_map_depth, mapTexST(st)).r);
+    f = c.w - d;
+    if (abs(f) <= REFINE_TOL * d || i == REFINE) break;
+    // The first step moves the ray point to the depth the map shows in its direction; then secant steps.
+    float t_next = i > 0 && f != f_prev ? t - f * (t - t_prev) / (f - f_prev) : (d - cx.w) / cr.w;
+    t_prev = t;
+    f_prev = f;
+    t = t_next;
+  }
+  vec4 z = textureGather(u_map_depth, mapTexST(st));
+  vec4 dz = u_depth_lin.y / (2.0 * z - 1.0 + u_depth_lin.x);
+  float lo = min(min(dz.x, dz.y), min(dz.z, dz.w)), hi = max(max(dz.x, dz.y), max(dz.z, dz.w));
+  return abs(f) <= REFINE_ACCEPT * d && hi <= lo * (1.0 + u_edge) && lo > u_depth_lin.z * 1.001;
+}
+
+// This fragment's exact reflected ray: its origin relative to the map's viewpoint, and its direction, from the
+// exact surface point on the view ray along `view` (unit, from u_view_origin) and the exact normal there; false
+// where the view ray misses the surface within its outline. One Gauss-Newton step of surfaceHit's from the
+// fragment's interpolated parameters: the triangle lies within its sag of the surface, so one step leaves an
+// error of the order of the sag squared over the radius of curvature. The derivatives (which only steer the step)
+// are filtered by the sampler; the position and the normal with full-precision weights (bilinear.glsl).
+bool exactReflection(vec3 view, out vec3 x, out vec3 R) {
+  vec3 e = u_to_local * (u_view_origin - u_offset), vl = u_to_local * view;
+  vec2 st = v_st1.xy * u_sm.x + u_sm.y;
+  vec4 sp = texture(u_surf_p, st);  // w: 1 inside the outline
+  vec3 su = texture(u_surf_du, st).xyz, sv = texture(u_surf_dv, st).xyz;
+  vec3 w = sp.xyz - e, r = w - dot(w, vl) * vl;
+  vec3 a = su - dot(su, vl) * vl, b = sv - dot(sv, vl) * vl;
+  float aa = dot(a, a), ab = dot(a, b), bb = dot(b, b);
+  float c = dot(cross(su, sv), vl), det = c * c;
+  if (sp.w < 0.5 || !(det > 1e-12 * aa * bb)) return false;
+  vec2 g = vec2(dot(a, r), dot(b, r));
+  vec2 delta = -vec2(bb * g.x - ab * g.y, aa * g.y - ab * g.x) / det;
+  vec2 uv = v_st1.xy + delta;
+  // A longer step: the view ray passes the surface's edge (the triangles' silhouette overhang).
+  if (length(delta) > REFINE_MAX_STEP || any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return false;
+  vec3 pos = u_offset + (sp.xyz + su * delta.x + sv * delta.y) * u_to_local;  // relative to this camera's origin
+  vec3 n = normalize(texture(u_surf_n, uv * u_sm.x + u_sm.y).xyz * u_to_local);
+  x = pos - u_seen_offset;
+  R = reflect(normalize(pos - u_view_origin), n);
+  return true;
+}
+
+// The texture coordinate (of the map's texture) this fragment reads: the refined one, or st_interpolated
+// (mapST's) where the fragment is not refined or its refinement fails.
+vec2 refinedST(vec3 view, vec2 st_interpolated) {
+  if (!u_refine) return st_interpolated;
+  vec3 x, R;
+  if (!exactReflection(view, x, R)) {
+    if (u_count) atomicCounterIncrement(u_count_missed);
+    return st_interpolated;
+  }
+  vec2 st;
+  if (!refineSearch(x, R, v_st0.xy / v_st0.z, st)) {
+    if (u_count) atomicCounterIncrement(u_count_failed);
+    return st_interpolated;
+  }
+  return mapTexST(st);
+}
+#endif

@@ -1,0 +1,223 @@
+// Per-fragment refinement of pvrr mode (render.refine; shaders/pvrr_refine.glsl): each mirror fragment's exact
+// reflected ray searched in its map. Against the reference tracer: a convex mirror and a saddle (whose
+// interpolated coordinates err most between vertices), one patch and 2 x 2 patches; off and skipped elements
+// draw exactly the unrefined pixels; every refined element's fragment is counted once, refined or fallen back.
+// OSMesa and EGL.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <iostream>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include "pvrr/analysis/accuracy.h"
+#include "pvrr/base/error.h"
+#include "pvrr/gl/renderer.h"
+#include "pvrr/scene/scene_build.h"
+#include "pvrr/scene/scene_json.h"
+#include "pvrr/trace/tracer.h"
+#include "support/gl_backends.h"
+#include "support/test_scenes.h"
+
+namespace pvrr {
+namespace {
+
+// The refined median must be at most this: the impostor mode, which reflects each fragment's exact ray too,
+// measures 0.0005' to 0.003' on such mirrors (grazing_test.cpp); refined: 0.008' to 0.03', unrefined 3' to 7'. A search
+// that converged onto the wrong surface, or a normal from the wrong parameters, is arcminutes off.
+constexpr double kRefinedMedianArcmin = 0.05;
+// And its p95 at most this (the depth edges of the room's box are where the interpolation fails; the
+// refined search lands on one side of them or falls back; measured 0.02' to 0.06'); unrefined: 13' to 30'.
+constexpr double kRefinedP95Arcmin = 1.0;
+
+// The shipped car mirror at 160 x 120 (its map scaled to the image: map_texels_per_pixel), refined median at
+// most this; unrefined 0.77'.
+constexpr double kSmallMapMedianArcmin = 0.15;
+
+ErrorStats errorStats(const Frame& ref, const Frame& f) {
+  const std::vector<double> e = angularErrors(ref, ref.seen, f.seen);
+  return summarizeErrors(e);
+}
+
+// The second pass's refinement note ("refine (N steps): D fragments drawn, F kept ..., M kept it ...").
+std::string refineNote(const Frame& f) {
+  for (const StageTiming& s : f.stages.stages)
+    if (s.note.find("refine (") != std::string::npos) return s.note.substr(s.note.find("refine ("));
+  return "";
+}
+
+// The counts of the note: drawn, failed (search off the map's surface), missed (view ray off the surface).
+std::array<long, 3> refineCounts(const std::string& note) {
+  std::smatch m;
+  const std::regex re(R"((\d+) fragments drawn, (\d+) kept the interpolated coordinate.*?, (\d+) kept it)");
+  if (!std::regex_search(note, m, re)) return {-1, -1, -1};
+  return {std::stol(m[1]), std::stol(m[2]), std::stol(m[3])};
+}
+
+Scene mirrorScene(cad::SagSurfacePtr surface, int patches, int tess = 9) {
+  const Vec3 eye(0.0, 0.3, 2.0), centre(0.0, 0.0, 0.0);
+  Scene s = test::roomScene(eye, centre, 200, 150);
+  s.observer.fov_y_rad = radians(25);
+  const cad::Outline outline = cad::Outline::rectangle(0.5, 0.4, 0.04);
+  // Turned 25 deg about the vertical axis: the reflection shows the room's box and its depth edges.
+  const Vec3 normal = glm::normalize(Vec3(std::sin(radians(25.0)), 0.1, std::cos(radians(25.0))));
+  test::addMirror(s, surface, outline, test::pose(centre, normal), tess, 0.9);
+  // A box on the mirror's central reflected ray, 2 m away, against the wall 1.5 m behind it: depth edges in
+  // the reflection, where searches must fall back.
+  EnvMesh box = makeBoxMesh(Vec3(1.5, 0.05, 1.3), Vec3(0.3, 0.3, 0.3), Mat3(1.0));
+  box.material = 2;
+  s.meshes.push_back(box);
+  s.elements[0].patches_u = s.elements[0].patches_v = patches;
+  s.updateBounds();
+  return s;
+}
+
+class RefineTest : public ::testing::TestWithParam<gl::GlBackend> {};
+
+// Refined against the reference: a convex mirror and a saddle, one patch and 2 x 2, each far closer than the
+// unrefined frame, and each refined fragment counted.
+TEST_P(RefineTest, MirrorsAndPatchesMatchTheReference) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  const cad::Outline outline = cad::Outline::rectangle(0.5, 0.4, 0.04);
+  struct Case {
+    const char* name;
+    cad::SagSurfacePtr surface;
+    int patches;
+  };
+  const Case cases[] = {{"convex", cad::makeSphere(1.2, outline), 1},
+                        {"convex 2x2 patches", cad::makeSphere(1.2, outline), 2},
+                        {"saddle 2x2 patches", cad::makeToric(1.5, -1.5, 0.0, outline), 2}};
+  for (const Case& c : cases) {
+    Scene s = mirrorScene(c.surface, c.patches);
+    RayScene rays(s);
+    const Frame ref = Tracer(rays, TraceOptions{}).render();
+    gl::Renderer r(s, rays, gl::RendererOptions{});
+    const gl::RasterFrame plain = r.render(RenderMode::Pvrr);
+    s.render.refine = 4;
+    const gl::RasterFrame refined = r.render(RenderMode::Pvrr);
+    const ErrorStats a = errorStats(ref, plain), b = errorStats(ref, refined);
+    const std::string note = refineNote(refined);
+    std::cout << "[ measured ] " << c.name << ": unrefined median " << a.median_arcmin << "' p95 " << a.p95_arcmin
+              << "', refined median " << b.median_arcmin << "' p95 " << b.p95_arcmin << "' (" << b.pixels << " px); "
+              << note << "\n";
+    ASSERT_GT(b.pixels, 2000u) << c.name;
+    EXPECT_LE(b.median_arcmin, kRefinedMedianArcmin) << c.name;
+    EXPECT_LE(b.p95_arcmin, kRefinedP95Arcmin) << c.name;
+    EXPECT_LT(b.median_arcmin, a.median_arcmin / 10) << c.name;
+    // The fragments drawn are the mirror's pixels (one mirror, no overdraw); few fall back, and the box's depth
+    // edges make some.
+    const std::array<long, 3> n = refineCounts(note);
+    ASSERT_GE(n[0], 0) << note;
+    size_t mirror_px = 0;
+    for (int e : refined.element) mirror_px += e == 0;
+    EXPECT_EQ(size_t(n[0]), mirror_px) << note;
+    EXPECT_LT(n[1] + n[2], n[0] / 10) << note;
+    EXPECT_GT(n[1], 0) << note;
+  }
+}
+
+// Off draws the unrefined pixels (the default, the paper's method), and so does refinement of an element it
+// skips: a plane mirror, whose interpolation is exact already, named with the reason in the note.
+TEST_P(RefineTest, OffAndSkippedElementsDrawTheUnrefinedPixels) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  const cad::Outline outline = cad::Outline::rectangle(0.5, 0.4, 0.04);
+  Scene s = mirrorScene(cad::makeSphere(1.2, outline), 1);
+  EXPECT_EQ(s.render.refine, 0);  // the format's default
+  RayScene rays(s);
+  gl::Renderer r(s, rays, gl::RendererOptions{});
+  const gl::RasterFrame off = r.render(RenderMode::Pvrr);
+  EXPECT_EQ(refineNote(off), "");
+  s.render.refine = 4;
+  EXPECT_NE(r.render(RenderMode::Pvrr).color, off.color);  // the knob reaches the renderer
+  s.render.refine = 0;
+  EXPECT_EQ(r.render(RenderMode::Pvrr).color, off.color);
+
+  Scene p = mirrorScene(cad::makePlane(outline), 1);
+  RayScene prays(p);
+  gl::Renderer pr(p, prays, gl::RendererOptions{});
+  const gl::RasterFrame plane_off = pr.render(RenderMode::Pvrr);
+  p.render.refine = 4;
+  const gl::RasterFrame plane_on = pr.render(RenderMode::Pvrr);
+  EXPECT_EQ(plane_on.color, plane_off.color);
+  EXPECT_EQ(plane_on.seen, plane_off.seen);
+  const std::string note = refineNote(plane_on);
+  EXPECT_NE(note.find("not refined: mirror0 (the vertex fit is exact"), std::string::npos) << note;
+}
+
+// The knob from a scene file (render.refine, through --set as `pvrr render` takes it), on the shipped car
+// mirror (a NURBS from STEP) and the mirror pair (the convex mirror seen in a plane one: nested maps; the
+// plane mirror skipped): refined against the reference, far below the unrefined frame.
+TEST_P(RefineTest, ShippedMirrorsFromTheirFiles) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  for (const std::string name : {"car-mirror", "mirror-pair"}) {
+    const std::string path = std::string(PVRR_SOURCE_DIR) + "/models/" + name + ".json";
+    const SceneDesc desc = loadScene(path, {"observer.image_size=[160,120]", "render.refine=2"});
+    ASSERT_EQ(desc.render.refine, 2);
+    Scene s = buildScene(desc);
+    RayScene rays(s);
+    const Frame ref = Tracer(rays, TraceOptions{}).render();
+    gl::Renderer r(s, rays, gl::RendererOptions{});
+    const gl::RasterFrame refined = r.render(RenderMode::Pvrr);
+    s.render.refine = 0;
+    const gl::RasterFrame plain = r.render(RenderMode::Pvrr);
+    const ErrorStats a = errorStats(ref, plain), b = errorStats(ref, refined);
+    const std::string note = refineNote(refined);
+    std::cout << "[ measured ] " << name << " 160x120: unrefined median " << a.median_arcmin << "' p95 " << a.p95_arcmin
+              << "', refined median " << b.median_arcmin << "' p95 " << b.p95_arcmin << "'; " << note << "\n";
+    EXPECT_LE(b.median_arcmin, a.median_arcmin / 5) << name;
+    EXPECT_LE(b.p95_arcmin, a.p95_arcmin) << name;
+    if (name == "car-mirror") {
+      // At 160 x 120 the map has ~6 times fewer texels across than at 640 x 480 (0.0078' there): measured
+      // 0.073' / 0.61'.
+      EXPECT_LE(b.median_arcmin, kSmallMapMedianArcmin);
+      EXPECT_LE(b.p95_arcmin, kRefinedP95Arcmin);
+    } else {
+      EXPECT_NE(note.find("not refined: back-wall-mirror (the vertex fit is exact"), std::string::npos) << note;
+    }
+  }
+}
+
+// A lens is not refined (its exit rays are not): the note names it and why, and its pixels are the unrefined
+// ones.
+TEST_P(RefineTest, LensIsSkippedWithItsReason) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  const std::string path = std::string(PVRR_SOURCE_DIR) + "/models/spectacle-lens.json";
+  Scene s = buildScene(loadScene(path, {"observer.image_size=[96,72]", "render.map_size=256"}));
+  RayScene rays(s);
+  gl::Renderer r(s, rays, gl::RendererOptions{});
+  const gl::RasterFrame off = r.render(RenderMode::Pvrr);
+  s.render.refine = 2;
+  const gl::RasterFrame on = r.render(RenderMode::Pvrr);
+  EXPECT_EQ(on.color, off.color);
+  EXPECT_EQ(on.seen, off.seen);
+  const std::string note = refineNote(on);
+  EXPECT_NE(note.find("(a lens: its exit rays are not refined)"), std::string::npos) << note;
+}
+
+// render.refine: "off" or a step count in [1, kMaxRefineSteps]; anything else is refused naming the path.
+TEST(RefineKnob, ParsesOffOrAStepCount) {
+  const std::string path = std::string(PVRR_SOURCE_DIR) + "/models/car-mirror.json";
+  EXPECT_EQ(loadScene(path).render.refine, 0);  // the shipped scene leaves the default: off
+  EXPECT_EQ(loadScene(path, {"render.refine=off"}).render.refine, 0);
+  EXPECT_EQ(loadScene(path, {"render.refine=16"}).render.refine, 16);
+  for (const std::string bad : {"render.refine=0", "render.refine=17", "render.refine=on", "render.refine=2.5"}) {
+    try {
+      loadScene(path, {bad});
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const Error& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("render.refine: expected \"off\" or an integer in [1, 16]"), std::string::npos) << m;
+    }
+  }
+}
+
+PVRR_GL_BACKENDS(RefineTest);
+
+}  // namespace
+}  // namespace pvrr
