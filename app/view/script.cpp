@@ -29,20 +29,25 @@ const std::map<std::string, std::pair<EventKind, std::vector<std::string>>>& kin
       {"save_view", {EventKind::SaveView, {"file"}}},
       {"quit", {EventKind::Quit, {}}},
       {"key", {EventKind::Key, {"key", "shift"}}},
+      {"reference", {EventKind::Reference, {}}},
+      {"wipe", {EventKind::Wipe, {"x"}}},
+      {"overlay", {EventKind::Overlay, {"on"}}},
+      {"drag", {EventKind::Drag, {"button", "from", "to"}}},
   };
   return table;
 }
 // Issue 25's other events, not in this version yet: named so that a script using them is told so.
-const std::set<std::string> kLater = {"turn_element", "reference", "wipe", "overlay", "drag"};
+const std::set<std::string> kLater = {"turn_element"};
 
 // The keys the viewer answers to, by their GLFW names (GLFW_KEY_<name>).
 const std::map<std::string, int>& keyCodes() {
   static const std::map<std::string, int> table = {
-      {"W", GLFW_KEY_W},         {"A", GLFW_KEY_A},       {"S", GLFW_KEY_S},         {"D", GLFW_KEY_D},
-      {"R", GLFW_KEY_R},         {"F", GLFW_KEY_F},       {"H", GLFW_KEY_H},         {"V", GLFW_KEY_V},
-      {"1", GLFW_KEY_1},         {"2", GLFW_KEY_2},       {"3", GLFW_KEY_3},         {"4", GLFW_KEY_4},
-      {"LEFT", GLFW_KEY_LEFT},   {"RIGHT", GLFW_KEY_RIGHT}, {"UP", GLFW_KEY_UP},     {"DOWN", GLFW_KEY_DOWN},
-      {"HOME", GLFW_KEY_HOME},   {"TAB", GLFW_KEY_TAB},   {"F12", GLFW_KEY_F12},     {"ESCAPE", GLFW_KEY_ESCAPE},
+      {"W", GLFW_KEY_W},       {"A", GLFW_KEY_A},         {"S", GLFW_KEY_S},     {"D", GLFW_KEY_D},
+      {"R", GLFW_KEY_R},       {"F", GLFW_KEY_F},         {"H", GLFW_KEY_H},     {"V", GLFW_KEY_V},
+      {"1", GLFW_KEY_1},       {"2", GLFW_KEY_2},         {"3", GLFW_KEY_3},     {"4", GLFW_KEY_4},
+      {"LEFT", GLFW_KEY_LEFT}, {"RIGHT", GLFW_KEY_RIGHT}, {"UP", GLFW_KEY_UP},   {"DOWN", GLFW_KEY_DOWN},
+      {"HOME", GLFW_KEY_HOME}, {"TAB", GLFW_KEY_TAB},     {"F12", GLFW_KEY_F12}, {"ESCAPE", GLFW_KEY_ESCAPE},
+      {"T", GLFW_KEY_T},       {"E", GLFW_KEY_E},
   };
   return table;
 }
@@ -162,7 +167,29 @@ ScriptEvent readEvent(const Reader& r, const json& e, const std::string& path) {
       }
       break;
     }
+    case EventKind::Reference:
     case EventKind::Quit: break;
+    case EventKind::Wipe:
+      ev.wipe_x = r.number(r.need(e, path, "x"), path + ".x");
+      if (ev.wipe_x < 0 || ev.wipe_x > 1)
+        r.expected(path + ".x", "a number from 0 (all reference) to 1 (all mode)", e.at("x"));
+      break;
+    case EventKind::Overlay:
+      if (!r.need(e, path, "on").is_boolean()) r.expected(path + ".on", "true or false", e.at("on"));
+      ev.on = e.at("on").get<bool>();
+      break;
+    case EventKind::Drag: {
+      if (e.contains("button") && e.at("button") != "left") r.expected(path + ".button", "\"left\"", e.at("button"));
+      const auto point = [&](const char* key, Vec2* out) {
+        const json& v = r.need(e, path, key);
+        if (!v.is_array() || v.size() != 2) r.expected(path + "." + key, "[x, y] in window pixels", v);
+        for (int k = 0; k < 2; ++k)
+          (*out)[k] = r.number(v[size_t(k)], path + "." + key + "[" + std::to_string(k) + "]");
+      };
+      point("from", &ev.from_px);
+      point("to", &ev.to_px);
+      break;
+    }
   }
   return ev;
 }

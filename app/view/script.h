@@ -10,7 +10,7 @@
 
 namespace pvrr::app::view {
 
-enum class EventKind { Set, TurnHead, MoveEye, Screenshot, SaveView, Quit, Key };
+enum class EventKind { Set, TurnHead, MoveEye, Screenshot, SaveView, Quit, Key, Reference, Wipe, Overlay, Drag };
 
 struct ScriptEvent {
   int at_frame = 0;
@@ -24,6 +24,11 @@ struct ScriptEvent {
   bool with_panel = false;            // screenshot: with the panel over the frame ("panel": true)
   int key = 0;                        // key: the GLFW key code of "key" (a GLFW key name: "W", "LEFT", "HOME")
   bool shift = false;                 // key: with Shift held ("shift": true)
+  // reference: start the live reference of the current view and run no later event until it is finished
+  // (the window keeps drawing meanwhile).
+  double wipe_x = 0.5;        // wipe: the split line's position, 0 (all reference) to 1 (all mode)
+  bool on = false;            // overlay: show ("on": true) or hide the error heat map
+  Vec2 from_px{0}, to_px{0};  // drag (left button): press at "from", move to "to", release; window pixels
 };
 
 struct Script {

@@ -10,14 +10,17 @@
 #include <cstdio>
 #include <deque>
 #include <optional>
+#include <thread>
 
 #include "app/args.h"
 #include "app/commands.h"
 #include "app/report.h"
 #include "app/view/head.h"
+#include "app/view/reference_tiles.h"
 #include "app/view/save_view.h"
 #include "app/view/script.h"
 #include "app/view/window.h"
+#include "app/view/wipe.h"
 #include "pvrr/analysis/accuracy.h"
 #include "pvrr/base/error.h"
 #include "pvrr/base/format.h"
@@ -34,6 +37,21 @@ using nlohmann::json;
 constexpr double kEyeStepM = 0.01, kTurnStepDeg = 1.0, kFast = 10.0;
 // Mouse-look: degrees of head turn per pixel of drag.
 constexpr double kLookDegPerPixel = 0.1;
+// A left-button press within this many pixels of the wipe's split line drags the line, not the head.
+constexpr double kWipeGrabPx = 8;
+
+// What a reference belongs to: the view it traced. Any change (the head, the eye, the window's size, the mode,
+// a setting, which rebuilds the scene) makes it another view's reference, and it is discarded.
+struct ViewKey {
+  Vec3 eye{0}, target{0}, up{0};
+  int width = 0, height = 0;
+  RenderMode mode = RenderMode::Pvrr;
+  int scene_build = 0;
+  bool operator==(const ViewKey& o) const {
+    return eye == o.eye && target == o.target && up == o.up && width == o.width && height == o.height &&
+           mode == o.mode && scene_build == o.scene_build;
+  }
+};
 
 class Viewer {
  public:
@@ -48,13 +66,17 @@ class Viewer {
     rebuild();
   }
   ~Viewer() {
+    reference_.reset();               // cancels a running trace and joins its threads
     window_.context().makeCurrent();  // GL objects go while their context is current
+    wipe_.reset();
+    seen_renderer_.reset();
     renderer_.reset();
     glfwSetKeyCallback(window_.handle(), nullptr);
   }
 
   void run();
   json stats() const;
+  json referenceStats() const;
 
  private:
   void rebuild();
@@ -62,6 +84,22 @@ class Viewer {
   void frame();
   void panel(const gl::RasterFrame& f, double frame_ms);
   void onKey(int key, int action, int mods);
+  const Observer& updateObserver();
+  ViewKey viewKey() const {
+    const Observer& ob = ls_.scene.observer;
+    return {ob.eye, ob.target, ob.up, ob.width, ob.height, mode_, scene_builds_};
+  }
+  // The live reference: startReference traces the current view in the background (and draws the mode's frame
+  // of it once with seen points, for the errors); discardReference cancels or drops it, saying why.
+  void startReference();
+  void discardReference(const std::string& why);
+  void presentFrame(const Observer& ob);
+  void referencePanel();
+  // The pointer's path, shared by the mouse and the script's drag: a left-button press (not over the panel), moves
+  // while held, release.
+  void pointerPress(double x, double y);
+  void pointerMove(double x, double y);
+  void pointerRelease() { drag_ = Drag::None; }
   void setMode(RenderMode m) {
     if (m == mode_) return;
     mode_ = m;
@@ -81,6 +119,7 @@ class Viewer {
   std::string script_path_;
   Script script_;
   size_t next_event_ = 0;
+  int waited_frames_ = 0;  // frames drawn while the script waited for a reference
 
   LoadedScene ls_;
   Observer design_;  // the scene's observer: the design eye point
@@ -98,13 +137,32 @@ class Viewer {
   // Where each frame's time went: the renderer's frame, presenting it, the panel, the swap and input.
   std::vector<double> render_ms_, present_ms_, panel_ms_, swap_ms_;
   std::deque<double> recent_ms_;   // the last frames, for the panel
-  bool dragging_ = false;
+  enum class Drag { None, Look, Wipe };
+  Drag drag_ = Drag::None;
+  bool mouse_down_ = false;
   double last_x_ = 0, last_y_ = 0;
+
+  int scene_builds_ = 0;
+  std::unique_ptr<gl::Renderer> seen_renderer_;  // the mode's frame with seen points, for the reference's errors
+  std::unique_ptr<ReferenceRun> reference_;
+  std::unique_ptr<Wipe> wipe_;
+  ViewKey reference_key_;
+  bool reference_requested_ = false;  // by key or panel: started at the next frame
+  bool waiting_reference_ = false;    // a script's "reference" event: later events wait for it
+  bool heat_uploaded_ = false;
+  double wipe_x_ = 0.5;  // the split line: 0 all reference, 1 all mode
+  bool overlay_ = false;
+  std::string reference_note_;  // why there is no reference now (cancelled, discarded)
+  int references_started_ = 0, frames_while_tracing_ = 0;
+  double frame_ms_max_while_tracing_ = 0, reference_start_ms_ = 0;
 };
 
 void Viewer::rebuild() {
+  if (reference_) discardReference("discarded: the scene was rebuilt (a setting changed)");
   window_.context().makeCurrent();
+  seen_renderer_.reset();
   renderer_.reset();
+  ++scene_builds_;
   rays_.reset();
   ls_ = loadScene(scene_path_, overrides_, width_, height_);
   design_ = ls_.scene.observer;
@@ -125,7 +183,14 @@ void Viewer::rebuild() {
 }
 
 void Viewer::runEvents() {
-  while (next_event_ < script_.events.size() && script_.events[next_event_].at_frame <= frames_) {
+  // A script waiting for its reference: the window draws on, and the later events move by the frames it waited.
+  if (waiting_reference_ && reference_ && !reference_->finished()) {
+    ++waited_frames_;
+    return;
+  }
+  waiting_reference_ = false;
+  while (next_event_ < script_.events.size() && script_.events[next_event_].at_frame + waited_frames_ <= frames_) {
+    if (waiting_reference_) return;
     const ScriptEvent& e = script_.events[next_event_++];
     try {
       switch (e.kind) {
@@ -140,6 +205,21 @@ void Viewer::runEvents() {
         case EventKind::SaveView: saveViewTo(e.file); break;
         case EventKind::Quit: quit_ = true; break;
         case EventKind::Key: onKey(e.key, GLFW_PRESS, e.shift ? GLFW_MOD_SHIFT : 0); break;  // the keyboard's path
+        case EventKind::Reference:
+          startReference();
+          waiting_reference_ = true;
+          break;
+        case EventKind::Wipe:
+          wipe_x_ = e.wipe_x;
+          break;
+        case EventKind::Overlay:
+          overlay_ = e.on;
+          break;
+        case EventKind::Drag:  // the mouse's path
+          pointerPress(e.from_px.x, e.from_px.y);
+          pointerMove(e.to_px.x, e.to_px.y);
+          pointerRelease();
+          break;
       }
     } catch (const Error& err) {
       throw Error(script_path_ + ": " + e.where + ": " + err.what());
@@ -158,14 +238,16 @@ void Viewer::frame() {
     cache_ = gl::FrameCache{};
   }
   const auto t0 = Clock::now();
-  const Observer ob = headObserver(design_, pose_);
-  Observer& current = ls_.scene.observer;
-  const bool moved = ob.eye != current.eye || ob.target != current.target;
-  current = ob;
-  if (moved && any_attached_) {
-    updateAttachedElements(ls_.scene, ls_.desc);
-    rays_->updateElementPoses();
+  if (reference_requested_) {
+    reference_requested_ = false;
+    if (reference_ && !reference_->finished())
+      discardReference("cancelled (T)");
+    else
+      startReference();
   }
+  const Observer ob = updateObserver();
+  if (reference_ && !(viewKey() == reference_key_)) discardReference("discarded: the view changed");
+  const bool tracing = reference_ && !reference_->finished();
   window_.context().makeCurrent();
   // A screenshot frame is drawn whole, every stage run (its own empty cache), so that it is what pvrr render
   // draws of the saved view: frames that reuse earlier maps (map reuse, render.map_reuse_margin_deg) differ
@@ -174,7 +256,7 @@ void Viewer::frame() {
   const gl::RasterFrame f = renderer_->render(mode_, pending_screenshots_.empty() ? &cache_ : &whole);
   cache_.environment_changed = false;  // the environment never changes while the window is open
   const auto t_render = Clock::now();
-  window_.present(renderer_->colorTexture(), ob.width, ob.height);
+  presentFrame(ob);
   const auto t_present = Clock::now();
   if (!pending_screenshots_.empty()) {
     // Screenshots show the frame alone: taken before the panel is drawn over it.
@@ -194,14 +276,14 @@ void Viewer::frame() {
   const auto t_panel = Clock::now();
   window_.swapAndPoll();
 
-  // Mouse-look: a left-button drag outside the panel turns the head.
+  // The mouse: a left-button drag outside the panel turns the head, or moves the wipe's split line.
   double x = 0, y = 0;
   glfwGetCursorPos(window_.handle(), &x, &y);
   const bool down = glfwGetMouseButton(window_.handle(), GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
-  if (down && dragging_) turnHead(pose_, -radians(kLookDegPerPixel * (x - last_x_)), -radians(kLookDegPerPixel * (y - last_y_)));
-  dragging_ = down && (dragging_ || !ImGui::GetIO().WantCaptureMouse);
-  last_x_ = x;
-  last_y_ = y;
+  if (down && !mouse_down_ && !ImGui::GetIO().WantCaptureMouse) pointerPress(x, y);
+  if (down) pointerMove(x, y);
+  if (!down && mouse_down_) pointerRelease();
+  mouse_down_ = down;
 
   const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   frame_ms_.push_back(ms);
@@ -212,9 +294,133 @@ void Viewer::frame() {
   present_ms_.push_back(span(t_render, t_present));
   panel_ms_.push_back(span(t_present, t_panel));
   swap_ms_.push_back(span(t_panel, Clock::now()));
+  if (tracing) {
+    ++frames_while_tracing_;
+    frame_ms_max_while_tracing_ = std::max(frame_ms_max_while_tracing_, ms);
+  }
   recent_ms_.push_back(ms);
   if (recent_ms_.size() > 60) recent_ms_.pop_front();
   ++frames_;
+}
+
+const Observer& Viewer::updateObserver() {
+  const Observer ob = headObserver(design_, pose_);
+  Observer& current = ls_.scene.observer;
+  const bool moved = ob.eye != current.eye || ob.target != current.target;
+  current = ob;
+  if (moved && any_attached_) {
+    updateAttachedElements(ls_.scene, ls_.desc);
+    rays_->updateElementPoses();
+  }
+  return current;
+}
+
+void Viewer::startReference() {
+  updateObserver();
+  if (reference_ && (reference_->finished() || !(viewKey() == reference_key_))) reference_.reset();  // traced anew
+  if (reference_ && viewKey() == reference_key_) return;  // this view's reference is being traced
+  window_.context().makeCurrent();
+  const auto t0 = Clock::now();
+  if (!seen_renderer_) {
+    gl::RendererOptions opt = gl::rendererOptionsFor(ls_.scene);
+    opt.seen_points = true;  // as pvrr compare draws the frame it measures
+    opt.read_back = true;
+    seen_renderer_ = std::make_unique<gl::Renderer>(ls_.scene, *rays_, opt);
+  }
+  gl::FrameCache fresh;  // every stage run, as compare's frame
+  gl::RasterFrame f = seen_renderer_->render(mode_, &fresh);
+  const int threads = std::max(1, int(std::thread::hardware_concurrency()) - 1);  // one core for the window
+  reference_ = std::make_unique<ReferenceRun>(ls_.scene, std::move(static_cast<Frame&>(f)), threads);
+  if (!wipe_) wipe_ = std::make_unique<Wipe>(window_);
+  wipe_->reset(reference_->width(), reference_->height());
+  heat_uploaded_ = false;
+  reference_key_ = viewKey();
+  reference_note_.clear();
+  ++references_started_;
+  reference_start_ms_ = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+void Viewer::discardReference(const std::string& why) {
+  reference_.reset();
+  reference_note_ = why;
+  waiting_reference_ = false;
+}
+
+void Viewer::presentFrame(const Observer& ob) {
+  if (!reference_) {
+    window_.present(renderer_->colorTexture(), ob.width, ob.height);
+    return;
+  }
+  const bool finished = reference_->finished();  // first: every tile is queued once it says so
+  wipe_->uploadTiles(reference_->takeTiles(), reference_->rgba());
+  if (finished && !heat_uploaded_ && reference_->hasErrors()) {
+    wipe_->uploadHeat(reference_->heatRgba());
+    heat_uploaded_ = true;
+  }
+  wipe_->present(renderer_->colorTexture(), ob.width, ob.height, wipe_x_ * ob.width, overlay_ && heat_uploaded_);
+}
+
+void Viewer::pointerPress(double x, double y) {
+  const bool on_line = reference_ && std::abs(x - wipe_x_ * double(ls_.scene.observer.width)) <= kWipeGrabPx;
+  drag_ = on_line ? Drag::Wipe : Drag::Look;
+  last_x_ = x;
+  last_y_ = y;
+}
+
+void Viewer::pointerMove(double x, double y) {
+  if (drag_ == Drag::Look)
+    turnHead(pose_, -radians(kLookDegPerPixel * (x - last_x_)), -radians(kLookDegPerPixel * (y - last_y_)));
+  else if (drag_ == Drag::Wipe)
+    wipe_x_ = std::clamp(x / double(std::max(1, ls_.scene.observer.width)), 0.0, 1.0);
+  last_x_ = x;
+  last_y_ = y;
+}
+
+void Viewer::referencePanel() {
+  if (!ImGui::CollapsingHeader("reference (Embree, exact)", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  if (!reference_) {
+    if (ImGui::Button("trace this view (T)")) reference_requested_ = true;
+    if (!reference_note_.empty()) {
+      ImGui::SameLine();
+      ImGui::TextWrapped("last: %s", reference_note_.c_str());
+    }
+    return;
+  }
+  if (!reference_->finished()) {
+    ImGui::ProgressBar(float(reference_->fraction()), ImVec2(260, 0));
+    ImGui::SameLine();
+    if (ImGui::Button("cancel (T)")) reference_requested_ = true;
+    ImGui::Text("tracing in %d background threads; drag the line to compare", reference_->threads());
+  } else {
+    ImGui::Text("traced in %.0f ms (%d threads); left: %s, right: reference", reference_->traceMs(),
+                reference_->threads(), nameOf(mode_));
+  }
+  float wipe = float(wipe_x_);
+  if (ImGui::SliderFloat("wipe", &wipe, 0.0f, 1.0f, "%.2f")) wipe_x_ = double(wipe);
+  ImGui::Checkbox("error overlay (E)", &overlay_);
+  if (!reference_->finished()) return;
+  if (!reference_->hasErrors()) {
+    ImGui::TextWrapped("no error figures: the mode's frame has no seen points");
+    return;
+  }
+  const ErrorStats& st = reference_->stats();
+  ImGui::Text("angular error (as pvrr compare): median %.3f', p95 %.3f', max %.2f' over %zu px", st.median_arcmin,
+              st.p95_arcmin, st.max_arcmin, st.pixels);
+  // The heat map's colour bar: errorHeatColour is linear in each third, so three gradients draw it exactly.
+  ImDrawList* dl = ImGui::GetWindowDrawList();
+  const ImVec2 p = ImGui::GetCursorScreenPos();
+  const float w = 300, h = 12;
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 a = errorHeatColour(k / 3.0), b = errorHeatColour((k + 1) / 3.0);
+    const ImU32 ca = ImGui::GetColorU32(ImVec4(float(a.r), float(a.g), float(a.b), 1)),
+                cb = ImGui::GetColorU32(ImVec4(float(b.r), float(b.g), float(b.b), 1));
+    dl->AddRectFilledMultiColor(ImVec2(p.x + w * float(k) / 3, p.y), ImVec2(p.x + w * float(k + 1) / 3, p.y + h), ca,
+                                cb, cb, ca);
+  }
+  ImGui::Dummy(ImVec2(w, h));
+  ImGui::Text("0'");
+  ImGui::SameLine(w - 40);
+  ImGui::Text("%.3g'", reference_->scaleArcmin());
 }
 
 void Viewer::panel(const gl::RasterFrame& f, double frame_ms) {
@@ -257,6 +463,7 @@ void Viewer::panel(const gl::RasterFrame& f, double frame_ms) {
     }
     ImGui::EndTable();
   }
+  referencePanel();
   if (ImGui::CollapsingHeader("keys")) {
     ImGui::TextUnformatted(
         "drag (left button)  turn the head\n"
@@ -264,6 +471,9 @@ void Viewer::panel(const gl::RasterFrame& f, double frame_ms) {
         "W/S A/D R/F         eye forward/back, left/right, up/down 1 cm (Shift: 10)\n"
         "Home or H           back to the design eye point\n"
         "1 2 3 4             mode pvrr, envmap, impostor, raster\n"
+        "T                   trace the reference of this view (again: cancel)\n"
+        "E                   error overlay on or off\n"
+        "drag the split line wipe between the mode and the reference\n"
         "Tab                 hide or show this panel\n"
         "F12 / V             screenshot / save view (out/view-N.png, .json)\n"
         "Esc                 quit");
@@ -293,6 +503,12 @@ void Viewer::onKey(int key, int action, int mods) {
     case GLFW_KEY_3: setMode(RenderMode::Impostor); break;
     case GLFW_KEY_4: setMode(RenderMode::Raster); break;
     case GLFW_KEY_TAB: show_panel_ = !show_panel_; break;
+    case GLFW_KEY_T:
+      reference_requested_ = true;
+      break;
+    case GLFW_KEY_E:
+      overlay_ = !overlay_;
+      break;
     case GLFW_KEY_F12: pending_screenshots_.push_back("out/view-" + std::to_string(++saved_) + ".png"); break;
     case GLFW_KEY_V: saveViewTo("out/view-" + std::to_string(++saved_) + ".json"); break;
     case GLFW_KEY_ESCAPE: quit_ = true; break;
@@ -312,6 +528,34 @@ void Viewer::run() {
     frame();
   }
   if (!pending_screenshots_.empty() || !panel_screenshots_.empty()) frame();  // asked for on the last frame
+  if (reference_ && !reference_->finished()) discardReference("cancelled: the window closed");
+}
+
+json Viewer::referenceStats() const {
+  std::string state = "none";
+  if (reference_)
+    state = reference_->finished() ? "done" : "tracing";
+  else if (references_started_ > 0)
+    state = reference_note_.rfind("cancelled", 0) == 0 ? "cancelled" : "discarded";
+  json j = {{"state", state},
+            {"note", reference_note_},
+            {"started", references_started_},
+            // Starting costs one frame of the mode drawn with seen points (the first time, its programs built too).
+            {"start_ms", reference_start_ms_},
+            {"frames_while_tracing", frames_while_tracing_},
+            {"frame_ms_max_while_tracing", frame_ms_max_while_tracing_}};
+  j["wipe_x"] = wipe_x_;
+  j["overlay"] = overlay_;
+  if (!reference_ || !reference_->finished()) return j;
+  j["threads"] = reference_->threads();
+  j["trace_ms"] = reference_->traceMs();
+  if (reference_->hasErrors()) {
+    const ErrorStats& st = reference_->stats();
+    j["pixels"] = st.pixels;
+    j["angular_error_arcmin"] = {{"median", st.median_arcmin}, {"p95", st.p95_arcmin}, {"max", st.max_arcmin}};
+    j["heat_map_scale_arcmin"] = reference_->scaleArcmin();
+  }
+  return j;
 }
 
 json Viewer::stats() const {
@@ -330,6 +574,7 @@ json Viewer::stats() const {
             {"panel", t.empty() ? 0.0 : median(panel_ms_)},
             {"swap", t.empty() ? 0.0 : median(swap_ms_)}}},
           {"size", {design_.width, design_.height}},
+          {"reference", referenceStats()},
           {"gl", glName()}};
 }
 
