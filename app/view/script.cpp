@@ -33,11 +33,10 @@ const std::map<std::string, std::pair<EventKind, std::vector<std::string>>>& kin
       {"wipe", {EventKind::Wipe, {"x"}}},
       {"overlay", {EventKind::Overlay, {"on"}}},
       {"drag", {EventKind::Drag, {"button", "from", "to"}}},
+      {"turn_element", {EventKind::TurnElement, {"element", "yaw_deg", "pitch_deg"}}},
   };
   return table;
 }
-// Issue 25's other events, not in this version yet: named so that a script using them is told so.
-const std::set<std::string> kLater = {"turn_element"};
 
 // The keys the viewer answers to, by their GLFW names (GLFW_KEY_<name>).
 const std::map<std::string, int>& keyCodes() {
@@ -47,7 +46,8 @@ const std::map<std::string, int>& keyCodes() {
       {"1", GLFW_KEY_1},       {"2", GLFW_KEY_2},         {"3", GLFW_KEY_3},     {"4", GLFW_KEY_4},
       {"LEFT", GLFW_KEY_LEFT}, {"RIGHT", GLFW_KEY_RIGHT}, {"UP", GLFW_KEY_UP},   {"DOWN", GLFW_KEY_DOWN},
       {"HOME", GLFW_KEY_HOME}, {"TAB", GLFW_KEY_TAB},     {"F12", GLFW_KEY_F12}, {"ESCAPE", GLFW_KEY_ESCAPE},
-      {"T", GLFW_KEY_T},       {"E", GLFW_KEY_E},
+      {"T", GLFW_KEY_T},       {"E", GLFW_KEY_E},         {"J", GLFW_KEY_J},     {"L", GLFW_KEY_L},
+      {"I", GLFW_KEY_I},       {"K", GLFW_KEY_K},
   };
   return table;
 }
@@ -106,7 +106,6 @@ ScriptEvent readEvent(const Reader& r, const json& e, const std::string& path) {
   for (const auto& [k, v] : kinds()) names += (names.empty() ? "" : ", ") + k;
   if (!d.is_string()) r.expected(path + ".do", "one of " + names, d);
   const std::string what = d.get<std::string>();
-  if (kLater.count(what)) r.fail(path + ".do", "\"" + what + "\" is not implemented yet (implemented: " + names + ")");
   const auto it = kinds().find(what);
   if (it == kinds().end()) {
     std::vector<std::string> all;
@@ -124,6 +123,9 @@ ScriptEvent readEvent(const Reader& r, const json& e, const std::string& path) {
       ev.path = r.text(r.need(e, path, "path"), path + ".path", "a scene path as --set takes it (\"render.mode\")");
       ev.value_json = r.need(e, path, "value").dump();
       break;
+    case EventKind::TurnElement:
+      ev.element = r.text(r.need(e, path, "element"), path + ".element", "an element's name");
+      [[fallthrough]];
     case EventKind::TurnHead:
       if (!e.contains("yaw_deg") && !e.contains("pitch_deg")) r.fail(path, "missing \"yaw_deg\" or \"pitch_deg\"");
       if (e.contains("yaw_deg")) ev.yaw_deg = r.number(e.at("yaw_deg"), path + ".yaw_deg");

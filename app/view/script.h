@@ -10,7 +10,20 @@
 
 namespace pvrr::app::view {
 
-enum class EventKind { Set, TurnHead, MoveEye, Screenshot, SaveView, Quit, Key, Reference, Wipe, Overlay, Drag };
+enum class EventKind {
+  Set,
+  TurnHead,
+  MoveEye,
+  Screenshot,
+  SaveView,
+  Quit,
+  Key,
+  Reference,
+  Wipe,
+  Overlay,
+  Drag,
+  TurnElement
+};
 
 struct ScriptEvent {
   int at_frame = 0;
@@ -18,7 +31,9 @@ struct ScriptEvent {
   std::string where;  // "events[3]", for messages about the event at run time
   // set: a scene path as --set takes it and its value as JSON text ("render.mode", "\"envmap\"").
   std::string path, value_json;
-  double yaw_deg = 0, pitch_deg = 0;  // turn_head: positive yaw turns left, positive pitch looks up
+  double yaw_deg = 0, pitch_deg = 0;  // turn_head: positive yaw turns left, positive pitch looks up;
+                                      // turn_element: app/view/element_pose.h
+  std::string element;                // turn_element: the element's name
   Vec3 by_m{0};                       // move_eye: metres in the observer frame (x right, y up, -z forward)
   std::string file;                   // screenshot, save_view
   bool with_panel = false;            // screenshot: with the panel over the frame ("panel": true)

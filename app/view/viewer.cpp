@@ -15,6 +15,7 @@
 #include "app/args.h"
 #include "app/commands.h"
 #include "app/report.h"
+#include "app/view/element_pose.h"
 #include "app/view/head.h"
 #include "app/view/reference_tiles.h"
 #include "app/view/save_view.h"
@@ -79,7 +80,12 @@ class Viewer {
   json referenceStats() const;
 
  private:
-  void rebuild();
+  // Loads and builds the scene with overrides_. `keep_mode`: the mode shown stays (a setting or a turned element),
+  // else it is the command line's or the scene's.
+  void rebuild(bool keep_mode = false);
+  // Element `index` turned about its vertex (app/view/element_pose.h): its pose written as overrides, rebuilt.
+  void turnElement(int index, double yaw_rad, double pitch_rad);
+  void elementsPanel(const gl::RasterFrame& f);
   void runEvents();
   void frame();
   void panel(const gl::RasterFrame& f, double frame_ms);
@@ -143,6 +149,10 @@ class Viewer {
   double last_x_ = 0, last_y_ = 0;
 
   int scene_builds_ = 0;
+  int selected_ = 0;  // the element the panel and the keys I/K/J/L turn
+  // Changes asked for by the panel or the keys, applied at the next frame (not inside the panel's frame).
+  std::vector<std::string> pending_overrides_;
+  double pending_yaw_rad_ = 0, pending_pitch_rad_ = 0;
   std::unique_ptr<gl::Renderer> seen_renderer_;  // the mode's frame with seen points, for the reference's errors
   std::unique_ptr<ReferenceRun> reference_;
   std::unique_ptr<Wipe> wipe_;
@@ -157,7 +167,7 @@ class Viewer {
   double frame_ms_max_while_tracing_ = 0, reference_start_ms_ = 0;
 };
 
-void Viewer::rebuild() {
+void Viewer::rebuild(bool keep_mode) {
   if (reference_) discardReference("discarded: the scene was rebuilt (a setting changed)");
   window_.context().makeCurrent();
   seen_renderer_.reset();
@@ -166,7 +176,8 @@ void Viewer::rebuild() {
   rays_.reset();
   ls_ = loadScene(scene_path_, overrides_, width_, height_);
   design_ = ls_.scene.observer;
-  mode_ = cli_mode_ ? *cli_mode_ : ls_.scene.render.mode;
+  if (!keep_mode || scene_builds_ == 1) mode_ = cli_mode_ ? *cli_mode_ : ls_.scene.render.mode;
+  selected_ = std::clamp(selected_, 0, std::max(0, int(ls_.scene.elements.size()) - 1));
   if (!isRasterMode(mode_))
     throw Error("pvrr view: mode " + std::string(nameOf(mode_)) + " is not a live mode; expected one of " +
                 nameListIf<RenderMode>(isRasterMode));
@@ -199,6 +210,14 @@ void Viewer::runEvents() {
           if (e.path.rfind("render.mode", 0) == 0) cli_mode_.reset();
           rebuild();
           break;
+        case EventKind::TurnElement: {
+          int index = -1;
+          for (size_t i = 0; i < ls_.scene.elements.size(); ++i)
+            if (ls_.scene.elements[i].name == e.element) index = int(i);
+          if (index < 0) throw Error("no element named \"" + e.element + "\"");  // checked before the window opened
+          turnElement(index, radians(e.yaw_deg), radians(e.pitch_deg));
+          break;
+        }
         case EventKind::TurnHead: turnHead(pose_, radians(e.yaw_deg), radians(e.pitch_deg)); break;
         case EventKind::MoveEye: moveEye(pose_, design_, e.by_m); break;
         case EventKind::Screenshot: (e.with_panel ? panel_screenshots_ : pending_screenshots_).push_back(e.file); break;
@@ -238,6 +257,15 @@ void Viewer::frame() {
     cache_ = gl::FrameCache{};
   }
   const auto t0 = Clock::now();
+  if (pending_yaw_rad_ != 0 || pending_pitch_rad_ != 0) {
+    turnElement(selected_, pending_yaw_rad_, pending_pitch_rad_);
+    pending_yaw_rad_ = pending_pitch_rad_ = 0;
+  }
+  if (!pending_overrides_.empty()) {
+    overrides_.insert(overrides_.end(), pending_overrides_.begin(), pending_overrides_.end());
+    pending_overrides_.clear();
+    rebuild(true);
+  }
   if (reference_requested_) {
     reference_requested_ = false;
     if (reference_ && !reference_->finished())
@@ -301,6 +329,71 @@ void Viewer::frame() {
   recent_ms_.push_back(ms);
   if (recent_ms_.size() > 60) recent_ms_.pop_front();
   ++frames_;
+}
+
+void Viewer::turnElement(int index, double yaw_rad, double pitch_rad) {
+  if (index < 0 || size_t(index) >= ls_.desc.elements.size()) return;
+  const PoseDesc& p = ls_.desc.elements[size_t(index)].pose;
+  for (const std::string& o : poseOverrides(index, turnElementPose(p.normal, p.up, yaw_rad, pitch_rad)))
+    overrides_.push_back(o);
+  rebuild(true);
+}
+
+void Viewer::elementsPanel(const gl::RasterFrame& f) {
+  if (ls_.scene.elements.empty() || !ImGui::CollapsingHeader("elements and settings")) return;
+  const Element& sel = ls_.scene.elements[size_t(selected_)];
+  if (ImGui::BeginCombo("element", sel.name.c_str())) {
+    for (size_t i = 0; i < ls_.scene.elements.size(); ++i)
+      if (ImGui::Selectable(ls_.scene.elements[i].name.c_str(), int(i) == selected_)) selected_ = int(i);
+    ImGui::EndCombo();
+  }
+  const PoseDesc& pose = ls_.desc.elements[size_t(selected_)].pose;
+  ImGui::Text("normal [%.4f, %.4f, %.4f]%s", pose.normal.x, pose.normal.y, pose.normal.z,
+              sel.attached_to_observer ? " (observer frame)" : "");
+  ImGui::Text("turn about its vertex:");
+  for (const auto& [label, yaw, pitch] :
+       {std::tuple{"yaw -1 (J)", -1.0, 0.0}, std::tuple{"yaw +1 (L)", 1.0, 0.0}, std::tuple{"pitch -1 (K)", 0.0, -1.0},
+        std::tuple{"pitch +1 (I)", 0.0, 1.0}}) {
+    ImGui::SameLine();
+    if (ImGui::Button(label)) pending_yaw_rad_ += radians(yaw), pending_pitch_rad_ += radians(pitch);
+  }
+  const std::string el = "elements[" + std::to_string(selected_) + "].";
+  const TessellationDesc& t = ls_.desc.elements[size_t(selected_)].tessellation;
+  int n = t.n_u;
+  if (t.mode == TessellationDesc::Mode::Grid &&
+      ImGui::InputInt("tessellation (N x N)", &n, 2, 8, ImGuiInputTextFlags_EnterReturnsTrue))
+    pending_overrides_.push_back(el + "tessellation=" + std::to_string(std::clamp(n, 2, 1024)));
+  int map_size = ls_.scene.render.map_size;
+  if (ImGui::InputInt("map size (texels)", &map_size, 256, 1024, ImGuiInputTextFlags_EnterReturnsTrue))
+    pending_overrides_.push_back("render.map_size=" + std::to_string(std::clamp(map_size, 64, 8192)));
+  int depth = ls_.scene.render.max_depth;
+  if (ImGui::SliderInt("max depth", &depth, 1, 16))
+    pending_overrides_.push_back("render.max_depth=" + std::to_string(depth));
+  ImGui::Text("dispersion:");
+  for (DispersionMode d : {DispersionMode::Off, DispersionMode::Rgb, DispersionMode::Spectral}) {
+    ImGui::SameLine();
+    if (ImGui::RadioButton(nameOf(d), ls_.scene.render.dispersion == d) && ls_.scene.render.dispersion != d)
+      pending_overrides_.push_back(std::string("render.dispersion=\"") + nameOf(d) + "\"");
+  }
+  // What the pvrr mode's planning made of each element this frame (nothing where another mode drew it).
+  const gl::RendererOptions opt = gl::rendererOptionsFor(ls_.scene);
+  for (const ElementFrame& ef : f.elements) {
+    if (ef.views.empty()) continue;
+    double worst = 0;
+    int fallbacks = 0, smallest = 1 << 30, largest = 0;
+    for (const PatchView& pv : ef.views) {
+      worst = std::max(worst, pv.fit.condition_number);
+      fallbacks += pv.fit.fallback.empty() ? 0 : 1;
+      const int side = gl::topLevelMapSide(ls_.scene, ef, pv, opt);
+      smallest = std::min(smallest, side);
+      largest = std::max(largest, side);
+    }
+    ImGui::TextWrapped(
+        "%s: %zu patches, %zu vertices; maps %d..%d texels (longer side); viewpoint fit condition "
+        "at most %.3g, %d fallbacks",
+        ls_.scene.elements[size_t(ef.element)].name.c_str(), ef.views.size(), ef.world_pos.size(), smallest, largest,
+        worst, fallbacks);
+  }
 }
 
 const Observer& Viewer::updateObserver() {
@@ -464,6 +557,7 @@ void Viewer::panel(const gl::RasterFrame& f, double frame_ms) {
     ImGui::EndTable();
   }
   referencePanel();
+  elementsPanel(f);
   if (ImGui::CollapsingHeader("keys")) {
     ImGui::TextUnformatted(
         "drag (left button)  turn the head\n"
@@ -471,6 +565,7 @@ void Viewer::panel(const gl::RasterFrame& f, double frame_ms) {
         "W/S A/D R/F         eye forward/back, left/right, up/down 1 cm (Shift: 10)\n"
         "Home or H           back to the design eye point\n"
         "1 2 3 4             mode pvrr, envmap, impostor, raster\n"
+        "J/L I/K             turn the selected element 1 deg in yaw / pitch (Shift: 10)\n"
         "T                   trace the reference of this view (again: cancel)\n"
         "E                   error overlay on or off\n"
         "drag the split line wipe between the mode and the reference\n"
@@ -505,6 +600,18 @@ void Viewer::onKey(int key, int action, int mods) {
     case GLFW_KEY_TAB: show_panel_ = !show_panel_; break;
     case GLFW_KEY_T:
       reference_requested_ = true;
+      break;
+    case GLFW_KEY_J:
+      pending_yaw_rad_ -= turn;
+      break;
+    case GLFW_KEY_L:
+      pending_yaw_rad_ += turn;
+      break;
+    case GLFW_KEY_K:
+      pending_pitch_rad_ -= turn;
+      break;
+    case GLFW_KEY_I:
+      pending_pitch_rad_ += turn;
       break;
     case GLFW_KEY_E:
       overlay_ = !overlay_;
@@ -605,6 +712,15 @@ int cmdView(const std::vector<std::string>& argv) {
     }
   }
   const SceneDesc desc = pvrr::loadScene(scene_path, overrides);
+  for (const view::ScriptEvent& e : script.events) {
+    if (e.kind != view::EventKind::TurnElement) continue;
+    std::vector<std::string> names;
+    for (const ElementDesc& el : desc.elements) names.push_back(el.name);
+    if (std::find(names.begin(), names.end(), e.element) != names.end()) continue;
+    const std::string hint = nearest(e.element, names);
+    throw Error(script_path + ": " + e.where + ".element: " + scene_path + " has no element named \"" + e.element +
+                "\"" + (hint.empty() ? std::string() : "; did you mean \"" + hint + "\"?"));
+  }
   const auto size = a.getSize("size");
   const int width = size ? size->first : script.width ? script.width : desc.observer.image_width;
   const int height = size ? size->second : script.height ? script.height : desc.observer.image_height;

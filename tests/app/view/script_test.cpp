@@ -72,7 +72,7 @@ TEST(ViewScript, ErrorsNameTheFileAndTheJsonPath) {
   EXPECT_EQ(
       errorOf(R"({"events": [{"at_frame": 1, "do": "teleport"}]})"),
       "s.json: events[0].do: expected one of drag, key, move_eye, overlay, quit, reference, save_view, screenshot, "
-      "set, turn_head, wipe, got \"teleport\"");
+      "set, turn_element, turn_head, wipe, got \"teleport\"");
   EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "quit"}, {"at_frame": -1, "do": "quit"}]})"),
             "s.json: events[1].at_frame: expected a frame number >= 0, got -1");
   EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "turn_head", "yaw_dg": 3}]})"),
@@ -116,6 +116,16 @@ TEST(ViewScript, CommandRefusesABadScriptWithOneLine) {
   EXPECT_EQ(s.code, 1);
   EXPECT_EQ(s.err.find(script + ": events[0]: models/car-mirror.json: render.map_size"), 0u) << s.err;
   EXPECT_EQ(std::count(s.err.begin(), s.err.end(), '\n'), 1) << s.err;
+  // turn_element names an element of the scene.
+  {
+    std::ofstream(script)
+        << R"({"events": [{"at_frame": 0, "do": "turn_element", "element": "door-miror", "yaw_deg": 1}]})";
+  }
+  const test::CliResult t = test::runPvrr("view --script '" + script + "'");
+  EXPECT_EQ(t.code, 1);
+  EXPECT_EQ(t.err, script +
+                       ": events[0].element: models/car-mirror.json has no element named \"door-miror\"; did you "
+                       "mean \"door-mirror\"?\n");
   std::filesystem::remove_all(dir);
 }
 
