@@ -34,6 +34,7 @@ const std::map<std::string, std::pair<EventKind, std::vector<std::string>>>& kin
       {"overlay", {EventKind::Overlay, {"on"}}},
       {"drag", {EventKind::Drag, {"button", "from", "to"}}},
       {"turn_element", {EventKind::TurnElement, {"element", "yaw_deg", "pitch_deg"}}},
+      {"cursor", {EventKind::Cursor, {"at"}}},
   };
   return table;
 }
@@ -190,6 +191,12 @@ ScriptEvent readEvent(const Reader& r, const json& e, const std::string& path) {
       };
       point("from", &ev.from_px);
       point("to", &ev.to_px);
+      break;
+    }
+    case EventKind::Cursor: {
+      const json& v = r.need(e, path, "at");
+      if (!v.is_array() || v.size() != 2) r.expected(path + ".at", "[x, y] in window pixels", v);
+      for (int k = 0; k < 2; ++k) ev.at_px[k] = r.number(v[size_t(k)], path + ".at[" + std::to_string(k) + "]");
       break;
     }
   }

@@ -10,20 +10,10 @@
 
 namespace pvrr::app::view {
 
-enum class EventKind {
-  Set,
-  TurnHead,
-  MoveEye,
-  Screenshot,
-  SaveView,
-  Quit,
-  Key,
-  Reference,
-  Wipe,
-  Overlay,
-  Drag,
-  TurnElement
-};
+// clang-format off
+enum class EventKind { Set, TurnHead, MoveEye, Screenshot, SaveView, Quit, Key, Reference, Wipe, Overlay, Drag,
+                       TurnElement, Cursor };
+// clang-format on
 
 struct ScriptEvent {
   int at_frame = 0;
@@ -34,6 +24,7 @@ struct ScriptEvent {
   double yaw_deg = 0, pitch_deg = 0;  // turn_head: positive yaw turns left, positive pitch looks up;
                                       // turn_element: app/view/element_pose.h
   std::string element;                // turn_element: the element's name
+  Vec2 at_px{0};                      // cursor: where the lens probe reads, window pixels (as the mouse hovering)
   Vec3 by_m{0};                       // move_eye: metres in the observer frame (x right, y up, -z forward)
   std::string file;                   // screenshot, save_view
   bool with_panel = false;            // screenshot: with the panel over the frame ("panel": true)

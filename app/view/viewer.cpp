@@ -17,6 +17,7 @@
 #include "app/report.h"
 #include "app/view/element_pose.h"
 #include "app/view/head.h"
+#include "app/view/lens_probe.h"
 #include "app/view/reference_tiles.h"
 #include "app/view/save_view.h"
 #include "app/view/script.h"
@@ -86,6 +87,8 @@ class Viewer {
   // Element `index` turned about its vertex (app/view/element_pose.h): its pose written as overrides, rebuilt.
   void turnElement(int index, double yaw_rad, double pitch_rad);
   void elementsPanel(const gl::RasterFrame& f);
+  void lensPanel();
+  json probeStats() const;
   void runEvents();
   void frame();
   void panel(const gl::RasterFrame& f, double frame_ms);
@@ -149,6 +152,15 @@ class Viewer {
   double last_x_ = 0, last_y_ = 0;
 
   int scene_builds_ = 0;
+  // The lens probe (scenes with a lens): the pixel under the cursor (the mouse when it moves, or a script's
+  // "cursor"), read again when that pixel or the view changes.
+  bool has_lens_ = false;
+  bool probe_asked_ = false, cursor_seen_ = false;
+  int probe_x_ = 0, probe_y_ = 0;
+  double cursor_x_ = 0, cursor_y_ = 0;
+  LensProbe probe_;
+  bool probe_fresh_ = false;
+  ViewKey probe_key_;
   int selected_ = 0;  // the element the panel and the keys I/K/J/L turn
   // Changes asked for by the panel or the keys, applied at the next frame (not inside the panel's frame).
   std::vector<std::string> pending_overrides_;
@@ -181,6 +193,9 @@ void Viewer::rebuild(bool keep_mode) {
   if (!isRasterMode(mode_))
     throw Error("pvrr view: mode " + std::string(nameOf(mode_)) + " is not a live mode; expected one of " +
                 nameListIf<RenderMode>(isRasterMode));
+  has_lens_ = std::any_of(ls_.scene.elements.begin(), ls_.scene.elements.end(),
+                          [](const Element& e) { return e.type == ElementType::Lens; });
+  probe_fresh_ = false;
   any_attached_ = std::any_of(ls_.scene.elements.begin(), ls_.scene.elements.end(),
                               [](const Element& e) { return e.attached_to_observer; });
   RaySceneOptions ro;
@@ -227,6 +242,11 @@ void Viewer::runEvents() {
         case EventKind::Reference:
           startReference();
           waiting_reference_ = true;
+          break;
+        case EventKind::Cursor:
+          probe_asked_ = true;
+          probe_x_ = int(std::floor(e.at_px.x));
+          probe_y_ = int(std::floor(e.at_px.y));
           break;
         case EventKind::Wipe:
           wipe_x_ = e.wipe_x;
@@ -276,6 +296,12 @@ void Viewer::frame() {
   const Observer ob = updateObserver();
   if (reference_ && !(viewKey() == reference_key_)) discardReference("discarded: the view changed");
   const bool tracing = reference_ && !reference_->finished();
+  if (has_lens_ && probe_asked_ &&
+      (!probe_fresh_ || !(viewKey() == probe_key_) || int(probe_.px) != probe_x_ || int(probe_.py) != probe_y_)) {
+    probe_ = probeLens(ls_.scene, *rays_, probe_x_, probe_y_);
+    probe_key_ = viewKey();
+    probe_fresh_ = true;
+  }
   window_.context().makeCurrent();
   // A screenshot frame is drawn whole, every stage run (its own empty cache), so that it is what pvrr render
   // draws of the saved view: frames that reuse earlier maps (map reuse, render.map_reuse_margin_deg) differ
@@ -312,6 +338,15 @@ void Viewer::frame() {
   if (down) pointerMove(x, y);
   if (!down && mouse_down_) pointerRelease();
   mouse_down_ = down;
+  // The lens probe follows the mouse when it moves over the picture (not at startup, where it was put).
+  if (cursor_seen_ && (x != cursor_x_ || y != cursor_y_) && !ImGui::GetIO().WantCaptureMouse) {
+    probe_asked_ = true;
+    probe_x_ = int(std::floor(x));
+    probe_y_ = int(std::floor(y));
+  }
+  cursor_seen_ = true;
+  cursor_x_ = x;
+  cursor_y_ = y;
 
   const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   frame_ms_.push_back(ms);
@@ -337,6 +372,45 @@ void Viewer::turnElement(int index, double yaw_rad, double pitch_rad) {
   for (const std::string& o : poseOverrides(index, turnElementPose(p.normal, p.up, yaw_rad, pitch_rad)))
     overrides_.push_back(o);
   rebuild(true);
+}
+
+void Viewer::lensPanel() {
+  if (!has_lens_ || !ImGui::CollapsingHeader("lens under the cursor (as pvrr lensmap)", ImGuiTreeNodeFlags_DefaultOpen))
+    return;
+  if (!probe_asked_ || !probe_fresh_) {
+    ImGui::TextUnformatted("move the mouse over the lens");
+    return;
+  }
+  if (!probe_.valid) {
+    ImGui::Text("pixel (%d, %d): %s", probe_x_, probe_y_, probe_.reason.c_str());
+    return;
+  }
+  const LensmapPoint& r = probe_.reading;
+  ImGui::Text("%s at lens (%.2f, %.2f) mm, gaze (%.2f, %.2f) deg",
+              ls_.scene.elements[size_t(probe_.element)].name.c_str(), r.lens_x_mm, r.lens_y_mm, r.gaze_x_deg,
+              r.gaze_y_deg);
+  ImGui::Text("sphere %+.2f D  cyl %+.2f D  axis %.0f deg (TABO)  mean %+.2f D", r.sphere_d, r.cylinder_d, r.axis_deg,
+              r.mean_power_d);
+  ImGui::Text("power error %+.2f D, unwanted cyl %.2f D; prism %.2f (h, base right +) %.2f (v, base up +) pd",
+              r.power_error_d, r.unwanted_cylinder_d, r.prism_h, r.prism_v);
+}
+
+json Viewer::probeStats() const {
+  if (!probe_asked_ || !probe_fresh_) return nullptr;
+  json j = {{"pixel", {probe_.px, probe_.py}}, {"valid", probe_.valid}, {"reason", probe_.reason}};
+  if (probe_.element >= 0) j["element"] = ls_.scene.elements[size_t(probe_.element)].name;
+  if (!probe_.valid) return j;
+  const LensmapPoint& r = probe_.reading;
+  j["lens_point_local_m"] = {probe_.lens_point_local.x, probe_.lens_point_local.y, probe_.lens_point_local.z};
+  for (const auto& [name, v] :
+       {std::pair{"gaze_x_deg", r.gaze_x_deg}, std::pair{"gaze_y_deg", r.gaze_y_deg},
+        std::pair{"lens_x_mm", r.lens_x_mm}, std::pair{"lens_y_mm", r.lens_y_mm}, std::pair{"sphere_d", r.sphere_d},
+        std::pair{"cylinder_d", r.cylinder_d}, std::pair{"axis_deg", r.axis_deg},
+        std::pair{"mean_power_d", r.mean_power_d}, std::pair{"power_error_d", r.power_error_d},
+        std::pair{"unwanted_cylinder_d", r.unwanted_cylinder_d}, std::pair{"prism_h", r.prism_h},
+        std::pair{"prism_v", r.prism_v}})
+    j[name] = v;
+  return j;
 }
 
 void Viewer::elementsPanel(const gl::RasterFrame& f) {
@@ -557,6 +631,7 @@ void Viewer::panel(const gl::RasterFrame& f, double frame_ms) {
     ImGui::EndTable();
   }
   referencePanel();
+  lensPanel();
   elementsPanel(f);
   if (ImGui::CollapsingHeader("keys")) {
     ImGui::TextUnformatted(
@@ -682,6 +757,7 @@ json Viewer::stats() const {
             {"swap", t.empty() ? 0.0 : median(swap_ms_)}}},
           {"size", {design_.width, design_.height}},
           {"reference", referenceStats()},
+          {"lens_probe", probeStats()},
           {"gl", glName()}};
 }
 

@@ -55,9 +55,17 @@ TEST(ViewScript, ReadsTheReferenceEvents) {
       {"at_frame": 1, "do": "reference"},
       {"at_frame": 2, "do": "wipe", "x": 0.25},
       {"at_frame": 3, "do": "overlay", "on": true},
-      {"at_frame": 4, "do": "drag", "button": "left", "from": [10, 20], "to": [30.5, 40]}]})",
+      {"at_frame": 4, "do": "drag", "button": "left", "from": [10, 20], "to": [30.5, 40]},
+      {"at_frame": 5, "do": "cursor", "at": [7, 8.5]},
+      {"at_frame": 6, "do": "turn_element", "element": "m", "yaw_deg": 2}]})",
                                "s.json");
-  ASSERT_EQ(s.events.size(), 4u);
+  ASSERT_EQ(s.events.size(), 6u);
+  EXPECT_EQ(s.events[4].kind, EventKind::Cursor);
+  EXPECT_EQ(s.events[4].at_px, Vec2(7, 8.5));
+  EXPECT_EQ(s.events[5].kind, EventKind::TurnElement);
+  EXPECT_EQ(s.events[5].element, "m");
+  EXPECT_EQ(s.events[5].yaw_deg, 2);
+  EXPECT_EQ(s.events[5].pitch_deg, 0);
   EXPECT_EQ(s.events[0].kind, EventKind::Reference);
   EXPECT_EQ(s.events[1].kind, EventKind::Wipe);
   EXPECT_EQ(s.events[1].wipe_x, 0.25);
@@ -69,10 +77,10 @@ TEST(ViewScript, ReadsTheReferenceEvents) {
 }
 
 TEST(ViewScript, ErrorsNameTheFileAndTheJsonPath) {
-  EXPECT_EQ(
-      errorOf(R"({"events": [{"at_frame": 1, "do": "teleport"}]})"),
-      "s.json: events[0].do: expected one of drag, key, move_eye, overlay, quit, reference, save_view, screenshot, "
-      "set, turn_element, turn_head, wipe, got \"teleport\"");
+  EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "teleport"}]})"),
+            "s.json: events[0].do: expected one of cursor, drag, key, move_eye, overlay, quit, reference, save_view, "
+            "screenshot, "
+            "set, turn_element, turn_head, wipe, got \"teleport\"");
   EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "quit"}, {"at_frame": -1, "do": "quit"}]})"),
             "s.json: events[1].at_frame: expected a frame number >= 0, got -1");
   EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "turn_head", "yaw_dg": 3}]})"),
