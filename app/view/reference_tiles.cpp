@@ -66,6 +66,23 @@ std::vector<TileRect> ReferenceRun::takeTiles() {
 }
 
 void ReferenceRun::run() {
+  // An exception must not leave a thread: it is kept for the window to show.
+  try {
+    traceAndMeasure();
+  } catch (const std::exception& e) {
+    fail(e.what());
+  }
+}
+
+void ReferenceRun::fail(const std::string& why) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  cancel_ = true;  // the other threads stop after their tile
+  if (failed_) return;
+  failure_ = why;
+  failed_.store(true, std::memory_order_release);
+}
+
+void ReferenceRun::traceAndMeasure() {
   prepareTracingThread();
   const auto t0 = std::chrono::steady_clock::now();
   // The scene's own Embree scene and tracer, with the options pvrr render and compare give the reference.
@@ -75,13 +92,20 @@ void ReferenceRun::run() {
   to.dispersion = scene_->render.dispersion;
   to.spectral_samples = scene_->render.spectral_samples;
   const Tracer tracer(rays, to);
+  const auto work = [this, &tracer] {
+    try {
+      traceTiles(tracer);
+    } catch (const std::exception& e) {
+      fail(e.what());
+    }
+  };
   std::vector<std::thread> helpers;
   for (int i = 1; i < threads_; ++i)
-    helpers.emplace_back([this, &tracer] {
+    helpers.emplace_back([&work] {
       prepareTracingThread();
-      traceTiles(tracer);
+      work();
     });
-  traceTiles(tracer);
+  work();
   for (std::thread& t : helpers) t.join();
   if (cancel_) return;
   trace_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -51,6 +52,9 @@ class ReferenceRun {
   double fraction() const;
   // Traced, and the errors computed: what follows may be read.
   bool finished() const { return finished_.load(std::memory_order_acquire); }
+  // The run stopped on an error (e.g. the scene's Embree build): finished() stays false; the message says why.
+  bool failed() const { return failed_.load(std::memory_order_acquire); }
+  const std::string& failure() const { return failure_; }  // after failed()
   // The tiles finished since the last call; their pixels of rgba() are final once returned here.
   std::vector<TileRect> takeTiles();
   // The reference's 8-bit picture as pvrr compare writes it (srgbPicture), RGBA with alpha 255 where traced.
@@ -69,6 +73,8 @@ class ReferenceRun {
 
  private:
   void run();
+  void traceAndMeasure();
+  void fail(const std::string& why);
   void traceTiles(const Tracer& tracer);
   void computeErrors();
 
@@ -78,7 +84,8 @@ class ReferenceRun {
   Frame ref_;
   std::vector<std::uint8_t> rgba_;
   std::atomic<int> next_tile_{0}, tiles_done_{0};
-  std::atomic<bool> cancel_{false}, finished_{false};
+  std::atomic<bool> cancel_{false}, finished_{false}, failed_{false};
+  std::string failure_;
   std::mutex mutex_;
   std::vector<TileRect> new_tiles_;  // guarded by mutex_
   double trace_ms_ = 0;

@@ -152,6 +152,7 @@ class Viewer {
   double last_x_ = 0, last_y_ = 0;
 
   int scene_builds_ = 0;
+  double rebuild_ms_max_ = 0;  // the slowest rebuild after the first (a setting, a turned element)
   // The lens probe (scenes with a lens): the pixel under the cursor (the mouse when it moves, or a script's
   // "cursor"), read again when that pixel or the view changes.
   bool has_lens_ = false;
@@ -181,6 +182,7 @@ class Viewer {
 
 void Viewer::rebuild(bool keep_mode) {
   if (reference_) discardReference("discarded: the scene was rebuilt (a setting changed)");
+  const auto t0 = Clock::now();
   window_.context().makeCurrent();
   seen_renderer_.reset();
   renderer_.reset();
@@ -206,6 +208,8 @@ void Viewer::rebuild(bool keep_mode) {
   opt.read_back = false;    // presented from the GPU
   renderer_ = std::make_unique<gl::Renderer>(ls_.scene, *rays_, opt);
   cache_ = gl::FrameCache{};
+  if (scene_builds_ > 1)
+    rebuild_ms_max_ = std::max(rebuild_ms_max_, std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
 }
 
 void Viewer::runEvents() {
@@ -289,12 +293,13 @@ void Viewer::frame() {
   if (reference_requested_) {
     reference_requested_ = false;
     if (reference_ && !reference_->finished())
-      discardReference("cancelled (T)");
+      discardReference("cancelled: T pressed");
     else
       startReference();
   }
   const Observer ob = updateObserver();
   if (reference_ && !(viewKey() == reference_key_)) discardReference("discarded: the view changed");
+  if (reference_ && reference_->failed()) discardReference("failed: " + reference_->failure());
   const bool tracing = reference_ && !reference_->finished();
   if (has_lens_ && probe_asked_ &&
       (!probe_fresh_ || !(viewKey() == probe_key_) || int(probe_.px) != probe_x_ || int(probe_.py) != probe_y_)) {
@@ -718,7 +723,7 @@ json Viewer::referenceStats() const {
   if (reference_)
     state = reference_->finished() ? "done" : "tracing";
   else if (references_started_ > 0)
-    state = reference_note_.rfind("cancelled", 0) == 0 ? "cancelled" : "discarded";
+    state = reference_note_.substr(0, reference_note_.find(':'));  // cancelled, discarded, failed
   json j = {{"state", state},
             {"note", reference_note_},
             {"started", references_started_},
@@ -758,6 +763,10 @@ json Viewer::stats() const {
           {"size", {design_.width, design_.height}},
           {"reference", referenceStats()},
           {"lens_probe", probeStats()},
+          // Rebuilds of the scene after the first (a "set", a panel setting, a turned element), and the slowest
+          // one's time (ms; the renderer's first frame after it, with its programs, is in frame_ms_max).
+          {"rebuilds", scene_builds_ - 1},
+          {"rebuild_ms_max", rebuild_ms_max_},
           {"gl", glName()}};
 }
 
