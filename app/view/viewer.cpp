@@ -86,7 +86,8 @@ class Viewer {
   void rebuild(bool keep_mode = false);
   // Element `index` turned about its vertex (app/view/element_pose.h): its pose written as overrides, rebuilt.
   void turnElement(int index, double yaw_rad, double pitch_rad);
-  void elementsPanel(const gl::RasterFrame& f);
+  void elementsPanel();
+  void planningLines(const gl::RasterFrame& f);
   void lensPanel();
   json probeStats() const;
   void runEvents();
@@ -418,7 +419,29 @@ json Viewer::probeStats() const {
   return j;
 }
 
-void Viewer::elementsPanel(const gl::RasterFrame& f) {
+void Viewer::planningLines(const gl::RasterFrame& f) {
+  // What the pvrr mode's planning made of each element this frame (nothing where another mode drew it).
+  const gl::RendererOptions opt = gl::rendererOptionsFor(ls_.scene);
+  for (const ElementFrame& ef : f.elements) {
+    if (ef.views.empty()) continue;
+    double worst = 0;
+    int fallbacks = 0, smallest = 1 << 30, largest = 0;
+    for (const PatchView& pv : ef.views) {
+      worst = std::max(worst, pv.fit.condition_number);
+      fallbacks += pv.fit.fallback.empty() ? 0 : 1;
+      const int side = gl::topLevelMapSide(ls_.scene, ef, pv, opt);
+      smallest = std::min(smallest, side);
+      largest = std::max(largest, side);
+    }
+    ImGui::TextWrapped(
+        "%s: %zu patch%s, %zu vertices; maps %d..%d texels (longer side); viewpoint fit condition "
+        "at most %.3g, %d fallbacks",
+        ls_.scene.elements[size_t(ef.element)].name.c_str(), ef.views.size(), ef.views.size() == 1 ? "" : "es",
+        ef.world_pos.size(), smallest, largest, worst, fallbacks);
+  }
+}
+
+void Viewer::elementsPanel() {
   if (ls_.scene.elements.empty() || !ImGui::CollapsingHeader("elements and settings")) return;
   const Element& sel = ls_.scene.elements[size_t(selected_)];
   if (ImGui::BeginCombo("element", sel.name.c_str())) {
@@ -453,25 +476,6 @@ void Viewer::elementsPanel(const gl::RasterFrame& f) {
     ImGui::SameLine();
     if (ImGui::RadioButton(nameOf(d), ls_.scene.render.dispersion == d) && ls_.scene.render.dispersion != d)
       pending_overrides_.push_back(std::string("render.dispersion=\"") + nameOf(d) + "\"");
-  }
-  // What the pvrr mode's planning made of each element this frame (nothing where another mode drew it).
-  const gl::RendererOptions opt = gl::rendererOptionsFor(ls_.scene);
-  for (const ElementFrame& ef : f.elements) {
-    if (ef.views.empty()) continue;
-    double worst = 0;
-    int fallbacks = 0, smallest = 1 << 30, largest = 0;
-    for (const PatchView& pv : ef.views) {
-      worst = std::max(worst, pv.fit.condition_number);
-      fallbacks += pv.fit.fallback.empty() ? 0 : 1;
-      const int side = gl::topLevelMapSide(ls_.scene, ef, pv, opt);
-      smallest = std::min(smallest, side);
-      largest = std::max(largest, side);
-    }
-    ImGui::TextWrapped(
-        "%s: %zu patches, %zu vertices; maps %d..%d texels (longer side); viewpoint fit condition "
-        "at most %.3g, %d fallbacks",
-        ls_.scene.elements[size_t(ef.element)].name.c_str(), ef.views.size(), ef.world_pos.size(), smallest, largest,
-        worst, fallbacks);
   }
 }
 
@@ -635,9 +639,10 @@ void Viewer::panel(const gl::RasterFrame& f, double frame_ms) {
     }
     ImGui::EndTable();
   }
+  planningLines(f);
   referencePanel();
   lensPanel();
-  elementsPanel(f);
+  elementsPanel();
   if (ImGui::CollapsingHeader("keys")) {
     ImGui::TextUnformatted(
         "drag (left button)  turn the head\n"
