@@ -19,6 +19,18 @@ TurnedPose turnElementPose(const Vec3& normal, const Vec3& up, double yaw_rad, d
   return p;
 }
 
+Vec3 movedElementPosition(const Vec3& position, const Vec3& normal, const Vec3& up, const Vec3& by_m) {
+  const Vec3 z = glm::normalize(normal);
+  const Vec3 y = glm::normalize(up - glm::dot(up, z) * z);
+  const Vec3 x = glm::cross(y, z);
+  return position + by_m.x * x + by_m.y * y + by_m.z * z;
+}
+
+std::string positionOverride(int element, const Vec3& position_m, double unit_m) {
+  const Vec3 p = position_m / unit_m;
+  return "elements[" + std::to_string(element) + "].pose.position=" + nlohmann::json::array({p.x, p.y, p.z}).dump();
+}
+
 std::vector<std::string> poseOverrides(int element, const TurnedPose& pose) {
   const auto text = [](const Vec3& v) { return nlohmann::json::array({v.x, v.y, v.z}).dump(); };
   const std::string at = "elements[" + std::to_string(element) + "].pose.";

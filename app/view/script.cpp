@@ -35,6 +35,7 @@ const std::map<std::string, std::pair<EventKind, std::vector<std::string>>>& kin
       {"drag", {EventKind::Drag, {"button", "from", "to"}}},
       {"turn_element", {EventKind::TurnElement, {"element", "yaw_deg", "pitch_deg"}}},
       {"cursor", {EventKind::Cursor, {"at"}}},
+      {"move_element", {EventKind::MoveElement, {"element", "by"}}},
   };
   return table;
 }
@@ -132,6 +133,9 @@ ScriptEvent readEvent(const Reader& r, const json& e, const std::string& path) {
       if (e.contains("yaw_deg")) ev.yaw_deg = r.number(e.at("yaw_deg"), path + ".yaw_deg");
       if (e.contains("pitch_deg")) ev.pitch_deg = r.number(e.at("pitch_deg"), path + ".pitch_deg");
       break;
+    case EventKind::MoveElement:
+      ev.element = r.text(r.need(e, path, "element"), path + ".element", "an element's name");
+      [[fallthrough]];
     case EventKind::MoveEye: {
       const json& by = r.need(e, path, "by");
       if (!by.is_array() || by.size() != 3) r.expected(path + ".by", "[x, y, z] in metres", by);

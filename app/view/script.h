@@ -12,7 +12,7 @@ namespace pvrr::app::view {
 
 // clang-format off
 enum class EventKind { Set, TurnHead, MoveEye, Screenshot, SaveView, Quit, Key, Reference, Wipe, Overlay, Drag,
-                       TurnElement, Cursor };
+                       TurnElement, Cursor, MoveElement };
 // clang-format on
 
 struct ScriptEvent {
@@ -23,7 +23,8 @@ struct ScriptEvent {
   std::string path, value_json;
   double yaw_deg = 0, pitch_deg = 0;  // turn_head: positive yaw turns left, positive pitch looks up;
                                       // turn_element: app/view/element_pose.h
-  std::string element;                // turn_element: the element's name
+  std::string element;                // turn_element, move_element: the element's name
+                                      // move_element: "by" (by_m) in metres in the element's frame
   Vec2 at_px{0};                      // cursor: where the lens probe reads, window pixels (as the mouse hovering)
   Vec3 by_m{0};                       // move_eye: metres in the observer frame (x right, y up, -z forward)
   std::string file;                   // screenshot, save_view

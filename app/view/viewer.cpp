@@ -41,6 +41,8 @@ constexpr double kEyeStepM = 0.01, kTurnStepDeg = 1.0, kFast = 10.0;
 constexpr double kLookDegPerPixel = 0.1;
 // A left-button press within this many pixels of the wipe's split line drags the line, not the head.
 constexpr double kWipeGrabPx = 8;
+// The panel's step of moving an element (metres).
+constexpr double kMoveStepM = 0.001;
 
 // What a reference belongs to: the view it traced. Any change (the head, the eye, the window's size, the mode,
 // a setting, which rebuilds the scene) makes it another view's reference, and it is discarded.
@@ -86,6 +88,9 @@ class Viewer {
   void rebuild(bool keep_mode = false);
   // Element `index` turned about its vertex (app/view/element_pose.h): its pose written as overrides, rebuilt.
   void turnElement(int index, double yaw_rad, double pitch_rad);
+  // Element `index` moved by `by_m` in its own frame (x right, y up, z along its normal), rebuilt likewise.
+  void moveElement(int index, const Vec3& by_m);
+  int elementIndex(const std::string& name) const;
   void elementsPanel();
   void planningLines(const gl::RasterFrame& f);
   void lensPanel();
@@ -167,6 +172,7 @@ class Viewer {
   // Changes asked for by the panel or the keys, applied at the next frame (not inside the panel's frame).
   std::vector<std::string> pending_overrides_;
   double pending_yaw_rad_ = 0, pending_pitch_rad_ = 0;
+  Vec3 pending_move_m_{0};
   std::unique_ptr<gl::Renderer> seen_renderer_;  // the mode's frame with seen points, for the reference's errors
   std::unique_ptr<ReferenceRun> reference_;
   std::unique_ptr<Wipe> wipe_;
@@ -230,14 +236,12 @@ void Viewer::runEvents() {
           if (e.path.rfind("render.mode", 0) == 0) cli_mode_.reset();
           rebuild();
           break;
-        case EventKind::TurnElement: {
-          int index = -1;
-          for (size_t i = 0; i < ls_.scene.elements.size(); ++i)
-            if (ls_.scene.elements[i].name == e.element) index = int(i);
-          if (index < 0) throw Error("no element named \"" + e.element + "\"");  // checked before the window opened
-          turnElement(index, radians(e.yaw_deg), radians(e.pitch_deg));
+        case EventKind::TurnElement:
+          turnElement(elementIndex(e.element), radians(e.yaw_deg), radians(e.pitch_deg));
           break;
-        }
+        case EventKind::MoveElement:
+          moveElement(elementIndex(e.element), e.by_m);
+          break;
         case EventKind::TurnHead: turnHead(pose_, radians(e.yaw_deg), radians(e.pitch_deg)); break;
         case EventKind::MoveEye: moveEye(pose_, design_, e.by_m); break;
         case EventKind::Screenshot: (e.with_panel ? panel_screenshots_ : pending_screenshots_).push_back(e.file); break;
@@ -285,6 +289,10 @@ void Viewer::frame() {
   if (pending_yaw_rad_ != 0 || pending_pitch_rad_ != 0) {
     turnElement(selected_, pending_yaw_rad_, pending_pitch_rad_);
     pending_yaw_rad_ = pending_pitch_rad_ = 0;
+  }
+  if (pending_move_m_ != Vec3(0)) {
+    moveElement(selected_, pending_move_m_);
+    pending_move_m_ = Vec3(0);
   }
   if (!pending_overrides_.empty()) {
     overrides_.insert(overrides_.end(), pending_overrides_.begin(), pending_overrides_.end());
@@ -370,6 +378,20 @@ void Viewer::frame() {
   recent_ms_.push_back(ms);
   if (recent_ms_.size() > 60) recent_ms_.pop_front();
   ++frames_;
+}
+
+int Viewer::elementIndex(const std::string& name) const {
+  for (size_t i = 0; i < ls_.scene.elements.size(); ++i)
+    if (ls_.scene.elements[i].name == name) return int(i);
+  throw Error("no element named \"" + name + "\"");  // checked before the window opened
+}
+
+void Viewer::moveElement(int index, const Vec3& by_m) {
+  if (index < 0 || size_t(index) >= ls_.desc.elements.size()) return;
+  const PoseDesc& p = ls_.desc.elements[size_t(index)].pose;
+  overrides_.push_back(
+      positionOverride(index, movedElementPosition(p.position, p.normal, p.up, by_m), ls_.desc.unit_m));
+  rebuild(true);
 }
 
 void Viewer::turnElement(int index, double yaw_rad, double pitch_rad) {
@@ -458,6 +480,12 @@ void Viewer::elementsPanel() {
         std::tuple{"pitch +1 (I)", 0.0, 1.0}}) {
     ImGui::SameLine();
     if (ImGui::Button(label)) pending_yaw_rad_ += radians(yaw), pending_pitch_rad_ += radians(pitch);
+  }
+  ImGui::Text("move 1 mm in its frame:");
+  for (int k = 0; k < 6; ++k) {
+    static const char* const kLabels[6] = {"x-", "x+", "y-", "y+", "z-", "z+"};
+    ImGui::SameLine();
+    if (ImGui::Button(kLabels[k])) pending_move_m_[k / 2] += (k % 2 ? 1 : -1) * kMoveStepM;
   }
   const std::string el = "elements[" + std::to_string(selected_) + "].";
   const TessellationDesc& t = ls_.desc.elements[size_t(selected_)].tessellation;
@@ -803,7 +831,7 @@ int cmdView(const std::vector<std::string>& argv) {
   }
   const SceneDesc desc = pvrr::loadScene(scene_path, overrides);
   for (const view::ScriptEvent& e : script.events) {
-    if (e.kind != view::EventKind::TurnElement) continue;
+    if (e.kind != view::EventKind::TurnElement && e.kind != view::EventKind::MoveElement) continue;
     std::vector<std::string> names;
     for (const ElementDesc& el : desc.elements) names.push_back(el.name);
     if (std::find(names.begin(), names.end(), e.element) != names.end()) continue;

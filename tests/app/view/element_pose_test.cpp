@@ -41,6 +41,19 @@ TEST(ViewElementPose, TurnsAreAboutTheElementsOwnFrame) {
   EXPECT_GT(glm::dot(p.normal, glm::cross(y, n)), 0);                    // towards local +x
 }
 
+TEST(ViewElementPose, MovesInTheElementsFrameAndWritesTheFilesUnit) {
+  const Vec3 n(0, 0, 1), up(0, 1, 0), p(1, 2, 3);  // local x = (1, 0, 0)
+  expectNear(movedElementPosition(p, n, up, Vec3(0.01, -0.02, 0.03)), Vec3(1.01, 1.98, 3.03));
+  // A millimetre scene: the override is in millimetres, exactly the moved metres / 0.001.
+  const Vec3 moved = movedElementPosition(p, glm::normalize(Vec3(1, 0, 1)), up, Vec3(0, 0, 0.002));
+  const std::string o = positionOverride(3, moved, 0.001);
+  ASSERT_EQ(o.rfind("elements[3].pose.position=", 0), 0u);
+  const nlohmann::json j = nlohmann::json::parse(o.substr(o.find('=') + 1));
+  EXPECT_EQ(j[0].get<double>(), moved.x / 0.001);
+  EXPECT_EQ(j[2].get<double>(), moved.z / 0.001);
+  EXPECT_NEAR(glm::length(moved - p), 0.002, kPoseTol);
+}
+
 TEST(ViewElementPose, OverridesHoldThePoseExactly) {
   const TurnedPose p = turnElementPose(Vec3(0.3834, 0.1238, 0.9153), Vec3(0, 1, 0), radians(3), radians(-2));
   const std::vector<std::string> o = poseOverrides(2, p);

@@ -78,7 +78,8 @@ TEST(ViewScript, ReadsTheReferenceEvents) {
 
 TEST(ViewScript, ErrorsNameTheFileAndTheJsonPath) {
   EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "teleport"}]})"),
-            "s.json: events[0].do: expected one of cursor, drag, key, move_eye, overlay, quit, reference, save_view, "
+            "s.json: events[0].do: expected one of cursor, drag, key, move_element, move_eye, overlay, quit, "
+            "reference, save_view, "
             "screenshot, "
             "set, turn_element, turn_head, wipe, got \"teleport\"");
   EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "quit"}, {"at_frame": -1, "do": "quit"}]})"),

@@ -22,6 +22,8 @@ namespace fs = std::filesystem;
 // The window and pvrr render both draw with the renderer into a linear target; the window encodes sRGB in a
 // shader (float), render on the CPU (double): a value on a rounding boundary may land one code apart.
 constexpr double kWindowVsRenderCodes = 1;
+// A saved pose against the move asked for: a few double additions of metre-sized numbers.
+constexpr double kSavedPoseTol = 1e-12;
 
 // A scripted run's screenshot equals pvrr render of the view it saved; the saved view reloads to the same pixels.
 // `check_saved` (optional) looks at the saved view.
@@ -93,6 +95,21 @@ TEST(ViewWindow, TurnedMirrorMatchesRenderOfTheSavedView) {
                                  const double dot = 0.3834 * n[0].get<double>() + 0.1238 * n[1].get<double>() +
                                                     0.9153 * n[2].get<double>();
                                  EXPECT_LT(dot, std::cos(12 * M_PI / 180));
+                               });
+}
+
+// A mirror moved in its own frame: the saved view holds the new vertex, 2 cm along the mirror's local x.
+TEST(ViewWindow, MovedMirrorMatchesRenderOfTheSavedView) {
+  checkScreenshotMatchesRender("view-move", "models/car-mirror.json",
+                               R"({"at_frame": 2, "do": "move_element", "element": "door-mirror",
+                                   "by": [0.02, 0, 0]})",
+                               [](const nlohmann::json& saved) {
+                                 const auto& p = saved["elements"][0]["pose"]["position"];
+                                 const double d[3] = {
+                                     p[0].get<double>() + 0.5, p[1].get<double>() - 1.05,
+                                     p[2].get<double>() + 0.35};  // from the scene's [-0.5, 1.05, -0.35]
+                                 EXPECT_NEAR(std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), 0.02, kSavedPoseTol);
+                                 EXPECT_NEAR(d[1], 0, kSavedPoseTol);  // local x is horizontal: up x normal with up = y
                                });
 }
 
