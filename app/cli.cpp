@@ -44,26 +44,43 @@ const std::map<std::string, Command>& commands() {
         "  the end, their difference (rss_growth_mb), the peak, and 20 samples over the run."}},
       {"view",
        {cmdView, "open a design-review window: the scene live, head and eye moved by mouse and keys",
-        "pvrr view [SCENE] [--mode pvrr|raster|envmap|impostor] [--gl auto|glx|egl] [--size WxH] [--set PATH=VALUE]...\n"
+        "pvrr view [SCENE] [--mode pvrr|raster|envmap|impostor] [--gl auto|glx|egl] [--size WxH] [--set "
+        "PATH=VALUE]...\n"
         "          [--script FILE.json] [--stats FILE.json]\n"
         "  Opens a window (an X display; under xvfb-run without one) rendering SCENE (default models/car-mirror.json)\n"
         "  every frame with the same renderer as pvrr render, and a panel with the frame time, fps and each stage's\n"
         "  time or why it was skipped. Keys: drag or arrows turn the head about the eye; W/S, A/D, R/F move the eye\n"
         "  (1 cm; Shift 10 cm); Home or H returns to the design eye point; 1-4 choose the mode; Tab hides the panel;\n"
         "  F12 writes out/view-N.png, V out/view-N.json (a scene that pvrr render reproduces); Esc quits.\n"
-        "  --script {\"size\":[w,h],\"events\":[{\"at_frame\":N,\"do\":...}]}, do one of: \"set\" (\"path\", \"value\": as --set),\n"
-        "  \"turn_head\" (\"yaw_deg\", \"pitch_deg\": positive turns left, looks up), \"move_eye\" (\"by\": [x,y,z] metres in\n"
-        "  the observer frame: x right, y up, -z forward), \"screenshot\" (\"file\": PNG, the frame without the panel,\n"
+        "  T traces the Embree reference of the view in background threads (again: cancels), shown right of a\n"
+        "  split line that a drag moves; E overlays the angular error heat map (pvrr compare's figures in the panel).\n"
+        "  J/L and K/I turn the selected mirror or lens about its vertex in yaw and pitch (1 deg; Shift 10 deg).\n"
+        "  Over a lens, the panel shows pvrr lensmap's readings at the lens point under the mouse.\n"
+        "  --script {\"size\":[w,h],\"events\":[{\"at_frame\":N,\"do\":...}]}, do one of: \"set\" (\"path\", "
+        "\"value\": as --set),\n"
+        "  \"turn_head\" (\"yaw_deg\", \"pitch_deg\": positive turns left, looks up), \"move_eye\" (\"by\": [x,y,z] "
+        "metres in\n"
+        "  the observer frame: x right, y up, -z forward), \"screenshot\" (\"file\": PNG, the frame without the "
+        "panel,\n"
         "  or with it: \"panel\": true),\n"
-        "  \"save_view\" (\"file\": JSON), \"key\" (\"key\": a GLFW key name of the keys above, \"shift\": true|false), \"quit\".\n"
-        "  --stats writes {\"frames\", \"fps_median\", \"frame_ms_median\", \"frame_ms_max\", \"mode\", \"size\", \"gl\"} at exit\n"
+        "  \"save_view\" (\"file\": JSON), \"key\" (\"key\": a GLFW key name of the keys above, \"shift\": "
+        "true|false), \"quit\",\n"
+        "  \"turn_element\" (\"element\": name, \"yaw_deg\", \"pitch_deg\"), \"move_element\" (\"element\", \"by\":\n"
+        "  [x,y,z] metres in its frame: x = up x normal, y up, z normal), \"reference\" (trace it; later events wait),\n"
+        "  \"wipe\" (\"x\": 0 all reference .. 1 all mode), \"overlay\" (\"on\": true|false), \"drag\" (\"from\", "
+        "\"to\":\n"
+        "  [x,y] window pixels, left button), \"cursor\" (\"at\": [x,y]: where the lens readings are taken).\n"
+        "  --stats writes {\"frames\", \"fps_median\", \"frame_ms_median\", \"frame_ms_max\", \"mode\", \"size\", "
+        "\"gl\",\n"
+        "  \"reference\", \"lens_probe\"} at exit\n"
         "  (frame time: the whole loop, render, present, panel and swap)."}},
       {"gl-info",
        {cmdGlInfo, "print the GL backend, GL_VERSION and GL_RENDERER",
         "pvrr gl-info [--gl auto|egl|osmesa]\n  The backend can also be chosen with the PVRR_GL variable."}},
       {"trace",
        {cmdTrace, "trace one reference ray and print its path as JSON",
-        "pvrr trace SCENE (--ray OX,OY,OZ,DX,DY,DZ | --pixel X,Y [--size WxH]) [--wavelength NM] [--set PATH=VALUE]...\n"
+        "pvrr trace SCENE (--ray OX,OY,OZ,DX,DY,DZ | --pixel X,Y [--size WxH]) [--wavelength NM] [--set "
+        "PATH=VALUE]...\n"
         "  Pixel centres are at +0.5, the origin is the top-left corner. Prints\n"
         "  {\"segments\":[{\"origin\",\"direction\",\"event\",\"element\",\"point\",\"normal\",\"n1\",\"n2\"}]}."}},
       {"vertices",
@@ -73,24 +90,26 @@ const std::map<std::string, Command>& commands() {
         "  (+ ix,iy,iz,bx,by,bz,bnx,bny,bnz for lenses); FILE.json beside it holds each patch's camera."}},
       {"compare",
        {cmdCompare, "render the reference and each mode; write images, error heat maps and metrics.json",
-        "pvrr compare SCENE [--modes pvrr,envmap,impostor,raster] [--size WxH] [--frames N] [--gl B] [--set PATH=VALUE]... --out DIR\n"
+        "pvrr compare SCENE [--modes pvrr,envmap,impostor,raster] [--size WxH] [--frames N] [--gl B] [--set "
+        "PATH=VALUE]... --out DIR\n"
         "  Writes DIR/reference.png, DIR/MODE.png, DIR/MODE-error.png and DIR/metrics.json: per mode the frame\n"
         "  time, stages and angular error (median, p95, max), split into the zooming region and the rest\n"
         "  (\"regions\"); with rgb dispersion also per colour channel (\"channels\") and the fringes' sign\n"
         "  (\"fringe\"). metrics.json's \"definitions\" says how each figure is measured."}},
       {"sweep",
        {cmdSweep, "compare over a grid of tessellations and map sizes; write sweep.csv and error-vs-time plots",
-        "pvrr sweep SCENE [--tessellation N1,N2,...] [--map-size S1,S2,...] [--vary PATH=V1,V2,...]... [--modes M1,...]\n"
+        "pvrr sweep SCENE [--tessellation N1,N2,...] [--map-size S1,S2,...] [--vary PATH=V1,V2,...]... [--modes "
+        "M1,...]\n"
         "           [--size WxH] [--frames N] [--gl B] --out DIR\n"
         "  Writes DIR/sweep.csv (mode,tessellation,map_size,vertices,frame_ms,median_arcmin,p95_arcmin,max_arcmin,\n"
         "  psnr_db,reference_ms,vary), DIR/error_vs_time.png and .svg, DIR/error_vs_vertices.png.\n"
         "  --map-size fixes each map's longer side (render.map_texels_per_pixel=0 unless --set says otherwise);\n"
         "  without it, the scene's own map sizing."}},
-      {"plot",
-       {cmdPlot, "redraw the plots of a sweep from its CSV", "pvrr plot DIR/sweep.csv [--out DIR]"}},
+      {"plot", {cmdPlot, "redraw the plots of a sweep from its CSV", "pvrr plot DIR/sweep.csv [--out DIR]"}},
       {"lensmap",
        {cmdLensmap, "power, astigmatism, prism, distortion and colour maps of a spectacle lens as worn",
-        "pvrr lensmap SCENE [--element NAME] [--grid N] [--gaze-max DEG] [--object-distance M] [--set PATH=VALUE]... --out DIR\n"
+        "pvrr lensmap SCENE [--element NAME] [--grid N] [--gaze-max DEG] [--object-distance M] [--set PATH=VALUE]... "
+        "--out DIR\n"
         "  Per gaze (Fick angles, N x N from -DEG to +DEG, default 41 and 40), the chief ray through the eye's centre\n"
         "  of rotation (the lens's \"eye\" block, default 25.5 mm behind its eye-side vertex) traced exactly, and the\n"
         "  wavefront of an object at infinity (or M metres from the rotation centre) on the vertex sphere.\n"

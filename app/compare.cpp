@@ -40,11 +40,8 @@ int rssBaselineFrame(int frames) { return frames < 100 ? 1 : 100; }
 
 namespace {
 
-// A perceptually ordered colour map (black-body-like: black, red, yellow, white) for heat maps.
-Vec3 heat(double x) {
-  x = std::clamp(x, 0.0, 1.0);
-  return Vec3(std::clamp(3 * x, 0.0, 1.0), std::clamp(3 * x - 1, 0.0, 1.0), std::clamp(3 * x - 2, 0.0, 1.0));
-}
+// The heat maps' colours: errorHeatColour (pvrr/analysis/accuracy.h), shared with pvrr view's overlay.
+Vec3 heat(double x) { return errorHeatColour(x); }
 
 // 3x5 bitmap digits for the colour bar's labels ('.', '0'-'9').
 const char* glyph(char c) {
@@ -260,7 +257,7 @@ int cmdCompare(const std::vector<std::string>& argv) {
     std::vector<double> err;
     const ErrorStats st = compareToReference(ref, f, &err);
     writeLinearPng(*out_dir + "/" + m + ".png", w, h, f.color);
-    const double scale = std::max(1.0, st.p95_arcmin * 1.5);
+    const double scale = heatMapScaleArcmin(st);
     writeHeatMap(*out_dir + "/" + m + "-error.png", w, h, err, scale);
     const json stages = stagesJson(f.stages);
     json per_element = json::array();

@@ -29,20 +29,27 @@ const std::map<std::string, std::pair<EventKind, std::vector<std::string>>>& kin
       {"save_view", {EventKind::SaveView, {"file"}}},
       {"quit", {EventKind::Quit, {}}},
       {"key", {EventKind::Key, {"key", "shift"}}},
+      {"reference", {EventKind::Reference, {}}},
+      {"wipe", {EventKind::Wipe, {"x"}}},
+      {"overlay", {EventKind::Overlay, {"on"}}},
+      {"drag", {EventKind::Drag, {"button", "from", "to"}}},
+      {"turn_element", {EventKind::TurnElement, {"element", "yaw_deg", "pitch_deg"}}},
+      {"cursor", {EventKind::Cursor, {"at"}}},
+      {"move_element", {EventKind::MoveElement, {"element", "by"}}},
   };
   return table;
 }
-// Issue 25's other events, not in this version yet: named so that a script using them is told so.
-const std::set<std::string> kLater = {"turn_element", "reference", "wipe", "overlay", "drag"};
 
 // The keys the viewer answers to, by their GLFW names (GLFW_KEY_<name>).
 const std::map<std::string, int>& keyCodes() {
   static const std::map<std::string, int> table = {
-      {"W", GLFW_KEY_W},         {"A", GLFW_KEY_A},       {"S", GLFW_KEY_S},         {"D", GLFW_KEY_D},
-      {"R", GLFW_KEY_R},         {"F", GLFW_KEY_F},       {"H", GLFW_KEY_H},         {"V", GLFW_KEY_V},
-      {"1", GLFW_KEY_1},         {"2", GLFW_KEY_2},       {"3", GLFW_KEY_3},         {"4", GLFW_KEY_4},
-      {"LEFT", GLFW_KEY_LEFT},   {"RIGHT", GLFW_KEY_RIGHT}, {"UP", GLFW_KEY_UP},     {"DOWN", GLFW_KEY_DOWN},
-      {"HOME", GLFW_KEY_HOME},   {"TAB", GLFW_KEY_TAB},   {"F12", GLFW_KEY_F12},     {"ESCAPE", GLFW_KEY_ESCAPE},
+      {"W", GLFW_KEY_W},       {"A", GLFW_KEY_A},         {"S", GLFW_KEY_S},     {"D", GLFW_KEY_D},
+      {"R", GLFW_KEY_R},       {"F", GLFW_KEY_F},         {"H", GLFW_KEY_H},     {"V", GLFW_KEY_V},
+      {"1", GLFW_KEY_1},       {"2", GLFW_KEY_2},         {"3", GLFW_KEY_3},     {"4", GLFW_KEY_4},
+      {"LEFT", GLFW_KEY_LEFT}, {"RIGHT", GLFW_KEY_RIGHT}, {"UP", GLFW_KEY_UP},   {"DOWN", GLFW_KEY_DOWN},
+      {"HOME", GLFW_KEY_HOME}, {"TAB", GLFW_KEY_TAB},     {"F12", GLFW_KEY_F12}, {"ESCAPE", GLFW_KEY_ESCAPE},
+      {"T", GLFW_KEY_T},       {"E", GLFW_KEY_E},         {"J", GLFW_KEY_J},     {"L", GLFW_KEY_L},
+      {"I", GLFW_KEY_I},       {"K", GLFW_KEY_K},
   };
   return table;
 }
@@ -101,7 +108,6 @@ ScriptEvent readEvent(const Reader& r, const json& e, const std::string& path) {
   for (const auto& [k, v] : kinds()) names += (names.empty() ? "" : ", ") + k;
   if (!d.is_string()) r.expected(path + ".do", "one of " + names, d);
   const std::string what = d.get<std::string>();
-  if (kLater.count(what)) r.fail(path + ".do", "\"" + what + "\" is not implemented yet (implemented: " + names + ")");
   const auto it = kinds().find(what);
   if (it == kinds().end()) {
     std::vector<std::string> all;
@@ -119,11 +125,17 @@ ScriptEvent readEvent(const Reader& r, const json& e, const std::string& path) {
       ev.path = r.text(r.need(e, path, "path"), path + ".path", "a scene path as --set takes it (\"render.mode\")");
       ev.value_json = r.need(e, path, "value").dump();
       break;
+    case EventKind::TurnElement:
+      ev.element = r.text(r.need(e, path, "element"), path + ".element", "an element's name");
+      [[fallthrough]];
     case EventKind::TurnHead:
       if (!e.contains("yaw_deg") && !e.contains("pitch_deg")) r.fail(path, "missing \"yaw_deg\" or \"pitch_deg\"");
       if (e.contains("yaw_deg")) ev.yaw_deg = r.number(e.at("yaw_deg"), path + ".yaw_deg");
       if (e.contains("pitch_deg")) ev.pitch_deg = r.number(e.at("pitch_deg"), path + ".pitch_deg");
       break;
+    case EventKind::MoveElement:
+      ev.element = r.text(r.need(e, path, "element"), path + ".element", "an element's name");
+      [[fallthrough]];
     case EventKind::MoveEye: {
       const json& by = r.need(e, path, "by");
       if (!by.is_array() || by.size() != 3) r.expected(path + ".by", "[x, y, z] in metres", by);
@@ -162,7 +174,35 @@ ScriptEvent readEvent(const Reader& r, const json& e, const std::string& path) {
       }
       break;
     }
+    case EventKind::Reference:
     case EventKind::Quit: break;
+    case EventKind::Wipe:
+      ev.wipe_x = r.number(r.need(e, path, "x"), path + ".x");
+      if (ev.wipe_x < 0 || ev.wipe_x > 1)
+        r.expected(path + ".x", "a number from 0 (all reference) to 1 (all mode)", e.at("x"));
+      break;
+    case EventKind::Overlay:
+      if (!r.need(e, path, "on").is_boolean()) r.expected(path + ".on", "true or false", e.at("on"));
+      ev.on = e.at("on").get<bool>();
+      break;
+    case EventKind::Drag: {
+      if (e.contains("button") && e.at("button") != "left") r.expected(path + ".button", "\"left\"", e.at("button"));
+      const auto point = [&](const char* key, Vec2* out) {
+        const json& v = r.need(e, path, key);
+        if (!v.is_array() || v.size() != 2) r.expected(path + "." + key, "[x, y] in window pixels", v);
+        for (int k = 0; k < 2; ++k)
+          (*out)[k] = r.number(v[size_t(k)], path + "." + key + "[" + std::to_string(k) + "]");
+      };
+      point("from", &ev.from_px);
+      point("to", &ev.to_px);
+      break;
+    }
+    case EventKind::Cursor: {
+      const json& v = r.need(e, path, "at");
+      if (!v.is_array() || v.size() != 2) r.expected(path + ".at", "[x, y] in window pixels", v);
+      for (int k = 0; k < 2; ++k) ev.at_px[k] = r.number(v[size_t(k)], path + ".at[" + std::to_string(k) + "]");
+      break;
+    }
   }
   return ev;
 }

@@ -10,7 +10,10 @@
 
 namespace pvrr::app::view {
 
-enum class EventKind { Set, TurnHead, MoveEye, Screenshot, SaveView, Quit, Key };
+// clang-format off
+enum class EventKind { Set, TurnHead, MoveEye, Screenshot, SaveView, Quit, Key, Reference, Wipe, Overlay, Drag,
+                       TurnElement, Cursor, MoveElement };
+// clang-format on
 
 struct ScriptEvent {
   int at_frame = 0;
@@ -18,12 +21,21 @@ struct ScriptEvent {
   std::string where;  // "events[3]", for messages about the event at run time
   // set: a scene path as --set takes it and its value as JSON text ("render.mode", "\"envmap\"").
   std::string path, value_json;
-  double yaw_deg = 0, pitch_deg = 0;  // turn_head: positive yaw turns left, positive pitch looks up
+  double yaw_deg = 0, pitch_deg = 0;  // turn_head: positive yaw turns left, positive pitch looks up;
+                                      // turn_element: app/view/element_pose.h
+  std::string element;                // turn_element, move_element: the element's name
+                                      // move_element: "by" (by_m) in metres in the element's frame
+  Vec2 at_px{0};                      // cursor: where the lens probe reads, window pixels (as the mouse hovering)
   Vec3 by_m{0};                       // move_eye: metres in the observer frame (x right, y up, -z forward)
   std::string file;                   // screenshot, save_view
   bool with_panel = false;            // screenshot: with the panel over the frame ("panel": true)
   int key = 0;                        // key: the GLFW key code of "key" (a GLFW key name: "W", "LEFT", "HOME")
   bool shift = false;                 // key: with Shift held ("shift": true)
+  // reference: start the live reference of the current view and run no later event until it is finished
+  // (the window keeps drawing meanwhile).
+  double wipe_x = 0.5;        // wipe: the split line's position, 0 (all reference) to 1 (all mode)
+  bool on = false;            // overlay: show ("on": true) or hide the error heat map
+  Vec2 from_px{0}, to_px{0};  // drag (left button): press at "from", move to "to", release; window pixels
 };
 
 struct Script {

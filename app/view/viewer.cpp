@@ -10,14 +10,20 @@
 #include <cstdio>
 #include <deque>
 #include <optional>
+#include <thread>
 
 #include "app/args.h"
 #include "app/commands.h"
 #include "app/report.h"
+#include "app/view/element_pose.h"
 #include "app/view/head.h"
+#include "app/view/lens_probe.h"
+#include "app/view/reference_tiles.h"
 #include "app/view/save_view.h"
 #include "app/view/script.h"
+#include "app/view/viewer_impl.h"
 #include "app/view/window.h"
+#include "app/view/wipe.h"
 #include "pvrr/analysis/accuracy.h"
 #include "pvrr/base/error.h"
 #include "pvrr/base/format.h"
@@ -25,93 +31,25 @@
 
 namespace pvrr::app {
 namespace view {
-namespace {
 
-using Clock = std::chrono::steady_clock;
-using nlohmann::json;
-
-// Eye steps (metres) and head turns (degrees) of one key press; Shift multiplies by kFast.
-constexpr double kEyeStepM = 0.01, kTurnStepDeg = 1.0, kFast = 10.0;
-// Mouse-look: degrees of head turn per pixel of drag.
-constexpr double kLookDegPerPixel = 0.1;
-
-class Viewer {
- public:
-  Viewer(Window& window, std::string scene_path, std::vector<std::string> overrides, std::optional<RenderMode> mode,
-         int width, int height, std::string script_path, Script script)
-      : window_(window), scene_path_(std::move(scene_path)), overrides_(std::move(overrides)), cli_mode_(mode),
-        width_(width), height_(height), script_path_(std::move(script_path)), script_(std::move(script)) {
-    glfwSetWindowUserPointer(window_.handle(), this);
-    glfwSetKeyCallback(window_.handle(), [](GLFWwindow* w, int key, int, int action, int mods) {
-      static_cast<Viewer*>(glfwGetWindowUserPointer(w))->onKey(key, action, mods);
-    });
-    rebuild();
-  }
-  ~Viewer() {
-    window_.context().makeCurrent();  // GL objects go while their context is current
-    renderer_.reset();
-    glfwSetKeyCallback(window_.handle(), nullptr);
-  }
-
-  void run();
-  json stats() const;
-
- private:
-  void rebuild();
-  void runEvents();
-  void frame();
-  void panel(const gl::RasterFrame& f, double frame_ms);
-  void onKey(int key, int action, int mods);
-  void setMode(RenderMode m) {
-    if (m == mode_) return;
-    mode_ = m;
-    cache_ = gl::FrameCache{};  // the cache holds the last mode's maps
-  }
-  void screenshot(const std::string& file);
-  void saveViewTo(const std::string& file);
-  std::string glName() const {
-    return window_.context().backendName() + " (" + window_.context().glRenderer() + ")";
-  }
-
-  Window& window_;
-  std::string scene_path_;
-  std::vector<std::string> overrides_;  // --set, then the script's "set" events
-  std::optional<RenderMode> cli_mode_;
-  int width_, height_;
-  std::string script_path_;
-  Script script_;
-  size_t next_event_ = 0;
-
-  LoadedScene ls_;
-  Observer design_;  // the scene's observer: the design eye point
-  HeadPose pose_;
-  RenderMode mode_ = RenderMode::Pvrr;
-  bool any_attached_ = false;
-  std::unique_ptr<RayScene> rays_;
-  std::unique_ptr<gl::Renderer> renderer_;
-  gl::FrameCache cache_;
-
-  bool quit_ = false, show_panel_ = true;
-  std::vector<std::string> pending_screenshots_, panel_screenshots_;
-  int frames_ = 0, saved_ = 0;
-  std::vector<double> frame_ms_;   // every frame, for --stats
-  // Where each frame's time went: the renderer's frame, presenting it, the panel, the swap and input.
-  std::vector<double> render_ms_, present_ms_, panel_ms_, swap_ms_;
-  std::deque<double> recent_ms_;   // the last frames, for the panel
-  bool dragging_ = false;
-  double last_x_ = 0, last_y_ = 0;
-};
-
-void Viewer::rebuild() {
+void Viewer::rebuild(bool keep_mode) {
+  if (reference_) discardReference("discarded: the scene was rebuilt (a setting changed)");
+  const auto t0 = Clock::now();
   window_.context().makeCurrent();
+  seen_renderer_.reset();
   renderer_.reset();
+  ++scene_builds_;
   rays_.reset();
   ls_ = loadScene(scene_path_, overrides_, width_, height_);
   design_ = ls_.scene.observer;
-  mode_ = cli_mode_ ? *cli_mode_ : ls_.scene.render.mode;
+  if (!keep_mode || scene_builds_ == 1) mode_ = cli_mode_ ? *cli_mode_ : ls_.scene.render.mode;
+  selected_ = std::clamp(selected_, 0, std::max(0, int(ls_.scene.elements.size()) - 1));
   if (!isRasterMode(mode_))
     throw Error("pvrr view: mode " + std::string(nameOf(mode_)) + " is not a live mode; expected one of " +
                 nameListIf<RenderMode>(isRasterMode));
+  has_lens_ = std::any_of(ls_.scene.elements.begin(), ls_.scene.elements.end(),
+                          [](const Element& e) { return e.type == ElementType::Lens; });
+  probe_fresh_ = false;
   any_attached_ = std::any_of(ls_.scene.elements.begin(), ls_.scene.elements.end(),
                               [](const Element& e) { return e.attached_to_observer; });
   RaySceneOptions ro;
@@ -122,10 +60,19 @@ void Viewer::rebuild() {
   opt.read_back = false;    // presented from the GPU
   renderer_ = std::make_unique<gl::Renderer>(ls_.scene, *rays_, opt);
   cache_ = gl::FrameCache{};
+  if (scene_builds_ > 1)
+    rebuild_ms_max_ = std::max(rebuild_ms_max_, std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
 }
 
 void Viewer::runEvents() {
-  while (next_event_ < script_.events.size() && script_.events[next_event_].at_frame <= frames_) {
+  // A script waiting for its reference: the window draws on, and the later events move by the frames it waited.
+  if (waiting_reference_ && reference_ && !reference_->finished()) {
+    ++waited_frames_;
+    return;
+  }
+  waiting_reference_ = false;
+  while (next_event_ < script_.events.size() && script_.events[next_event_].at_frame + waited_frames_ <= frames_) {
+    if (waiting_reference_) return;
     const ScriptEvent& e = script_.events[next_event_++];
     try {
       switch (e.kind) {
@@ -134,12 +81,38 @@ void Viewer::runEvents() {
           if (e.path.rfind("render.mode", 0) == 0) cli_mode_.reset();
           rebuild();
           break;
+        case EventKind::TurnElement:
+          turnElement(elementIndex(e.element), radians(e.yaw_deg), radians(e.pitch_deg));
+          break;
+        case EventKind::MoveElement:
+          moveElement(elementIndex(e.element), e.by_m);
+          break;
         case EventKind::TurnHead: turnHead(pose_, radians(e.yaw_deg), radians(e.pitch_deg)); break;
         case EventKind::MoveEye: moveEye(pose_, design_, e.by_m); break;
         case EventKind::Screenshot: (e.with_panel ? panel_screenshots_ : pending_screenshots_).push_back(e.file); break;
         case EventKind::SaveView: saveViewTo(e.file); break;
         case EventKind::Quit: quit_ = true; break;
         case EventKind::Key: onKey(e.key, GLFW_PRESS, e.shift ? GLFW_MOD_SHIFT : 0); break;  // the keyboard's path
+        case EventKind::Reference:
+          startReference();
+          waiting_reference_ = true;
+          break;
+        case EventKind::Cursor:
+          probe_asked_ = true;
+          probe_x_ = int(std::floor(e.at_px.x));
+          probe_y_ = int(std::floor(e.at_px.y));
+          break;
+        case EventKind::Wipe:
+          wipe_x_ = e.wipe_x;
+          break;
+        case EventKind::Overlay:
+          overlay_ = e.on;
+          break;
+        case EventKind::Drag:  // the mouse's path
+          pointerPress(e.from_px.x, e.from_px.y);
+          pointerMove(e.to_px.x, e.to_px.y);
+          pointerRelease();
+          break;
       }
     } catch (const Error& err) {
       throw Error(script_path_ + ": " + e.where + ": " + err.what());
@@ -158,13 +131,35 @@ void Viewer::frame() {
     cache_ = gl::FrameCache{};
   }
   const auto t0 = Clock::now();
-  const Observer ob = headObserver(design_, pose_);
-  Observer& current = ls_.scene.observer;
-  const bool moved = ob.eye != current.eye || ob.target != current.target;
-  current = ob;
-  if (moved && any_attached_) {
-    updateAttachedElements(ls_.scene, ls_.desc);
-    rays_->updateElementPoses();
+  if (pending_yaw_rad_ != 0 || pending_pitch_rad_ != 0) {
+    turnElement(selected_, pending_yaw_rad_, pending_pitch_rad_);
+    pending_yaw_rad_ = pending_pitch_rad_ = 0;
+  }
+  if (pending_move_m_ != Vec3(0)) {
+    moveElement(selected_, pending_move_m_);
+    pending_move_m_ = Vec3(0);
+  }
+  if (!pending_overrides_.empty()) {
+    overrides_.insert(overrides_.end(), pending_overrides_.begin(), pending_overrides_.end());
+    pending_overrides_.clear();
+    rebuild(true);
+  }
+  if (reference_requested_) {
+    reference_requested_ = false;
+    if (reference_ && !reference_->finished())
+      discardReference("cancelled: T pressed");
+    else
+      startReference();
+  }
+  const Observer ob = updateObserver();
+  if (reference_ && !(viewKey() == reference_key_)) discardReference("discarded: the view changed");
+  if (reference_ && reference_->failed()) discardReference("failed: " + reference_->failure());
+  const bool tracing = reference_ && !reference_->finished();
+  if (has_lens_ && probe_asked_ &&
+      (!probe_fresh_ || !(viewKey() == probe_key_) || int(probe_.px) != probe_x_ || int(probe_.py) != probe_y_)) {
+    probe_ = probeLens(ls_.scene, *rays_, probe_x_, probe_y_);
+    probe_key_ = viewKey();
+    probe_fresh_ = true;
   }
   window_.context().makeCurrent();
   // A screenshot frame is drawn whole, every stage run (its own empty cache), so that it is what pvrr render
@@ -174,7 +169,7 @@ void Viewer::frame() {
   const gl::RasterFrame f = renderer_->render(mode_, pending_screenshots_.empty() ? &cache_ : &whole);
   cache_.environment_changed = false;  // the environment never changes while the window is open
   const auto t_render = Clock::now();
-  window_.present(renderer_->colorTexture(), ob.width, ob.height);
+  presentFrame(ob);
   const auto t_present = Clock::now();
   if (!pending_screenshots_.empty()) {
     // Screenshots show the frame alone: taken before the panel is drawn over it.
@@ -194,14 +189,23 @@ void Viewer::frame() {
   const auto t_panel = Clock::now();
   window_.swapAndPoll();
 
-  // Mouse-look: a left-button drag outside the panel turns the head.
+  // The mouse: a left-button drag outside the panel turns the head, or moves the wipe's split line.
   double x = 0, y = 0;
   glfwGetCursorPos(window_.handle(), &x, &y);
   const bool down = glfwGetMouseButton(window_.handle(), GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
-  if (down && dragging_) turnHead(pose_, -radians(kLookDegPerPixel * (x - last_x_)), -radians(kLookDegPerPixel * (y - last_y_)));
-  dragging_ = down && (dragging_ || !ImGui::GetIO().WantCaptureMouse);
-  last_x_ = x;
-  last_y_ = y;
+  if (down && !mouse_down_ && !ImGui::GetIO().WantCaptureMouse) pointerPress(x, y);
+  if (down) pointerMove(x, y);
+  if (!down && mouse_down_) pointerRelease();
+  mouse_down_ = down;
+  // The lens probe follows the mouse when it moves over the picture (not at startup, where it was put).
+  if (cursor_seen_ && (x != cursor_x_ || y != cursor_y_) && !ImGui::GetIO().WantCaptureMouse) {
+    probe_asked_ = true;
+    probe_x_ = int(std::floor(x));
+    probe_y_ = int(std::floor(y));
+  }
+  cursor_seen_ = true;
+  cursor_x_ = x;
+  cursor_y_ = y;
 
   const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   frame_ms_.push_back(ms);
@@ -212,63 +216,126 @@ void Viewer::frame() {
   present_ms_.push_back(span(t_render, t_present));
   panel_ms_.push_back(span(t_present, t_panel));
   swap_ms_.push_back(span(t_panel, Clock::now()));
+  if (tracing) {
+    ++frames_while_tracing_;
+    frame_ms_max_while_tracing_ = std::max(frame_ms_max_while_tracing_, ms);
+  }
   recent_ms_.push_back(ms);
   if (recent_ms_.size() > 60) recent_ms_.pop_front();
   ++frames_;
 }
 
-void Viewer::panel(const gl::RasterFrame& f, double frame_ms) {
-  ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(460, 0), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowBgAlpha(0.85f);
-  ImGui::Begin("pvrr view");
-  const double med = median(std::vector<double>(recent_ms_.begin(), recent_ms_.end()));
-  ImGui::Text("frame %.2f ms, %.1f fps (median of the last %zu: %.2f ms)", frame_ms, med > 0 ? 1000.0 / med : 0.0,
-              recent_ms_.size(), med);
-  ImGui::Text("renderer %.2f ms; %dx%d", f.frame_ms, f.width, f.height);
-  ImGui::TextWrapped("GL: %s, %s", glName().c_str(), window_.context().glVersion().c_str());
-  ImGui::Text("mode:");
-  for (RenderMode m : {RenderMode::Pvrr, RenderMode::Envmap, RenderMode::Impostor, RenderMode::Raster}) {
-    ImGui::SameLine();
-    if (ImGui::RadioButton(nameOf(m), mode_ == m)) setMode(m);
+int Viewer::elementIndex(const std::string& name) const {
+  for (size_t i = 0; i < ls_.scene.elements.size(); ++i)
+    if (ls_.scene.elements[i].name == name) return int(i);
+  throw Error("no element named \"" + name + "\"");  // checked before the window opened
+}
+
+void Viewer::moveElement(int index, const Vec3& by_m) {
+  if (index < 0 || size_t(index) >= ls_.desc.elements.size()) return;
+  const PoseDesc& p = ls_.desc.elements[size_t(index)].pose;
+  overrides_.push_back(
+      positionOverride(index, movedElementPosition(p.position, p.normal, p.up, by_m), ls_.desc.unit_m));
+  rebuild(true);
+}
+
+void Viewer::turnElement(int index, double yaw_rad, double pitch_rad) {
+  if (index < 0 || size_t(index) >= ls_.desc.elements.size()) return;
+  const PoseDesc& p = ls_.desc.elements[size_t(index)].pose;
+  for (const std::string& o : poseOverrides(index, turnElementPose(p.normal, p.up, yaw_rad, pitch_rad)))
+    overrides_.push_back(o);
+  rebuild(true);
+}
+
+json Viewer::probeStats() const {
+  if (!probe_asked_ || !probe_fresh_) return nullptr;
+  json j = {{"pixel", {probe_.px, probe_.py}}, {"valid", probe_.valid}, {"reason", probe_.reason}};
+  if (probe_.element >= 0) j["element"] = ls_.scene.elements[size_t(probe_.element)].name;
+  if (!probe_.valid) return j;
+  const LensmapPoint& r = probe_.reading;
+  j["lens_point_local_m"] = {probe_.lens_point_local.x, probe_.lens_point_local.y, probe_.lens_point_local.z};
+  for (const auto& [name, v] :
+       {std::pair{"gaze_x_deg", r.gaze_x_deg}, std::pair{"gaze_y_deg", r.gaze_y_deg},
+        std::pair{"lens_x_mm", r.lens_x_mm}, std::pair{"lens_y_mm", r.lens_y_mm}, std::pair{"sphere_d", r.sphere_d},
+        std::pair{"cylinder_d", r.cylinder_d}, std::pair{"axis_deg", r.axis_deg},
+        std::pair{"mean_power_d", r.mean_power_d}, std::pair{"power_error_d", r.power_error_d},
+        std::pair{"unwanted_cylinder_d", r.unwanted_cylinder_d}, std::pair{"prism_h", r.prism_h},
+        std::pair{"prism_v", r.prism_v}})
+    j[name] = v;
+  return j;
+}
+
+const Observer& Viewer::updateObserver() {
+  const Observer ob = headObserver(design_, pose_);
+  Observer& current = ls_.scene.observer;
+  const bool moved = ob.eye != current.eye || ob.target != current.target;
+  current = ob;
+  if (moved && any_attached_) {
+    updateAttachedElements(ls_.scene, ls_.desc);
+    rays_->updateElementPoses();
   }
-  const Observer& ob = ls_.scene.observer;
-  ImGui::Text("eye [%.3f, %.3f, %.3f] m, head yaw %.1f, pitch %.1f deg", ob.eye.x, ob.eye.y, ob.eye.z,
-              degrees(pose_.yaw_rad), degrees(pose_.pitch_rad));
-  if (ImGui::Button("design eye (Home)")) pose_ = HeadPose{};
-  ImGui::SameLine();
-  if (ImGui::Button("screenshot (F12)")) pending_screenshots_.push_back("out/view-" + std::to_string(++saved_) + ".png");
-  ImGui::SameLine();
-  if (ImGui::Button("save view (V)")) saveViewTo("out/view-" + std::to_string(++saved_) + ".json");
-  if (ImGui::BeginTable("stages", 3, ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingStretchProp)) {
-    ImGui::TableSetupColumn("stage", ImGuiTableColumnFlags_WidthStretch, 1.0f);
-    ImGui::TableSetupColumn("ms", ImGuiTableColumnFlags_WidthFixed, 50.0f);
-    ImGui::TableSetupColumn("ran, or why not", ImGuiTableColumnFlags_WidthStretch, 2.2f);
-    ImGui::TableHeadersRow();
-    for (const StageTiming& s : f.stages.stages) {
-      ImGui::TableNextRow();
-      ImGui::TableNextColumn();
-      ImGui::TextUnformatted(s.name.c_str());
-      ImGui::TableNextColumn();
-      if (s.ran) ImGui::Text("%.2f", s.ms);
-      ImGui::TableNextColumn();
-      const std::string what = s.ran ? "ran" + (s.note.empty() ? std::string() : ": " + s.note) : "skipped: " + s.reason;
-      ImGui::TextWrapped("%s", what.c_str());
-    }
-    ImGui::EndTable();
+  return current;
+}
+
+void Viewer::startReference() {
+  updateObserver();
+  if (reference_ && (reference_->finished() || !(viewKey() == reference_key_))) reference_.reset();  // traced anew
+  if (reference_ && viewKey() == reference_key_) return;  // this view's reference is being traced
+  window_.context().makeCurrent();
+  const auto t0 = Clock::now();
+  if (!seen_renderer_) {
+    gl::RendererOptions opt = gl::rendererOptionsFor(ls_.scene);
+    opt.seen_points = true;  // as pvrr compare draws the frame it measures
+    opt.read_back = true;
+    seen_renderer_ = std::make_unique<gl::Renderer>(ls_.scene, *rays_, opt);
   }
-  if (ImGui::CollapsingHeader("keys")) {
-    ImGui::TextUnformatted(
-        "drag (left button)  turn the head\n"
-        "arrows              turn the head 1 deg (Shift: 10)\n"
-        "W/S A/D R/F         eye forward/back, left/right, up/down 1 cm (Shift: 10)\n"
-        "Home or H           back to the design eye point\n"
-        "1 2 3 4             mode pvrr, envmap, impostor, raster\n"
-        "Tab                 hide or show this panel\n"
-        "F12 / V             screenshot / save view (out/view-N.png, .json)\n"
-        "Esc                 quit");
+  gl::FrameCache fresh;  // every stage run, as compare's frame
+  gl::RasterFrame f = seen_renderer_->render(mode_, &fresh);
+  const int threads = std::max(1, int(std::thread::hardware_concurrency()) - 1);  // one core for the window
+  reference_ = std::make_unique<ReferenceRun>(ls_.scene, std::move(static_cast<Frame&>(f)), threads);
+  if (!wipe_) wipe_ = std::make_unique<Wipe>(window_);
+  wipe_->reset(reference_->width(), reference_->height());
+  heat_uploaded_ = false;
+  reference_key_ = viewKey();
+  reference_note_.clear();
+  ++references_started_;
+  reference_start_ms_ = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+void Viewer::discardReference(const std::string& why) {
+  reference_.reset();
+  reference_note_ = why;
+  waiting_reference_ = false;
+}
+
+void Viewer::presentFrame(const Observer& ob) {
+  if (!reference_) {
+    window_.present(renderer_->colorTexture(), ob.width, ob.height);
+    return;
   }
-  ImGui::End();
+  const bool finished = reference_->finished();  // first: every tile is queued once it says so
+  wipe_->uploadTiles(reference_->takeTiles(), reference_->rgba());
+  if (finished && !heat_uploaded_ && reference_->hasErrors()) {
+    wipe_->uploadHeat(reference_->heatRgba());
+    heat_uploaded_ = true;
+  }
+  wipe_->present(renderer_->colorTexture(), ob.width, ob.height, wipe_x_ * ob.width, overlay_ && heat_uploaded_);
+}
+
+void Viewer::pointerPress(double x, double y) {
+  const bool on_line = reference_ && std::abs(x - wipe_x_ * double(ls_.scene.observer.width)) <= kWipeGrabPx;
+  drag_ = on_line ? Drag::Wipe : Drag::Look;
+  last_x_ = x;
+  last_y_ = y;
+}
+
+void Viewer::pointerMove(double x, double y) {
+  if (drag_ == Drag::Look)
+    turnHead(pose_, -radians(kLookDegPerPixel * (x - last_x_)), -radians(kLookDegPerPixel * (y - last_y_)));
+  else if (drag_ == Drag::Wipe)
+    wipe_x_ = std::clamp(x / double(std::max(1, ls_.scene.observer.width)), 0.0, 1.0);
+  last_x_ = x;
+  last_y_ = y;
 }
 
 void Viewer::onKey(int key, int action, int mods) {
@@ -293,6 +360,24 @@ void Viewer::onKey(int key, int action, int mods) {
     case GLFW_KEY_3: setMode(RenderMode::Impostor); break;
     case GLFW_KEY_4: setMode(RenderMode::Raster); break;
     case GLFW_KEY_TAB: show_panel_ = !show_panel_; break;
+    case GLFW_KEY_T:
+      reference_requested_ = true;
+      break;
+    case GLFW_KEY_J:
+      pending_yaw_rad_ -= turn;
+      break;
+    case GLFW_KEY_L:
+      pending_yaw_rad_ += turn;
+      break;
+    case GLFW_KEY_K:
+      pending_pitch_rad_ -= turn;
+      break;
+    case GLFW_KEY_I:
+      pending_pitch_rad_ += turn;
+      break;
+    case GLFW_KEY_E:
+      overlay_ = !overlay_;
+      break;
     case GLFW_KEY_F12: pending_screenshots_.push_back("out/view-" + std::to_string(++saved_) + ".png"); break;
     case GLFW_KEY_V: saveViewTo("out/view-" + std::to_string(++saved_) + ".json"); break;
     case GLFW_KEY_ESCAPE: quit_ = true; break;
@@ -312,6 +397,34 @@ void Viewer::run() {
     frame();
   }
   if (!pending_screenshots_.empty() || !panel_screenshots_.empty()) frame();  // asked for on the last frame
+  if (reference_ && !reference_->finished()) discardReference("cancelled: the window closed");
+}
+
+json Viewer::referenceStats() const {
+  std::string state = "none";
+  if (reference_)
+    state = reference_->finished() ? "done" : "tracing";
+  else if (references_started_ > 0)
+    state = reference_note_.substr(0, reference_note_.find(':'));  // cancelled, discarded, failed
+  json j = {{"state", state},
+            {"note", reference_note_},
+            {"started", references_started_},
+            // Starting costs one frame of the mode drawn with seen points (the first time, its programs built too).
+            {"start_ms", reference_start_ms_},
+            {"frames_while_tracing", frames_while_tracing_},
+            {"frame_ms_max_while_tracing", frame_ms_max_while_tracing_}};
+  j["wipe_x"] = wipe_x_;
+  j["overlay"] = overlay_;
+  if (!reference_ || !reference_->finished()) return j;
+  j["threads"] = reference_->threads();
+  j["trace_ms"] = reference_->traceMs();
+  if (reference_->hasErrors()) {
+    const ErrorStats& st = reference_->stats();
+    j["pixels"] = st.pixels;
+    j["angular_error_arcmin"] = {{"median", st.median_arcmin}, {"p95", st.p95_arcmin}, {"max", st.max_arcmin}};
+    j["heat_map_scale_arcmin"] = reference_->scaleArcmin();
+  }
+  return j;
 }
 
 json Viewer::stats() const {
@@ -330,10 +443,15 @@ json Viewer::stats() const {
             {"panel", t.empty() ? 0.0 : median(panel_ms_)},
             {"swap", t.empty() ? 0.0 : median(swap_ms_)}}},
           {"size", {design_.width, design_.height}},
+          {"reference", referenceStats()},
+          {"lens_probe", probeStats()},
+          // Rebuilds of the scene after the first (a "set", a panel setting, a turned element), and the slowest
+          // one's time (ms; the renderer's first frame after it, with its programs, is in frame_ms_max).
+          {"rebuilds", scene_builds_ - 1},
+          {"rebuild_ms_max", rebuild_ms_max_},
           {"gl", glName()}};
 }
 
-}  // namespace
 }  // namespace view
 
 int cmdView(const std::vector<std::string>& argv) {
@@ -360,6 +478,15 @@ int cmdView(const std::vector<std::string>& argv) {
     }
   }
   const SceneDesc desc = pvrr::loadScene(scene_path, overrides);
+  for (const view::ScriptEvent& e : script.events) {
+    if (e.kind != view::EventKind::TurnElement && e.kind != view::EventKind::MoveElement) continue;
+    std::vector<std::string> names;
+    for (const ElementDesc& el : desc.elements) names.push_back(el.name);
+    if (std::find(names.begin(), names.end(), e.element) != names.end()) continue;
+    const std::string hint = nearest(e.element, names);
+    throw Error(script_path + ": " + e.where + ".element: " + scene_path + " has no element named \"" + e.element +
+                "\"" + (hint.empty() ? std::string() : "; did you mean \"" + hint + "\"?"));
+  }
   const auto size = a.getSize("size");
   const int width = size ? size->first : script.width ? script.width : desc.observer.image_width;
   const int height = size ? size->second : script.height ? script.height : desc.observer.image_height;

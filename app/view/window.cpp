@@ -24,11 +24,6 @@ void onGlfwError(int code, const char* text) { g_glfw_error = std::string(text) 
 // (pvrr/base/image.h) over the 65536 values of the renderer's 16-bit target (a float target is rounded to them
 // first: at most 1/131070 off, under 0.03 of a code). The table is exact where pow() in the shader was not, and
 // cheaper on llvmpipe (docs/method.md "Measurements behind the design").
-constexpr const char* kPresentVs = R"(#version 330 core
-void main() {
-  vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
-  gl_Position = vec4(2.0 * p - 1.0, 0.0, 1.0);
-})";
 constexpr const char* kPresentFs = R"(#version 330 core
 uniform sampler2D u_frame;
 uniform sampler2D u_srgb;  // 256 x 256 R8: texel (k & 255, k >> 8) holds the code of k / 65535
@@ -42,7 +37,7 @@ void main() {
   out_color = vec4(encode(c.r), encode(c.g), encode(c.b), 1.0);
 })";
 
-GLuint compile(GLenum kind, const char* source) {
+GLuint compile(GLenum kind, const char* source, const std::string& what) {
   const GLuint s = glCreateShader(kind);
   glShaderSource(s, 1, &source, nullptr);
   glCompileShader(s);
@@ -51,7 +46,7 @@ GLuint compile(GLenum kind, const char* source) {
   if (!ok) {
     char log[1024] = {};
     glGetShaderInfoLog(s, sizeof log, nullptr, log);
-    throw Error(std::string("pvrr view: the present shader does not compile: ") + log);
+    throw Error("pvrr view: the " + what + " program does not compile: " + log);
   }
   return s;
 }
@@ -72,6 +67,30 @@ GLFWwindow* openWindow(int width, int height, int api, const std::string& title)
 }
 
 }  // namespace
+
+const char* const kFullScreenVs = R"(#version 330 core
+void main() {
+  vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
+  gl_Position = vec4(2.0 * p - 1.0, 0.0, 1.0);
+})";
+
+unsigned buildProgram(const char* vertex_source, const char* fragment_source, const std::string& what) {
+  const GLuint vs = compile(GL_VERTEX_SHADER, vertex_source, what),
+               fs = compile(GL_FRAGMENT_SHADER, fragment_source, what);
+  const GLuint program = glCreateProgram();
+  glAttachShader(program, vs);
+  glAttachShader(program, fs);
+  glLinkProgram(program);
+  glDeleteShader(vs);
+  glDeleteShader(fs);
+  GLint ok = 0;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    glDeleteProgram(program);
+    throw Error("pvrr view: the " + what + " program does not link");
+  }
+  return program;
+}
 
 WindowGl parseWindowGl(const std::string& name) {
   if (name == "auto") return WindowGl::Auto;
@@ -116,16 +135,7 @@ Window::Window(int width, int height, WindowGl api, bool vsync, const std::strin
   fc.get_proc_address = glfwGetProcAddress;
   context_ = gl::GlContext::adopt(std::move(fc));
 
-  const GLuint vs = compile(GL_VERTEX_SHADER, kPresentVs), fs = compile(GL_FRAGMENT_SHADER, kPresentFs);
-  program_ = glCreateProgram();
-  glAttachShader(program_, vs);
-  glAttachShader(program_, fs);
-  glLinkProgram(program_);
-  glDeleteShader(vs);
-  glDeleteShader(fs);
-  GLint ok = 0;
-  glGetProgramiv(program_, GL_LINK_STATUS, &ok);
-  if (!ok) throw Error("pvrr view: the present program does not link");
+  program_ = buildProgram(kFullScreenVs, kPresentFs, "present");
   glGenVertexArrays(1, &vao_);
   std::vector<std::uint8_t> table(65536);
   for (size_t k = 0; k < table.size(); ++k) table[k] = linearToSrgb8(double(float(k) / 65535.0f));

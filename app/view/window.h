@@ -18,6 +18,14 @@ enum class WindowGl { Auto, Glx, Egl };
 // "auto" | "glx" | "egl"; throws pvrr::Error listing the choices otherwise.
 WindowGl parseWindowGl(const std::string& name);
 
+// Compiles and links a GL program of a vertex and a fragment shader in the current context; throws pvrr::Error
+// "pvrr view: the WHAT program does not compile: LOG" (or link).
+unsigned buildProgram(const char* vertex_source, const char* fragment_source, const std::string& what);
+
+// The present pass's full-screen triangle (gl_VertexID 0..2, no attributes): a vertex shader for any pass
+// that draws every pixel of the window once.
+extern const char* const kFullScreenVs;
+
 class Window {
  public:
   // Opens a width x height window (framebuffer pixels). `vsync`: swap interval 1, else 0 (scripted runs, which
@@ -40,6 +48,11 @@ class Window {
   // The back buffer's pixels (after present and before swap), rows top-down.
   ImageRGB8 readBackBuffer(int width, int height) const;
   void swapAndPoll();
+  // The present pass's sRGB table (256 x 256 R8: texel (k & 255, k >> 8) holds linearToSrgb8(k / 65535)), for
+  // passes that present the frame as present() does.
+  unsigned srgbTable() const { return srgb_table_; }
+  // An empty vertex array object of this context, for full-screen passes.
+  unsigned emptyVertexArray() const { return vao_; }
 
  private:
   GLFWwindow* window_ = nullptr;

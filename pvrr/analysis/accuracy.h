@@ -59,6 +59,16 @@ ErrorStats summarizeErrors(const std::vector<double>& errors_arcmin, const std::
 ErrorStats compareToReference(const Frame& ref, const Frame& frame, std::vector<double>* errors_arcmin = nullptr,
                               int only_element = -1);
 
+// The error heat maps' colour of x in [0, 1] (clamped): a perceptually ordered black-body-like ramp, black -> red
+// -> yellow -> white, linear in each third. What `pvrr compare` writes (MODE-error.png) and `pvrr view` overlays.
+inline Vec3 errorHeatColour(double x) {
+  x = x < 0 ? 0 : x > 1 ? 1 : x;
+  auto ramp = [](double v) { return v < 0 ? 0.0 : v > 1 ? 1.0 : v; };
+  return Vec3(ramp(3 * x), ramp(3 * x - 1), ramp(3 * x - 2));
+}
+// The heat map's full-scale error (arcmin): 1.5 x the p95, at least 1 arcmin.
+inline double heatMapScaleArcmin(const ErrorStats& s) { return s.p95_arcmin * 1.5 > 1.0 ? s.p95_arcmin * 1.5 : 1.0; }
+
 // The squared sRGB difference of two linear colours (each channel clamped to [0, 1], then encoded), summed over
 // R, G and B.
 double srgbSquaredError(const Vec3& a, const Vec3& b);

@@ -50,9 +50,38 @@ TEST(ViewScript, ReadsEveryEventInFrameOrder) {
   EXPECT_EQ(s.events[5].where, "events[0]");
 }
 
+TEST(ViewScript, ReadsTheReferenceEvents) {
+  const Script s = parseScript(R"({"events": [
+      {"at_frame": 1, "do": "reference"},
+      {"at_frame": 2, "do": "wipe", "x": 0.25},
+      {"at_frame": 3, "do": "overlay", "on": true},
+      {"at_frame": 4, "do": "drag", "button": "left", "from": [10, 20], "to": [30.5, 40]},
+      {"at_frame": 5, "do": "cursor", "at": [7, 8.5]},
+      {"at_frame": 6, "do": "turn_element", "element": "m", "yaw_deg": 2}]})",
+                               "s.json");
+  ASSERT_EQ(s.events.size(), 6u);
+  EXPECT_EQ(s.events[4].kind, EventKind::Cursor);
+  EXPECT_EQ(s.events[4].at_px, Vec2(7, 8.5));
+  EXPECT_EQ(s.events[5].kind, EventKind::TurnElement);
+  EXPECT_EQ(s.events[5].element, "m");
+  EXPECT_EQ(s.events[5].yaw_deg, 2);
+  EXPECT_EQ(s.events[5].pitch_deg, 0);
+  EXPECT_EQ(s.events[0].kind, EventKind::Reference);
+  EXPECT_EQ(s.events[1].kind, EventKind::Wipe);
+  EXPECT_EQ(s.events[1].wipe_x, 0.25);
+  EXPECT_EQ(s.events[2].kind, EventKind::Overlay);
+  EXPECT_TRUE(s.events[2].on);
+  EXPECT_EQ(s.events[3].kind, EventKind::Drag);
+  EXPECT_EQ(s.events[3].from_px, Vec2(10, 20));
+  EXPECT_EQ(s.events[3].to_px, Vec2(30.5, 40));
+}
+
 TEST(ViewScript, ErrorsNameTheFileAndTheJsonPath) {
   EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "teleport"}]})"),
-            "s.json: events[0].do: expected one of key, move_eye, quit, save_view, screenshot, set, turn_head, got \"teleport\"");
+            "s.json: events[0].do: expected one of cursor, drag, key, move_element, move_eye, overlay, quit, "
+            "reference, save_view, "
+            "screenshot, "
+            "set, turn_element, turn_head, wipe, got \"teleport\"");
   EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "quit"}, {"at_frame": -1, "do": "quit"}]})"),
             "s.json: events[1].at_frame: expected a frame number >= 0, got -1");
   EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "turn_head", "yaw_dg": 3}]})"),
@@ -62,9 +91,14 @@ TEST(ViewScript, ErrorsNameTheFileAndTheJsonPath) {
   EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "screenshot", "file": "a.jpg"}]})"),
             "s.json: events[0].file: expected a file name ending in \".png\", got \"a.jpg\"");
   EXPECT_EQ(errorOf(R"({"size": [320], "events": []})"), "s.json: size: expected [width, height] in pixels, got [320]");
-  EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "wipe", "x": 0.5}]})"),
-            "s.json: events[0].do: \"wipe\" is not implemented yet (implemented: key, move_eye, quit, save_view, "
-            "screenshot, set, turn_head)");
+  EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "wipe", "x": 1.5}]})"),
+            "s.json: events[0].x: expected a number from 0 (all reference) to 1 (all mode), got 1.5");
+  EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "overlay", "on": 1}]})"),
+            "s.json: events[0].on: expected true or false, got 1");
+  EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "drag", "from": [1, 2], "to": [3]}]})"),
+            "s.json: events[0].to: expected [x, y] in window pixels, got [3]");
+  EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "drag", "button": "middle", "from": [1, 2], "to": [3, 4]}]})"),
+            "s.json: events[0].button: expected \"left\", got \"middle\"");
   EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "key", "key": "HOM"}]})").substr(0, 32),
             "s.json: events[0].key: expected ");
   EXPECT_NE(errorOf(R"({"events": [{"at_frame": 1, "do": "key", "key": "HOM"}]})").find("did you mean \"HOME\"?"),
@@ -91,6 +125,16 @@ TEST(ViewScript, CommandRefusesABadScriptWithOneLine) {
   EXPECT_EQ(s.code, 1);
   EXPECT_EQ(s.err.find(script + ": events[0]: models/car-mirror.json: render.map_size"), 0u) << s.err;
   EXPECT_EQ(std::count(s.err.begin(), s.err.end(), '\n'), 1) << s.err;
+  // turn_element names an element of the scene.
+  {
+    std::ofstream(script)
+        << R"({"events": [{"at_frame": 0, "do": "turn_element", "element": "door-miror", "yaw_deg": 1}]})";
+  }
+  const test::CliResult t = test::runPvrr("view --script '" + script + "'");
+  EXPECT_EQ(t.code, 1);
+  EXPECT_EQ(t.err, script +
+                       ": events[0].element: models/car-mirror.json has no element named \"door-miror\"; did you "
+                       "mean \"door-mirror\"?\n");
   std::filesystem::remove_all(dir);
 }
 

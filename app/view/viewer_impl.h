@@ -1,0 +1,185 @@
+// The viewer's state and loop (app/view/viewer.cpp) and its panel (app/view/viewer_panel.cpp): internal to
+// `pvrr view`, shared by those two files only.
+#pragma once
+#define GLFW_INCLUDE_NONE  // no GL header: the viewer itself makes no GL call
+#include <GLFW/glfw3.h>
+
+#include <chrono>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "app/commands.h"
+#include "app/view/head.h"
+#include "app/view/lens_probe.h"
+#include "app/view/reference_tiles.h"
+#include "app/view/script.h"
+#include "app/view/window.h"
+#include "app/view/wipe.h"
+
+namespace pvrr::app::view {
+
+using Clock = std::chrono::steady_clock;
+using nlohmann::json;
+
+// Eye steps (metres) and head turns (degrees) of one key press; Shift multiplies by kFast.
+inline constexpr double kEyeStepM = 0.01, kTurnStepDeg = 1.0, kFast = 10.0;
+// Mouse-look: degrees of head turn per pixel of drag.
+inline constexpr double kLookDegPerPixel = 0.1;
+// A left-button press within this many pixels of the wipe's split line drags the line, not the head.
+inline constexpr double kWipeGrabPx = 8;
+// The panel's step of moving an element (metres).
+inline constexpr double kMoveStepM = 0.001;
+
+// What a reference belongs to: the view it traced. Any change (the head, the eye, the window's size, the mode,
+// a setting, which rebuilds the scene) makes it another view's reference, and it is discarded.
+struct ViewKey {
+  Vec3 eye{0}, target{0}, up{0};
+  int width = 0, height = 0;
+  RenderMode mode = RenderMode::Pvrr;
+  int scene_build = 0;
+  bool operator==(const ViewKey& o) const {
+    return eye == o.eye && target == o.target && up == o.up && width == o.width && height == o.height &&
+           mode == o.mode && scene_build == o.scene_build;
+  }
+};
+
+class Viewer {
+ public:
+  Viewer(Window& window, std::string scene_path, std::vector<std::string> overrides, std::optional<RenderMode> mode,
+         int width, int height, std::string script_path, Script script)
+      : window_(window),
+        scene_path_(std::move(scene_path)),
+        overrides_(std::move(overrides)),
+        cli_mode_(mode),
+        width_(width),
+        height_(height),
+        script_path_(std::move(script_path)),
+        script_(std::move(script)) {
+    glfwSetWindowUserPointer(window_.handle(), this);
+    glfwSetKeyCallback(window_.handle(), [](GLFWwindow* w, int key, int, int action, int mods) {
+      static_cast<Viewer*>(glfwGetWindowUserPointer(w))->onKey(key, action, mods);
+    });
+    rebuild();
+  }
+  ~Viewer() {
+    reference_.reset();               // cancels a running trace and joins its threads
+    window_.context().makeCurrent();  // GL objects go while their context is current
+    wipe_.reset();
+    seen_renderer_.reset();
+    renderer_.reset();
+    glfwSetKeyCallback(window_.handle(), nullptr);
+  }
+
+  void run();
+  json stats() const;
+  json referenceStats() const;
+
+ private:
+  // Loads and builds the scene with overrides_. `keep_mode`: the mode shown stays (a setting or a turned element),
+  // else it is the command line's or the scene's.
+  void rebuild(bool keep_mode = false);
+  // Element `index` turned about its vertex (app/view/element_pose.h): its pose written as overrides, rebuilt.
+  void turnElement(int index, double yaw_rad, double pitch_rad);
+  // Element `index` moved by `by_m` in its own frame (x right, y up, z along its normal), rebuilt likewise.
+  void moveElement(int index, const Vec3& by_m);
+  int elementIndex(const std::string& name) const;
+  void elementsPanel();
+  void planningLines(const gl::RasterFrame& f);
+  void lensPanel();
+  json probeStats() const;
+  void runEvents();
+  void frame();
+  void panel(const gl::RasterFrame& f, double frame_ms);
+  void onKey(int key, int action, int mods);
+  const Observer& updateObserver();
+  ViewKey viewKey() const {
+    const Observer& ob = ls_.scene.observer;
+    return {ob.eye, ob.target, ob.up, ob.width, ob.height, mode_, scene_builds_};
+  }
+  // The live reference: startReference traces the current view in the background (and draws the mode's frame
+  // of it once with seen points, for the errors); discardReference cancels or drops it, saying why.
+  void startReference();
+  void discardReference(const std::string& why);
+  void presentFrame(const Observer& ob);
+  void referencePanel();
+  // The pointer's path, shared by the mouse and the script's drag: a left-button press (not over the panel), moves
+  // while held, release.
+  void pointerPress(double x, double y);
+  void pointerMove(double x, double y);
+  void pointerRelease() { drag_ = Drag::None; }
+  void setMode(RenderMode m) {
+    if (m == mode_) return;
+    mode_ = m;
+    cache_ = gl::FrameCache{};  // the cache holds the last mode's maps
+  }
+  void screenshot(const std::string& file);
+  void saveViewTo(const std::string& file);
+  std::string glName() const { return window_.context().backendName() + " (" + window_.context().glRenderer() + ")"; }
+
+  Window& window_;
+  std::string scene_path_;
+  std::vector<std::string> overrides_;  // --set, then the script's "set" events
+  std::optional<RenderMode> cli_mode_;
+  int width_, height_;
+  std::string script_path_;
+  Script script_;
+  size_t next_event_ = 0;
+  int waited_frames_ = 0;  // frames drawn while the script waited for a reference
+
+  LoadedScene ls_;
+  Observer design_;  // the scene's observer: the design eye point
+  HeadPose pose_;
+  RenderMode mode_ = RenderMode::Pvrr;
+  bool any_attached_ = false;
+  std::unique_ptr<RayScene> rays_;
+  std::unique_ptr<gl::Renderer> renderer_;
+  gl::FrameCache cache_;
+
+  bool quit_ = false, show_panel_ = true;
+  std::vector<std::string> pending_screenshots_, panel_screenshots_;
+  int frames_ = 0, saved_ = 0;
+  std::vector<double> frame_ms_;  // every frame, for --stats
+  // Where each frame's time went: the renderer's frame, presenting it, the panel, the swap and input.
+  std::vector<double> render_ms_, present_ms_, panel_ms_, swap_ms_;
+  std::deque<double> recent_ms_;  // the last frames, for the panel
+  enum class Drag { None, Look, Wipe };
+  Drag drag_ = Drag::None;
+  bool mouse_down_ = false;
+  double last_x_ = 0, last_y_ = 0;
+
+  int scene_builds_ = 0;
+  double rebuild_ms_max_ = 0;  // the slowest rebuild after the first (a setting, a turned element)
+  // The lens probe (scenes with a lens): the pixel under the cursor (the mouse when it moves, or a script's
+  // "cursor"), read again when that pixel or the view changes.
+  bool has_lens_ = false;
+  bool probe_asked_ = false, cursor_seen_ = false;
+  int probe_x_ = 0, probe_y_ = 0;
+  double cursor_x_ = 0, cursor_y_ = 0;
+  LensProbe probe_;
+  bool probe_fresh_ = false;
+  ViewKey probe_key_;
+  int selected_ = 0;  // the element the panel and the keys I/K/J/L turn
+  // Changes asked for by the panel or the keys, applied at the next frame (not inside the panel's frame).
+  std::vector<std::string> pending_overrides_;
+  double pending_yaw_rad_ = 0, pending_pitch_rad_ = 0;
+  Vec3 pending_move_m_{0};
+  std::unique_ptr<gl::Renderer> seen_renderer_;  // the mode's frame with seen points, for the reference's errors
+  std::unique_ptr<ReferenceRun> reference_;
+  std::unique_ptr<Wipe> wipe_;
+  ViewKey reference_key_;
+  bool reference_requested_ = false;  // by key or panel: started at the next frame
+  bool waiting_reference_ = false;    // a script's "reference" event: later events wait for it
+  bool heat_uploaded_ = false;
+  double wipe_x_ = 0.5;  // the split line: 0 all reference, 1 all mode
+  bool overlay_ = false;
+  std::string reference_note_;  // why there is no reference now (cancelled, discarded)
+  int references_started_ = 0, frames_while_tracing_ = 0;
+  double frame_ms_max_while_tracing_ = 0, reference_start_ms_ = 0;
+};
+
+}  // namespace pvrr::app::view

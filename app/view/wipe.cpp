@@ -1,0 +1,130 @@
+#include "app/view/wipe.h"
+
+#include "pvrr/gl/gl.h"  // glad first
+
+#include "app/view/window.h"
+
+namespace pvrr::app::view {
+namespace {
+
+// The mode's frame encoded as Window::present encodes it (its sRGB table); the reference and heat map are
+// 8-bit codes already, stored top-down (flipped here: GL's rows are bottom-up).
+constexpr const char* kWipeFs = R"(#version 330 core
+uniform sampler2D u_frame;
+uniform sampler2D u_srgb;
+uniform sampler2D u_reference;
+uniform sampler2D u_heat;
+uniform int u_split;
+uniform int u_overlay;
+uniform int u_height;
+out vec4 out_color;
+const float kOverlayDim = 0.4;  // the frame under the overlay where there is no error to show
+float encode(float c) {
+  int k = int(clamp(c, 0.0, 1.0) * 65535.0 + 0.5);
+  return texelFetch(u_srgb, ivec2(k & 255, k >> 8), 0).r;
+}
+void main() {
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  ivec2 q = ivec2(p.x, u_height - 1 - p.y);
+  vec3 c = texelFetch(u_frame, p, 0).rgb;
+  vec3 mode = vec3(encode(c.r), encode(c.g), encode(c.b));
+  vec3 outc;
+  if (p.x >= u_split) {
+    vec4 r = texelFetch(u_reference, q, 0);
+    outc = r.a > 0.5 ? r.rgb : 0.5 * mode;
+  } else if (u_overlay != 0) {
+    vec4 h = texelFetch(u_heat, q, 0);
+    outc = h.a > 0.5 ? h.rgb : kOverlayDim * mode;
+  } else {
+    outc = mode;
+  }
+  if (p.x == u_split - 1 && u_split < textureSize(u_frame, 0).x) outc = vec3(1.0);
+  out_color = vec4(outc, 1.0);
+})";
+
+unsigned makeTexture(int width, int height) {
+  GLuint t = 0;
+  glGenTextures(1, &t);
+  glBindTexture(GL_TEXTURE_2D, t);
+  const std::vector<std::uint8_t> zero(size_t(width) * size_t(height) * 4, 0);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, zero.data());
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  return t;
+}
+
+}  // namespace
+
+Wipe::Wipe(Window& window) : window_(window) { program_ = buildProgram(kFullScreenVs, kWipeFs, "wipe"); }
+
+Wipe::~Wipe() {
+  window_.context().makeCurrent();
+  glDeleteProgram(program_);
+  if (reference_) glDeleteTextures(1, &reference_);
+  if (heat_) glDeleteTextures(1, &heat_);
+}
+
+void Wipe::reset(int width, int height) {
+  if (reference_) glDeleteTextures(1, &reference_);
+  if (heat_) glDeleteTextures(1, &heat_);
+  width_ = width;
+  height_ = height;
+  reference_ = makeTexture(width, height);
+  heat_ = makeTexture(width, height);
+  gl::checkGlError("creating the wipe's textures");
+}
+
+void Wipe::uploadTiles(const std::vector<TileRect>& tiles, const std::vector<std::uint8_t>& rgba) {
+  if (tiles.empty()) return;
+  glBindTexture(GL_TEXTURE_2D, reference_);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, width_);
+  for (const TileRect& t : tiles) {
+    glPixelStorei(GL_UNPACK_SKIP_PIXELS, t.x0);
+    glPixelStorei(GL_UNPACK_SKIP_ROWS, t.y0);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, t.x0, t.y0, t.x1 - t.x0, t.y1 - t.y0, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+  }
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+  glPixelStorei(GL_UNPACK_SKIP_PIXELS, 0);
+  glPixelStorei(GL_UNPACK_SKIP_ROWS, 0);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  gl::checkGlError("uploading the reference's tiles");
+}
+
+void Wipe::uploadHeat(const std::vector<std::uint8_t>& rgba) {
+  glBindTexture(GL_TEXTURE_2D, heat_);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+  glBindTexture(GL_TEXTURE_2D, 0);
+  gl::checkGlError("uploading the error heat map");
+}
+
+void Wipe::present(unsigned frame, int width, int height, double split_px, bool overlay) {
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glViewport(0, 0, width, height);
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_BLEND);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_SCISSOR_TEST);
+  glDisable(GL_FRAMEBUFFER_SRGB);
+  glUseProgram(program_);
+  const unsigned textures[4] = {frame, window_.srgbTable(), reference_, heat_};
+  const char* names[4] = {"u_frame", "u_srgb", "u_reference", "u_heat"};
+  for (int k = 0; k < 4; ++k) {
+    glActiveTexture(GLenum(GL_TEXTURE0 + k));
+    glBindTexture(GL_TEXTURE_2D, textures[k]);
+    glUniform1i(glGetUniformLocation(program_, names[k]), k);
+  }
+  glActiveTexture(GL_TEXTURE0);
+  glUniform1i(glGetUniformLocation(program_, "u_split"), int(split_px + 0.5));
+  glUniform1i(glGetUniformLocation(program_, "u_overlay"), overlay ? 1 : 0);
+  glUniform1i(glGetUniformLocation(program_, "u_height"), height);
+  glBindVertexArray(window_.emptyVertexArray());
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glBindVertexArray(0);
+  gl::checkGlError("presenting the wipe");
+}
+
+}  // namespace pvrr::app::view
