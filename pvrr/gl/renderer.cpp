@@ -67,7 +67,7 @@ struct Renderer::Impl {
   MeshPool meshes;
   ElementGridCache grid_cache;
   int max_texture_size = 0, max_texture_units = 0;
-  GlLimits limits;  // queryGlLimits, with the first context()
+  GlLimits limits;                            // queryGlLimits, with the first context()
   std::unique_ptr<Framebuffer> frame_target;  // the second pass: colour, seen point, surface point
   // The passes of each mode (made with the renderer; each compiles its programs when a frame first needs them).
   RasterPass raster_pass;
@@ -132,7 +132,8 @@ RasterFrame Renderer::Impl::render(RenderMode mode, FrameCache* cache) {
   out.width = ob.width;
   out.height = ob.height;
   // Every texture and target of the frame against the GL's limits and memory before anything is drawn.
-  checkMapLimits(scene, mode, {options.map_size, options.seen_points, options.lens_height_map_size, options.surface_map_size},
+  checkMapLimits(scene, mode,
+                 {options.map_size, options.seen_points, options.lens_height_map_size, options.surface_map_size},
                  limits);
   meshes.rewind();
   ModePass& pass = passFor(mode);

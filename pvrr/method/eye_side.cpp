@@ -45,8 +45,9 @@ void applyEyeSide(const Scene& scene, ElementFrame& f) {
   f.quality.note = eyeSideNote(scene, f);
   const Element& el = scene.elements[size_t(f.element)];
   if (el.type != ElementType::Lens || f.quality.note.empty()) return;
-  f.quality.note += ": pvrr mode's vertex rays enter a lens through its front surface, so the patches seen from "
-                    "behind are drawn from the reference tracer's colours at their vertices";
+  f.quality.note +=
+      ": pvrr mode's vertex rays enter a lens through its front surface, so the patches seen from "
+      "behind are drawn from the reference tracer's colours at their vertices";
   int marked = 0;
   for (PatchView& pv : f.views) {
     if (!pv.in_view) continue;
@@ -55,8 +56,8 @@ void applyEyeSide(const Scene& scene, ElementFrame& f) {
       back += (f.in_view.empty() || f.in_view[vi] == 2) && lensSeenFromBehind(el, f, vi);
     if (back == 0) continue;
     pv.quality.verdict = QualityVerdict::kFallback;
-    pv.quality.reasons += std::string(pv.quality.reasons.empty() ? "" : "; ") + "the eye is behind the lens's front surface at " +
-                          std::to_string(back) + " seen vertices";
+    pv.quality.reasons += std::string(pv.quality.reasons.empty() ? "" : "; ") +
+                          "the eye is behind the lens's front surface at " + std::to_string(back) + " seen vertices";
     pv.quality.action = "flagged";
     ++marked;
   }

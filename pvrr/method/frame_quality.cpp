@@ -199,7 +199,8 @@ int applyTracedFallback(const RayScene& rays, ElementFrame& f, int max_depth) {
         r.traced_seen = t.seen;
         return;
       }
-      if (r.status == VertexStatus::Tir || max_depth <= 0) return;  // Tir: already the tracer's answer along the incoming ray
+      if (r.status == VertexStatus::Tir || max_depth <= 0)
+        return;  // Tir: already the tracer's answer along the incoming ray
       // Started an epsilon along the ray, so that its first event is not the surface it leaves.
       const TraceResult t = tracer.trace(r.origin + eps * r.dir, r.dir, wl);
       r.traced = true;

@@ -44,7 +44,8 @@ std::string gib(double bytes) {
 }
 
 bool usesMaps(const Scene& scene, RenderMode mode) {
-  return !scene.elements.empty() && (mode == RenderMode::Pvrr || mode == RenderMode::Envmap || mode == RenderMode::Impostor);
+  return !scene.elements.empty() &&
+         (mode == RenderMode::Pvrr || mode == RenderMode::Envmap || mode == RenderMode::Impostor);
 }
 
 // The first GL limit a map of side `map_size` exceeds ("" when none).
@@ -84,8 +85,10 @@ int largestFitting(const Scene& scene, RenderMode mode, const MapSizeSettings& s
   if (hi < lo || !fits(scene, mode, s, lo, g)) return 0;
   while (lo < hi) {  // fits(lo), and memory and limits grow with the size
     const int mid = lo + (hi - lo + 1) / 2;
-    if (fits(scene, mode, s, mid, g)) lo = mid;
-    else hi = mid - 1;
+    if (fits(scene, mode, s, mid, g))
+      lo = mid;
+    else
+      hi = mid - 1;
   }
   return lo;
 }
@@ -111,8 +114,9 @@ void checkMapLimits(const Scene& scene, RenderMode mode, const MapSizeSettings& 
     return std::any_of(scene.elements.begin(), scene.elements.end(), [t](const Element& el) { return el.type == t; });
   };
   if (mode == RenderMode::Impostor)
-    for (const auto& [side, what] : {std::pair{any(ElementType::Lens) ? settings.lens_height_map_size : 0, "lens height maps"},
-                                     std::pair{any(ElementType::Mirror) ? settings.surface_map_size : 0, "mirror surface maps"}})
+    for (const auto& [side, what] :
+         {std::pair{any(ElementType::Lens) ? settings.lens_height_map_size : 0, "lens height maps"},
+          std::pair{any(ElementType::Mirror) ? settings.surface_map_size : 0, "mirror surface maps"}})
       if (side > limits.max_texture_size)
         throw Error(name + ": impostor mode's " + what + " of " + std::to_string(side) +
                     " texels exceed this GL's GL_MAX_TEXTURE_SIZE " + std::to_string(limits.max_texture_size));
@@ -126,7 +130,8 @@ void checkMapLimits(const Scene& scene, RenderMode mode, const MapSizeSettings& 
   if (!over.empty()) throw Error(setting + over + advice());
   const double need = mapMemoryBytes(scene, mode, settings);
   if (!(limits.memory_bytes > 0) || need <= limits.memory_bytes) return;
-  const std::string budget = ", over the memory budget of " + gib(limits.memory_bytes) + " (" + limits.memory_source + ")";
+  const std::string budget =
+      ", over the memory budget of " + gib(limits.memory_bytes) + " (" + limits.memory_source + ")";
   if (!usesMaps(scene, mode))
     throw Error(name + ": observer.image_size " + std::to_string(ob.width) + " x " + std::to_string(ob.height) +
                 ": the frame's targets need " + gib(need) + budget);

@@ -14,19 +14,19 @@
 namespace pvrr {
 
 struct GlLimits {
-  int max_texture_size = 0;        // GL_MAX_TEXTURE_SIZE
-  int max_cube_map_size = 0;       // GL_MAX_CUBE_MAP_TEXTURE_SIZE
-  int max_renderbuffer_size = 0;   // GL_MAX_RENDERBUFFER_SIZE
-  double memory_bytes = 0;         // the budget for the frame's textures and targets; <= 0: not checked
-  std::string memory_source;       // where the budget comes from, for the message (e.g. "PVRR_GPU_MEMORY_MB")
+  int max_texture_size = 0;       // GL_MAX_TEXTURE_SIZE
+  int max_cube_map_size = 0;      // GL_MAX_CUBE_MAP_TEXTURE_SIZE
+  int max_renderbuffer_size = 0;  // GL_MAX_RENDERBUFFER_SIZE
+  double memory_bytes = 0;        // the budget for the frame's textures and targets; <= 0: not checked
+  std::string memory_source;      // where the budget comes from, for the message (e.g. "PVRR_GPU_MEMORY_MB")
 };
 
 // The sizes a frame's allocations follow, besides the scene's (RendererOptions' fields of the same names).
 struct MapSizeSettings {
-  int map_size = 0;               // pvrr: a top-level map's texture side; envmap, impostor: the cube face side
-  bool seen_points = true;        // seen-point attachments in every pass
-  int lens_height_map_size = 0;   // impostor: a lens's refractor height maps (longer side)
-  int surface_map_size = 0;       // impostor: a mirror's surface maps
+  int map_size = 0;              // pvrr: a top-level map's texture side; envmap, impostor: the cube face side
+  bool seen_points = true;       // seen-point attachments in every pass
+  int lens_height_map_size = 0;  // impostor: a lens's refractor height maps (longer side)
+  int surface_map_size = 0;      // impostor: a mirror's surface maps
 };
 
 // The bytes of GPU memory a frame of `mode` needs at least at `map_size`: the second pass's target

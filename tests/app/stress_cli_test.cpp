@@ -23,7 +23,9 @@ using pvrr::test::runPvrr;
 
 class StressCli : public ::testing::Test {
  protected:
-  void SetUp() override { dir_ = pvrr::test::freshTestDir(::testing::UnitTest::GetInstance()->current_test_info()->name()); }
+  void SetUp() override {
+    dir_ = pvrr::test::freshTestDir(::testing::UnitTest::GetInstance()->current_test_info()->name());
+  }
   void TearDown() override { fs::remove_all(dir_); }
 
   std::string write(const std::string& name, const std::string& text) const {
@@ -38,7 +40,8 @@ class StressCli : public ::testing::Test {
                             std::initializer_list<std::string> outputs) {
     EXPECT_EQ(r.code, 1) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "expected one line, got:\n" << r.err;
-    for (const std::string& p : parts) EXPECT_NE(r.err.find(p), std::string::npos) << "no \"" << p << "\" in: " << r.err;
+    for (const std::string& p : parts)
+      EXPECT_NE(r.err.find(p), std::string::npos) << "no \"" << p << "\" in: " << r.err;
     for (const std::string& o : outputs) EXPECT_FALSE(fs::exists(o)) << o;
   }
 
@@ -74,10 +77,12 @@ TEST_F(StressCli, MapSizeBeyondTheMemoryBudgetIsRefusedBeforeAnyPass) {
   // pvrr: one 4096^2 map of colour and depth (20 B a texel: 320 MiB); envmap: a 2048^2 cube (6 x 8 B + 4 B).
   const CliResult pvrr = runPvrr("render '" + scene + "' --gl osmesa --set render.map_size=4096 --out '" + out +
                                  "' --stats '" + stats + "'");
-  expectRefusal(pvrr, {"maps.json: render.map_size 4096: pvrr mode needs at least 320", "memory budget of 64 MiB (PVRR_GPU_MEMORY_MB)",
-                       "the largest render.map_size that fits is "},
+  expectRefusal(pvrr,
+                {"maps.json: render.map_size 4096: pvrr mode needs at least 320",
+                 "memory budget of 64 MiB (PVRR_GPU_MEMORY_MB)", "the largest render.map_size that fits is "},
                 {out, stats});
-  const CliResult envmap = runPvrr("render '" + scene + "' --gl osmesa --mode envmap --set render.map_size=2048 --out '" + out + "'");
+  const CliResult envmap =
+      runPvrr("render '" + scene + "' --gl osmesa --mode envmap --set render.map_size=2048 --out '" + out + "'");
   expectRefusal(envmap, {"maps.json: render.map_size 2048: envmap mode needs at least"}, {out});
   const CliResult fits = runPvrr("render '" + scene + "' --gl osmesa --set render.map_size=1024 --out '" + out + "'");
   ::unsetenv("PVRR_GPU_MEMORY_MB");
@@ -88,13 +93,15 @@ TEST_F(StressCli, MapSizeBeyondTheMemoryBudgetIsRefusedBeforeAnyPass) {
 TEST_F(StressCli, TheLargestMapSizeTheRefusalAdvisesRenders) {
   const std::string scene = write("maps.json", kMirrorScene), out = path("out.png");
   ::setenv("PVRR_GPU_MEMORY_MB", "40", 1);
-  const CliResult refused = runPvrr("render '" + scene + "' --gl osmesa --set render.map_size=2048 --out '" + out + "'");
+  const CliResult refused =
+      runPvrr("render '" + scene + "' --gl osmesa --set render.map_size=2048 --out '" + out + "'");
   const size_t at = refused.err.find("fits is ");
   ASSERT_NE(at, std::string::npos) << refused.err;
   const int best = std::atoi(refused.err.c_str() + at + 8);
   EXPECT_GT(best, 1024);
   EXPECT_LT(best, 2048);
-  const CliResult ok = runPvrr("render '" + scene + "' --gl osmesa --set render.map_size=" + std::to_string(best) + " --out '" + out + "'");
+  const CliResult ok = runPvrr("render '" + scene + "' --gl osmesa --set render.map_size=" + std::to_string(best) +
+                               " --out '" + out + "'");
   ::unsetenv("PVRR_GPU_MEMORY_MB");
   EXPECT_EQ(ok.code, 0) << ok.err;
 }
@@ -116,7 +123,8 @@ TEST_F(StressCli, EyeBehindAMirrorIsExplainedAndDrawnAsTheReference) {
                     stats = path("stats.json");
   const CliResult r = runPvrr("render '" + scene + "' --gl osmesa --out '" + out + "' --stats '" + stats + "'");
   ASSERT_EQ(r.code, 0) << r.err;
-  const std::string note = "the eye is behind mirror 'left' (its back side faces the eye): nothing is reflected toward it";
+  const std::string note =
+      "the eye is behind mirror 'left' (its back side faces the eye): nothing is reflected toward it";
   EXPECT_NE(r.out.find("note: " + note), std::string::npos) << r.out;
   EXPECT_NE(pvrr::test::slurp(stats).find(note), std::string::npos);
   ASSERT_EQ(runPvrr("render '" + scene + "' --mode raytrace --out '" + ref + "'").code, 0);
@@ -131,10 +139,13 @@ TEST_F(StressCli, EyeBehindAMirrorIsExplainedAndDrawnAsTheReference) {
 // picture was garbage (PSNR 1.5 dB against the reference, exit 0, verdict good).
 TEST_F(StressCli, EyeBehindALensIsFlaggedAndDrawnFromTheTracer) {
   const std::string sets = " --set 'observer.eye=[0,0.85,0.06]' --set 'observer.target=[0,1.25,0.3]' --size 96x72";
-  const std::string out = path("pvrr.png"), ref = path("ref.png"), front = path("front.png"), front_ref = path("front-ref.png");
+  const std::string out = path("pvrr.png"), ref = path("ref.png"), front = path("front.png"),
+                    front_ref = path("front-ref.png");
   const CliResult r = runPvrr("render models/reading-lens.json --gl osmesa --out '" + out + "'" + sets);
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.out.find("note: the eye is behind lens 'reading-lens' (its back surface faces the eye)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("note: the eye is behind lens 'reading-lens' (its back surface faces the eye)"),
+            std::string::npos)
+      << r.out;
   EXPECT_NE(r.out.find("quality: reading-lens fallback"), std::string::npos) << r.out;
   ASSERT_EQ(runPvrr("render models/reading-lens.json --mode raytrace --out '" + ref + "'" + sets).code, 0);
   const double behind = meanCodeDifference(out, ref);
@@ -150,9 +161,11 @@ TEST_F(StressCli, EyeBehindALensIsFlaggedAndDrawnFromTheTracer) {
 TEST_F(StressCli, LensSurfacesThatCrossOrTouchAreRefusedNamingTheElement) {
   const std::string out = path("out.png");
   // The reading lens's edge is 1.57 mm thick at 5 mm in the centre: at 3 mm its surfaces cross near the rim.
-  expectRefusal(runPvrr("render models/reading-lens.json --gl osmesa --set elements[0].centre_thickness=0.003 --out '" + out + "'"),
-                {"reading-lens.json: elements[0] (reading-lens): the surfaces cross or touch inside the outline: thickness -"},
-                {out});
+  expectRefusal(
+      runPvrr("render models/reading-lens.json --gl osmesa --set elements[0].centre_thickness=0.003 --out '" + out +
+              "'"),
+      {"reading-lens.json: elements[0] (reading-lens): the surfaces cross or touch inside the outline: thickness -"},
+      {out});
   // A meniscus whose front is more curved than its back: at 1 mm in the centre, the thickness 1 mm - r^2 / 0.4 m
   // reaches 0 at r = 20 mm, between the centre and the 30 mm rim.
   const std::string meniscus = write("meniscus.json", R"({
@@ -169,8 +182,10 @@ TEST_F(StressCli, LensSurfacesThatCrossOrTouchAreRefusedNamingTheElement) {
                 {"meniscus.json: elements[0] (thin): the surfaces cross or touch inside the outline"}, {out});
   // Touching at the rim: 2 (R - sqrt(R^2 - r^2)) = 3.4260252 mm of sag at R 0.46787 m, r 40 mm leaves the
   // surfaces 4e-12 m apart across the rim (a contact, as far as any lens tolerance goes).
-  expectRefusal(runPvrr("render models/reading-lens.json --gl osmesa --set elements[0].centre_thickness=0.0034260252 --out '" + out + "'"),
-                {"reading-lens.json: elements[0] (reading-lens): the surfaces cross or touch inside the outline"}, {out});
+  expectRefusal(
+      runPvrr("render models/reading-lens.json --gl osmesa --set elements[0].centre_thickness=0.0034260252 --out '" +
+              out + "'"),
+      {"reading-lens.json: elements[0] (reading-lens): the surfaces cross or touch inside the outline"}, {out});
 }
 
 }  // namespace

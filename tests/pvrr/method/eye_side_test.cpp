@@ -37,7 +37,8 @@ TEST(EyeSide, PlaneMirrorFromTheFrontHasNoNote) {
 
 TEST(EyeSide, EyeBehindAPlaneMirrorIsExplained) {
   // The mirror hangs at z = -1.99 facing +z; the eye 1 m behind it, looking at its back.
-  const Scene s = test::shippedScene("plane-mirror", {"observer.eye=[0.2, 1.5, -3]", "observer.target=[0, 1.4, -1.99]"});
+  const Scene s =
+      test::shippedScene("plane-mirror", {"observer.eye=[0.2, 1.5, -3]", "observer.target=[0, 1.4, -1.99]"});
   const RayScene rays(s);
   const ElementFrame f = frameFromEye(s, rays);
   const EyeSide side = eyeSide(f);
@@ -55,7 +56,8 @@ TEST(EyeSide, EyeInTheMirrorsPlaneSeesPartOfItsBack) {
   const Scene s = test::shippedScene("car-mirror");
   ASSERT_EQ(s.elements[0].type, ElementType::Mirror);
   ElementFrame f = prepareElement(s, 0);
-  const Vec3 centre = Vec3(s.elements[0].local_to_world[3]), n = glm::normalize(f.world_normal[f.world_normal.size() / 2]);
+  const Vec3 centre = Vec3(s.elements[0].local_to_world[3]),
+             n = glm::normalize(f.world_normal[f.world_normal.size() / 2]);
   // Just in front of the mirror's centre tangent plane, far to one side: the rim curving back is seen from behind.
   Vec3 side = glm::normalize(glm::cross(n, Vec3(0, 1, 0)));
   f.eye = centre + 1e-3 * n + 0.5 * side;
@@ -64,16 +66,18 @@ TEST(EyeSide, EyeInTheMirrorsPlaneSeesPartOfItsBack) {
   EXPECT_LT(e.back, e.seen);
   const std::string note = eyeSideNote(s, f);
   EXPECT_NE(note.find("the eye sees the back side of mirror '"), std::string::npos) << note;
-  EXPECT_NE(note.find(std::to_string(e.back) + " of " + std::to_string(e.seen) + " seen vertices"), std::string::npos) << note;
+  EXPECT_NE(note.find(std::to_string(e.back) + " of " + std::to_string(e.seen) + " seen vertices"), std::string::npos)
+      << note;
 }
 
 TEST(EyeSide, LensFromBehindFallsBackToTheTracerAlongTheEyesRays) {
-  const Scene s = test::shippedScene("reading-lens", {"observer.eye=[0, 0.85, 0.06]", "observer.target=[0, 1.25, 0.3]",
-                                                      "render.dispersion=\"off\""});
+  const Scene s = test::shippedScene(
+      "reading-lens", {"observer.eye=[0, 0.85, 0.06]", "observer.target=[0, 1.25, 0.3]", "render.dispersion=\"off\""});
   const RayScene rays(s);
   ElementFrame f = frameFromEye(s, rays);
   EXPECT_EQ(f.quality.verdict, QualityVerdict::kFallback);
-  EXPECT_NE(f.quality.note.find("the eye is behind lens 'reading-lens' (its back surface faces the eye)"), std::string::npos)
+  EXPECT_NE(f.quality.note.find("the eye is behind lens 'reading-lens' (its back surface faces the eye)"),
+            std::string::npos)
       << f.quality.note;
   ASSERT_GT(applyTracedFallback(rays, f, s.render.max_depth - 2), 0);
   // Each traced vertex colour is the reference's along the eye's ray through the vertex.

@@ -77,8 +77,10 @@ TEST(MapLimits, CubeAboveTheCubeLimitIsRefusedInCubeModesOnly) {
   EXPECT_EQ(refusal(s, RenderMode::Pvrr, {1024, true, 512, 512}, g), "");  // 2D maps: not bound by it
   g.max_renderbuffer_size = 512;  // the cube's depth buffer, the pvrr map's depth texture target
   const Scene small = test::shippedScene("plane-mirror", {"observer.image_size=[320, 240]"});
-  EXPECT_NE(refusal(small, RenderMode::Envmap, {800, true, 512, 512}, g).find("GL_MAX_RENDERBUFFER_SIZE 512"), std::string::npos);
-  EXPECT_NE(refusal(small, RenderMode::Pvrr, {1024, true, 512, 512}, g).find("GL_MAX_RENDERBUFFER_SIZE 512"), std::string::npos);
+  EXPECT_NE(refusal(small, RenderMode::Envmap, {800, true, 512, 512}, g).find("GL_MAX_RENDERBUFFER_SIZE 512"),
+            std::string::npos);
+  EXPECT_NE(refusal(small, RenderMode::Pvrr, {1024, true, 512, 512}, g).find("GL_MAX_RENDERBUFFER_SIZE 512"),
+            std::string::npos);
 }
 
 TEST(MapLimits, MemoryBeyondTheBudgetIsRefusedWithTheLargestSizeThatFits) {
@@ -105,13 +107,16 @@ TEST(MapLimits, FrameTargetsAloneBeyondTheLimitsNameTheImageSize) {
   const Scene s = test::shippedScene("plane-mirror");
   GlLimits g = roomyLimits();
   g.max_renderbuffer_size = 700;  // the 800 x 600 image's depth target
-  EXPECT_NE(refusal(s, RenderMode::Raster, {1024, true, 512, 512}, g).find("plane-mirror.json: observer.image_size 800 x 600: "),
+  EXPECT_NE(refusal(s, RenderMode::Raster, {1024, true, 512, 512}, g)
+                .find("plane-mirror.json: observer.image_size 800 x 600: "),
             std::string::npos);
   g = roomyLimits();
   g.memory_bytes = 1e6;  // less than the frame's own targets: no map size helps
-  EXPECT_NE(refusal(s, RenderMode::Pvrr, {1024, true, 512, 512}, g).find("no render.map_size fits (lower observer.image_size)"),
+  EXPECT_NE(refusal(s, RenderMode::Pvrr, {1024, true, 512, 512}, g)
+                .find("no render.map_size fits (lower observer.image_size)"),
             std::string::npos);
-  EXPECT_NE(refusal(s, RenderMode::Raster, {1024, true, 512, 512}, g).find("observer.image_size 800 x 600: the frame's targets need"),
+  EXPECT_NE(refusal(s, RenderMode::Raster, {1024, true, 512, 512}, g)
+                .find("observer.image_size 800 x 600: the frame's targets need"),
             std::string::npos);
 }
 
