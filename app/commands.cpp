@@ -110,6 +110,8 @@ json patchQualityJson(const PatchQuality& q) {
 
 void printQuality(const json& elements, const std::string& prefix) {
   for (const json& e : elements) {
+    if (e.contains("quality") && !e["quality"].value("note", "").empty())
+      std::printf("%snote: %s\n", prefix.c_str(), e["quality"]["note"].get<std::string>().c_str());
     if (!e.contains("quality") || e["quality"]["verdict"] == "good") continue;
     std::string line = prefix + "quality: " + e["name"].get<std::string>() + " " + e["quality"]["verdict"].get<std::string>() +
                        ": " + e["quality"]["action"].get<std::string>();
@@ -160,7 +162,7 @@ json elementsJson(const Scene& scene, const std::vector<ElementFrame>& frames) {
                          {"quality", patchQualityJson(pv.quality)}});
     }
     e["patches"] = patches;
-    e["quality"] = {{"verdict", toString(f.quality.verdict)}, {"action", f.quality.action}};
+    e["quality"] = {{"verdict", toString(f.quality.verdict)}, {"action", f.quality.action}, {"note", f.quality.note}};
     out.push_back(e);
   }
   return out;

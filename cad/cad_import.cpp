@@ -52,10 +52,16 @@
 #include <TopoDS_Wire.hxx>
 #include <gp_Pnt2d.hxx>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
@@ -520,6 +526,56 @@ ImportedModel importIges(const std::string& path) {
 
 }  // namespace
 
+// OpenCASCADE's STEP and IGES readers crash on some malformed files (fuzz findings, tests/fuzz/corpus/cad/
+// finding-*: a STEP list with a broken reference leaves a null entity that the transfer dereferences; an IGES
+// B-spline whose counts do not match its data crashes the parser itself), where no check of ours can run
+// first. So the import runs once in a child process: when the child dies (a signal, or any exit but
+// "imported" or "refused with a pvrr::Error"), the file is refused with one line; otherwise the import runs
+// again here, where a refusal gives its own message. Costs one more read of the file (milliseconds for
+// a lens or mirror face). The child restores the default crash signals (a sanitizer's handler would turn a
+// crash into an ordinary exit) and leaves with _exit (no atexit handlers, no stdio buffers flushed twice).
+static void requireImportSurvives(const std::string& path, bool step) {
+  std::fflush(nullptr);
+  const pid_t child = ::fork();
+  if (child < 0) return;  // no process to spare: import in-process, as before
+  if (child == 0) {
+    for (int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) std::signal(sig, SIG_DFL);
+    int code = 4;
+    try {
+      (void)(step ? importStep(path) : importIges(path));
+      code = 0;
+    } catch (const Error&) {
+      code = 3;
+    } catch (const Standard_Failure&) {
+      code = 3;
+    } catch (...) {
+    }
+    ::_exit(code);
+  }
+  // A child that never ends (a reader stuck on a lock another thread held at the fork) must not hang the
+  // import: after kChildSeconds it is killed and the import runs in-process, as without the child.
+  constexpr double kChildSeconds = 120;
+  int status = 0;
+  for (double waited = 0;; waited += 2e-3) {
+    const pid_t r = ::waitpid(child, &status, WNOHANG);
+    if (r == child || (r < 0 && errno != EINTR)) break;
+    if (waited > kChildSeconds) {
+      ::kill(child, SIGKILL);
+      while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
+      }
+      return;
+    }
+    ::usleep(2000);
+  }
+  const std::string format = step ? "STEP" : "IGES";
+  if (WIFSIGNALED(status))
+    throw Error(path + ": not a valid " + format + " file: OpenCASCADE's reader crashed on it (" +
+                ::strsignal(WTERMSIG(status)) + ")");
+  if (!WIFEXITED(status) || (WEXITSTATUS(status) != 0 && WEXITSTATUS(status) != 3))
+    throw Error(path + ": not a valid " + format + " file: OpenCASCADE's reader failed on it (exit status " +
+                std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")");
+}
+
 ImportedModel importCadFile(const std::string& path) {
   const std::string ext = lower(fs::path(path).extension().string());
   const bool step = ext == ".step" || ext == ".stp";
@@ -529,6 +585,7 @@ ImportedModel importCadFile(const std::string& path) {
   std::lock_guard<std::mutex> lock(occt::translationMutex());
   occt::silence();
   try {
+    requireImportSurvives(path, step);
     return step ? importStep(path) : importIges(path);
   } catch (const Standard_Failure& f) {
     throw Error(path + ": OpenCASCADE failed to read the file (" + occt::failureMessage(f) + ")");

@@ -2,6 +2,8 @@
 // OSMesa specifics are in context_egl.cpp and context_osmesa.cpp.
 #include "pvrr/gl/context.h"
 
+#include <unistd.h>
+
 #include <cstdlib>
 #include <functional>
 #include <sstream>
@@ -35,7 +37,56 @@ bool containsSoftwareRasteriser(const std::string& renderer) {
   return false;
 }
 
+bool hasExtension(const char* name) {
+  GLint n = 0;
+  glGetIntegerv(GL_NUM_EXTENSIONS, &n);
+  for (GLint i = 0; i < n; ++i) {
+    const GLubyte* e = glGetStringi(GL_EXTENSIONS, GLuint(i));
+    if (e && std::string(reinterpret_cast<const char*>(e)) == name) return true;
+  }
+  return false;
+}
+
+// The memory budget of queryGlLimits and where it comes from.
+void memoryBudget(GlLimits& g) {
+  if (const char* env = std::getenv("PVRR_GPU_MEMORY_MB"); env && *env) {
+    char* end = nullptr;
+    const double mb = std::strtod(env, &end);
+    if (end == env || *end != '\0' || !(mb > 0) || !(mb < 1e12))
+      throw Error(std::string("PVRR_GPU_MEMORY_MB: expected a positive number of MiB, got \"") + env + "\"");
+    g.memory_bytes = mb * 1024.0 * 1024.0;
+    g.memory_source = "PVRR_GPU_MEMORY_MB";
+    return;
+  }
+  constexpr GLenum kNvxCurrentAvailableKb = 0x9049, kAtiTextureFreeKb = 0x87FC;
+  GLint kb[4] = {0, 0, 0, 0};
+  if (hasExtension("GL_NVX_gpu_memory_info")) {
+    glGetIntegerv(kNvxCurrentAvailableKb, kb);
+    g.memory_source = "the free video memory GL_NVX_gpu_memory_info reports; PVRR_GPU_MEMORY_MB sets it";
+  } else if (hasExtension("GL_ATI_meminfo")) {
+    glGetIntegerv(kAtiTextureFreeKb, kb);
+    g.memory_source = "the free texture memory GL_ATI_meminfo reports; PVRR_GPU_MEMORY_MB sets it";
+  }
+  while (glGetError() != GL_NO_ERROR) {
+  }
+  if (kb[0] > 0) {
+    g.memory_bytes = double(kb[0]) * 1024.0;
+    return;
+  }
+  g.memory_bytes = 0.75 * double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
+  g.memory_source = "three quarters of the machine's memory; PVRR_GPU_MEMORY_MB sets it";
+}
+
 }  // namespace
+
+GlLimits queryGlLimits() {
+  GlLimits g;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &g.max_texture_size);
+  glGetIntegerv(GL_MAX_CUBE_MAP_TEXTURE_SIZE, &g.max_cube_map_size);
+  glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &g.max_renderbuffer_size);
+  memoryBudget(g);
+  return g;
+}
 
 GlBackend parseGlBackend(const std::string& name) {
   if (name == "auto") return GlBackend::Auto;

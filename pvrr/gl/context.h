@@ -10,6 +10,8 @@
 #include <memory>
 #include <string>
 
+#include "pvrr/method/map_limits.h"
+
 namespace pvrr::gl {
 
 namespace detail {
@@ -90,5 +92,13 @@ class GlContext {
   int gl_major_ = 0, gl_minor_ = 0;
   bool is_hardware_ = false;
 };
+
+// The current context's limits on map sizes (pvrr/method/map_limits.h): GL_MAX_TEXTURE_SIZE,
+// GL_MAX_CUBE_MAP_TEXTURE_SIZE, GL_MAX_RENDERBUFFER_SIZE, and the memory budget: the environment variable
+// PVRR_GPU_MEMORY_MB when set (a positive number of MiB; anything else throws pvrr::Error naming it), else the
+// free video memory the GL reports (GL_NVX_gpu_memory_info, GL_ATI_meminfo), else three quarters of the
+// machine's memory (a software rasteriser's textures live there; a GPU that reports nothing shares it or has
+// less, so the check refuses only what cannot fit).
+GlLimits queryGlLimits();
 
 }  // namespace pvrr::gl

@@ -15,6 +15,7 @@
 #include "pvrr/gl/cube_pass.h"
 #include "pvrr/gl/gl.h"
 #include "pvrr/gl/pvrr_pass.h"
+#include "pvrr/method/map_limits.h"
 
 namespace pvrr::gl {
 
@@ -66,6 +67,7 @@ struct Renderer::Impl {
   MeshPool meshes;
   ElementGridCache grid_cache;
   int max_texture_size = 0, max_texture_units = 0;
+  GlLimits limits;                            // queryGlLimits, with the first context()
   std::unique_ptr<Framebuffer> frame_target;  // the second pass: colour, seen point, surface point
   // The passes of each mode (made with the renderer; each compiles its programs when a frame first needs them).
   RasterPass raster_pass;
@@ -80,6 +82,7 @@ struct Renderer::Impl {
     if (!max_texture_size) {
       glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture_size);
       glGetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &max_texture_units);
+      limits = queryGlLimits();
     }
     return {scene, rays, options, programs, environment, meshes, grid_cache, max_texture_size, max_texture_units};
   }
@@ -128,6 +131,10 @@ RasterFrame Renderer::Impl::render(RenderMode mode, FrameCache* cache) {
   RasterFrame out;
   out.width = ob.width;
   out.height = ob.height;
+  // Every texture and target of the frame against the GL's limits and memory before anything is drawn.
+  checkMapLimits(scene, mode,
+                 {options.map_size, options.seen_points, options.lens_height_map_size, options.surface_map_size},
+                 limits);
   meshes.rewind();
   ModePass& pass = passFor(mode);
   // The CPU stages and the first passes (and the nested passes of elements seen in other elements' maps).

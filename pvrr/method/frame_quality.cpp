@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "pvrr/method/eye_side.h"
 #include "pvrr/method/vertex_stage.h"
 #include "pvrr/trace/tracer.h"
 
@@ -167,7 +168,8 @@ std::array<int, 2> refinedGridSize(const ElementFrame& f, int max_vertices, cons
 }
 
 int applyTracedFallback(const RayScene& rays, ElementFrame& f, int max_depth) {
-  if (max_depth <= 0) return 0;
+  const Element& el = rays.scene().elements[size_t(f.element)];
+  const auto from_eye = [&](uint32_t vi) { return f.tir_trace_depth > 0 && lensSeenFromBehind(el, f, vi); };
   std::vector<uint32_t> vertices;
   std::vector<PatchView*> patches;
   for (PatchView& pv : f.views)
@@ -179,16 +181,26 @@ int applyTracedFallback(const RayScene& rays, ElementFrame& f, int max_depth) {
   if (patches.empty()) return 0;
   std::sort(vertices.begin(), vertices.end());
   vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
-  TraceOptions to;
+  if (max_depth <= 0 && !std::any_of(vertices.begin(), vertices.end(), from_eye)) return 0;
+  TraceOptions to, eye_to;
   to.max_depth = max_depth;
-  const Tracer tracer(rays, to);
+  eye_to.max_depth = f.tir_trace_depth;
+  const Tracer tracer(rays, to), eye_tracer(rays, eye_to);
   const double eps = rays.epsilon();
   for (size_t c = 0; c < f.rays.size(); ++c) {
     const double wl =
         c < f.channels.size() && f.channels[c].wavelength_nm > 0 ? f.channels[c].wavelength_nm : kLineD_nm;
     tbb::parallel_for(size_t(0), vertices.size(), [&](size_t k) {
       VertexRay& r = f.rays[c][vertices[k]];
-      if (r.status == VertexStatus::Tir) return;  // already the tracer's answer along the incoming ray
+      if (from_eye(vertices[k])) {  // the whole path from the eye: its first event is the lens's back
+        const TraceResult t = eye_tracer.trace(f.eye, glm::normalize(f.world_pos[vertices[k]] - f.eye), wl);
+        r.traced = true;
+        r.traced_color = t.color;
+        r.traced_seen = t.seen;
+        return;
+      }
+      if (r.status == VertexStatus::Tir || max_depth <= 0)
+        return;  // Tir: already the tracer's answer along the incoming ray
       // Started an epsilon along the ray, so that its first event is not the surface it leaves.
       const TraceResult t = tracer.trace(r.origin + eps * r.dir, r.dir, wl);
       r.traced = true;

@@ -54,6 +54,9 @@ struct PatchQuality {
 struct ElementQuality {
   QualityVerdict verdict = QualityVerdict::kGood;  // the worst of its seen patches
   std::string action;                              // the element's split, if any, and the patch actions
+  // What the viewer should know besides the verdict, in the user's terms (pvrr/method/eye_side.h: the eye
+  // behind a mirror or a lens); "" when nothing.
+  std::string note;
 };
 
 struct FrameQualityLimits {
@@ -91,8 +94,10 @@ void assessFrameQuality(ElementFrame& f, const FrameQualityLimits& limits = {});
 // the tracer's colour along its outgoing ray (a mirror: what the map would show there, before the mirror's
 // reflectance, which the shader applies; a lens: the light that leaves its back surface, times the
 // transmittance) and the seen point, and PatchView::draw_traced is set. max_depth: the events the tracer may
-// take from the outgoing ray; <= 0 leaves the patches flagged but drawn from their maps. Returns the number
-// of patches drawn traced.
+// take from the outgoing ray; <= 0 leaves the patches flagged but drawn from their maps. A lens vertex the
+// eye sees from behind (lensSeenFromBehind, pvrr/method/eye_side.h) is traced from f.eye through the vertex
+// instead, with f.tir_trace_depth events: its traced colour is the whole pixel's. Returns the number of
+// patches drawn traced.
 int applyTracedFallback(const RayScene& rays, ElementFrame& f, int max_depth);
 
 }  // namespace pvrr

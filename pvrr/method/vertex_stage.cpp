@@ -7,6 +7,7 @@
 
 #include "pvrr/base/error.h"
 #include "pvrr/base/format.h"
+#include "pvrr/method/eye_side.h"
 #include "pvrr/optics/optics.h"
 #include "pvrr/optics/spectrum.h"
 #include "pvrr/trace/tracer.h"
@@ -505,6 +506,7 @@ void fitPatchViews(const Scene& scene, ElementFrame& f, const VertexStageOptions
   f.patches_u = pu;
   f.patches_v = pv;
   assessFrameQuality(f);
+  applyEyeSide(scene, f);
   f.fit_ms = msSince(t0);
 }
 

@@ -1,0 +1,38 @@
+// Which side of an element the eye sees (issue 26 item 3: the eye on or behind an element, explained in the
+// user's terms). A mirror reflects on its front side only; its back is drawn dark in every mode, as the
+// reference tracer draws it, so an eye behind a mirror sees nothing reflected: the note says why. pvrr mode
+// traces a lens's vertex rays into its front surface; an eye on the lens's back side gets a note and the
+// frame's quality verdict says whether the picture can be trusted.
+#pragma once
+#include <string>
+
+#include "pvrr/scene/scene.h"
+
+namespace pvrr {
+
+struct ElementFrame;
+
+struct EyeSide {
+  int seen = 0;  // vertices the viewer sees (ElementFrame::in_view == 2; all when in_view is empty)
+  int back = 0;  // of those, the vertices whose front surface faces away from the eye: (eye - p) . n < 0
+};
+
+// Over f's seen vertices, as seen from f.eye.
+EyeSide eyeSide(const ElementFrame& f);
+
+// "" when the eye sees the element's front side wherever it sees the element; otherwise one sentence in the
+// user's terms, e.g. "the eye is behind mirror 'left' (its back side faces the eye): nothing is reflected
+// toward it; it is drawn as its dark back, as the reference draws it".
+std::string eyeSideNote(const Scene& scene, const ElementFrame& f);
+
+// After assessFrameQuality, for an element traced from the observer's eye (not a nested frame): sets
+// f.quality.note (eyeSideNote) and, for a lens whose back the eye sees, makes every seen patch that holds such
+// a vertex a fallback patch (its vertex rays entered the front surface from the wrong side: the map would show
+// nothing the lens shows); applyTracedFallback then draws those vertices from the tracer's colour along the
+// eye's ray through them (pvrr/method/frame_quality.h).
+void applyEyeSide(const Scene& scene, ElementFrame& f);
+
+// Whether f's vertex i is a lens vertex whose front surface faces away from f.eye.
+bool lensSeenFromBehind(const Element& el, const ElementFrame& f, size_t i);
+
+}  // namespace pvrr

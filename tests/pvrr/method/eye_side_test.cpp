@@ -1,0 +1,101 @@
+// Which side of an element the eye sees (pvrr/method/eye_side.h): the notes in the user's terms, and a lens
+// seen from behind made a fallback patch drawn from the tracer along the eye's rays.
+#include <gtest/gtest.h>
+
+#include "pvrr/method/eye_side.h"
+#include "pvrr/method/frame_quality.h"
+#include "pvrr/method/pass_plan.h"
+#include "pvrr/method/vertex_stage.h"
+#include "pvrr/trace/ray_scene.h"
+#include "pvrr/trace/tracer.h"
+#include "support/scenes.h"
+
+namespace pvrr {
+namespace {
+
+// Element 0 traced from the observer's eye and fitted, as the renderer's CPU stages do.
+ElementFrame frameFromEye(const Scene& s, const RayScene& rays) {
+  VertexStageOptions o;
+  o.channels = dispersionChannels(s, 0);
+  o.tir_trace_depth = s.render.max_depth;
+  o.viewer_clip = s.observer.visibilityProjection() * s.observer.view();
+  ElementFrame f = prepareElement(s, 0);
+  traceVertexRays(rays, f, s.observer.eye, o);
+  fitPatchViews(s, f, o);
+  return f;
+}
+
+TEST(EyeSide, PlaneMirrorFromTheFrontHasNoNote) {
+  const Scene s = test::shippedScene("plane-mirror");
+  const RayScene rays(s);
+  const ElementFrame f = frameFromEye(s, rays);
+  const EyeSide side = eyeSide(f);
+  EXPECT_GT(side.seen, 0);
+  EXPECT_EQ(side.back, 0);
+  EXPECT_EQ(f.quality.note, "");
+}
+
+TEST(EyeSide, EyeBehindAPlaneMirrorIsExplained) {
+  // The mirror hangs at z = -1.99 facing +z; the eye 1 m behind it, looking at its back.
+  const Scene s =
+      test::shippedScene("plane-mirror", {"observer.eye=[0.2, 1.5, -3]", "observer.target=[0, 1.4, -1.99]"});
+  const RayScene rays(s);
+  const ElementFrame f = frameFromEye(s, rays);
+  const EyeSide side = eyeSide(f);
+  EXPECT_GT(side.seen, 0);
+  EXPECT_EQ(side.back, side.seen);
+  EXPECT_EQ(f.quality.note.rfind("the eye is behind mirror '", 0), 0u) << f.quality.note;
+  EXPECT_NE(f.quality.note.find("(its back side faces the eye): nothing is reflected toward it"), std::string::npos);
+  // The picture is the mirror's dark back in every mode, as traced: nothing to flag.
+  EXPECT_EQ(f.quality.verdict, QualityVerdict::kGood);
+}
+
+TEST(EyeSide, EyeInTheMirrorsPlaneSeesPartOfItsBack) {
+  // A convex mirror curves away from its plane: an eye beside it, a little in front of the plane, sees the front
+  // of the near part and the back of the far part.
+  const Scene s = test::shippedScene("car-mirror");
+  ASSERT_EQ(s.elements[0].type, ElementType::Mirror);
+  ElementFrame f = prepareElement(s, 0);
+  const Vec3 centre = Vec3(s.elements[0].local_to_world[3]),
+             n = glm::normalize(f.world_normal[f.world_normal.size() / 2]);
+  // Just in front of the mirror's centre tangent plane, far to one side: the rim curving back is seen from behind.
+  Vec3 side = glm::normalize(glm::cross(n, Vec3(0, 1, 0)));
+  f.eye = centre + 1e-3 * n + 0.5 * side;
+  const EyeSide e = eyeSide(f);
+  EXPECT_GT(e.back, 0);
+  EXPECT_LT(e.back, e.seen);
+  const std::string note = eyeSideNote(s, f);
+  EXPECT_NE(note.find("the eye sees the back side of mirror '"), std::string::npos) << note;
+  EXPECT_NE(note.find(std::to_string(e.back) + " of " + std::to_string(e.seen) + " seen vertices"), std::string::npos)
+      << note;
+}
+
+TEST(EyeSide, LensFromBehindFallsBackToTheTracerAlongTheEyesRays) {
+  const Scene s = test::shippedScene(
+      "reading-lens", {"observer.eye=[0, 0.85, 0.06]", "observer.target=[0, 1.25, 0.3]", "render.dispersion=\"off\""});
+  const RayScene rays(s);
+  ElementFrame f = frameFromEye(s, rays);
+  EXPECT_EQ(f.quality.verdict, QualityVerdict::kFallback);
+  EXPECT_NE(f.quality.note.find("the eye is behind lens 'reading-lens' (its back surface faces the eye)"),
+            std::string::npos)
+      << f.quality.note;
+  ASSERT_GT(applyTracedFallback(rays, f, s.render.max_depth - 2), 0);
+  // Each traced vertex colour is the reference's along the eye's ray through the vertex.
+  TraceOptions to;
+  to.max_depth = s.render.max_depth;
+  const Tracer tracer(rays, to);
+  int checked = 0;
+  for (size_t i = 0; i < f.world_pos.size(); i += 37) {
+    if (!f.in_view.empty() && f.in_view[i] != 2) continue;
+    const VertexRay& r = f.rays[0][i];
+    ASSERT_TRUE(r.traced) << i;
+    const TraceResult t = tracer.trace(s.observer.eye, glm::normalize(f.world_pos[i] - s.observer.eye), kLineD_nm);
+    EXPECT_LT(glm::length(r.traced_color - t.color), 1e-12) << i;
+    EXPECT_EQ(t.first_element, 0) << i;  // the eye's ray meets the lens (its back) first
+    ++checked;
+  }
+  EXPECT_GT(checked, 5);
+}
+
+}  // namespace
+}  // namespace pvrr
