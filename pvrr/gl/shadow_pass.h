@@ -43,7 +43,7 @@ std::vector<std::string> shadowDefines(const Scene& scene);
 class ShadowPass {
  public:
   // The map side (texels) of every layer.
-  static constexpr int kMapSize = 2048;
+  static constexpr int kMapSize = 1024;
 
   // The maps' units are the last three of `max_texture_units` (GL_MAX_TEXTURE_IMAGE_UNITS), as
   // GL_TEXTURE_2D_ARRAY bindings, which no other program of the renderer samples there.
