@@ -29,8 +29,11 @@ constexpr double kFaceMarginTexels = 4;
 // (shaders/shadow_lookup.glsl).
 constexpr float kOffsetFactor = 2.0f, kOffsetUnits = 4.0f;
 
+// The tangent of each point-light face's half angle.
+constexpr double kFaceTanHalf = 1.0 + 2.0 * kFaceMarginTexels / ShadowPass::kMapSize;
+
 // The six axis directions of a point light's maps, in the shader's face order (+x, -x, +y, -y, +z, -z), and
-// an up vector for each.
+// an up vector for each (shaders/shadow_lookup.glsl pointFace projects with them in closed form).
 const Vec3 kFaceAxis[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
 const Vec3 kFaceUp[6] = {{0, 1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}, {0, 1, 0}, {0, 1, 0}};
 
@@ -110,7 +113,7 @@ void ShadowPass::makeLayers() {
                         (c & 4) ? scene_.bounds_max.z : scene_.bounds_min.z);
       far_m = std::max(far_m, 1.01 * glm::length(corner - l.position) + 1e-3);
     }
-    const double tan_half = 1.0 + 2.0 * kFaceMarginTexels / kMapSize;
+    const double tan_half = kFaceTanHalf;
     for (int f = 0; f < 6; ++f) {
       Layer layer;
       layer.origin = l.position;
@@ -118,6 +121,8 @@ void ShadowPass::makeLayers() {
       layer.proj = glm::perspective(2.0 * std::atan(tan_half), 1.0, kPointNear_m, far_m);
       layer.texel_m = 2.0 * tan_half / kMapSize;  // at unit distance along the face's axis
       layer.perspective = true;
+      layer.near_m = kPointNear_m;
+      layer.far_m = far_m;
       layers_.push_back(layer);
     }
   }
@@ -242,24 +247,29 @@ void ShadowPass::bind(const Program& p, const Vec3& origin) const {
     p.set("u_shadow_lens_t", unit_ + 2);
   }
   glActiveTexture(GL_TEXTURE0);
-  // Each layer's matrix takes points relative to this pass's origin to the light's clip space, folded in
-  // double (camera-relative rendering).
-  std::vector<float> matrices, texels;
-  for (const Layer& layer : layers_) {
-    const glm::mat4 m = toFloat(relativeViewProj(layer.proj, layer.view, origin));
-    matrices.insert(matrices.end(), &m[0][0], &m[0][0] + 16);
-    texels.push_back(float(layer.texel_m));
-  }
-  p.setMat4("u_shadow_matrix", matrices.data(), int(layers_.size()));
-  p.setFloats("u_shadow_texel_m", texels.data(), int(texels.size()));
   p.set("u_shadow_texel", float(1.0 / kMapSize));
+  p.set("u_point_shadow_tan_half", float(kFaceTanHalf));
+  // Per light, in the order of setLights' arrays: its first layer (or -1), and for a directional light its
+  // matrix from points relative to this pass's origin to its clip space, folded in double; for a point light
+  // its maps' near and far distances.
   int dir = 0, point = 0;
   for (size_t i = 0; i < scene_.lights.size(); ++i) {
     const Light& l = scene_.lights[i];
-    if (l.type == Light::Type::Directional)
-      p.set("u_dir_shadow_layer[" + std::to_string(dir++) + "]", layout_.first_layer[i]);
-    else if (l.type == Light::Type::Point)
-      p.set("u_point_shadow_layer[" + std::to_string(point++) + "]", layout_.first_layer[i]);
+    const int first = layout_.first_layer[i];
+    if (l.type == Light::Type::Directional) {
+      const std::string k = "[" + std::to_string(dir++) + "]";
+      p.set("u_dir_shadow_layer" + k, float(first));
+      if (first < 0) continue;
+      const Layer& layer = layers_[size_t(first)];
+      p.set("u_dir_shadow_matrix" + k, toFloat(relativeViewProj(layer.proj, layer.view, origin)));
+      p.set("u_dir_shadow_texel_m" + k, float(layer.texel_m));
+    } else if (l.type == Light::Type::Point) {
+      const std::string k = "[" + std::to_string(point++) + "]";
+      p.set("u_point_shadow_layer" + k, float(first));
+      if (first < 0) continue;
+      const Layer& layer = layers_[size_t(first)];
+      p.set("u_point_shadow_near_far" + k, glm::vec2(float(layer.near_m), float(layer.far_m)));
+    }
   }
 }
 
