@@ -175,7 +175,8 @@ void ShadowPass::update(FrameStages& stages) {
   rendered_poses_ = elementPoses();
   rendered_ = true;
   stages.ran(kShadowMapsStage, msSince(t0), layout_.layers,
-             std::to_string(layout_.layers) + " layers of " + std::to_string(kMapSize) + " x " +
+             std::to_string(layout_.layers) + (layout_.layers == 1 ? " layer of " : " layers of ") +
+                 std::to_string(kMapSize) + " x " +
                  std::to_string(kMapSize) + (layout_.lenses ? ", lens layers beside" : ""));
 }
 
