@@ -89,8 +89,9 @@ const Program& Programs::cubeGeometry(bool lens, bool peel) const {
 
 const Program& Programs::shadowCaster(bool lens) const {
   std::unique_ptr<Program>& p = shadow_casters_[lens];
-  if (!p) p = std::make_unique<Program>("shadow_caster.vert", "shadow_caster.frag",
-                                        lens ? std::vector<std::string>{"#define LENS"} : std::vector<std::string>{});
+  if (!p)
+    p = std::make_unique<Program>("shadow_caster.vert", "shadow_caster.frag",
+                                  lens ? std::vector<std::string>{"#define LENS"} : std::vector<std::string>{});
   return *p;
 }
 

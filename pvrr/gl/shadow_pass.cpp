@@ -61,7 +61,11 @@ std::vector<std::string> shadowDefines(const Scene& scene) {
 
 ShadowPass::ShadowPass(const Scene& scene, const Programs& programs, const EnvironmentPass& environment,
                        int max_texture_units)
-    : scene_(scene), programs_(programs), environment_(environment), layout_(shadowLayout(scene)), unit_(max_texture_units - 3) {
+    : scene_(scene),
+      programs_(programs),
+      environment_(environment),
+      layout_(shadowLayout(scene)),
+      unit_(max_texture_units - 3) {
   if (!active()) return;
   makeLayers();
   makeTextures();
@@ -163,7 +167,8 @@ std::vector<Mat4> ShadowPass::elementPoses() const {
 
 void ShadowPass::update(FrameStages& stages) {
   if (!active()) {
-    stages.skipped(kShadowMapsStage, "no light casts shadows (every directional and point light has \"shadows\": false)");
+    stages.skipped(kShadowMapsStage,
+                   "no light casts shadows (every directional and point light has \"shadows\": false)");
     return;
   }
   if (rendered_ && elementPoses() == rendered_poses_) {
@@ -176,8 +181,8 @@ void ShadowPass::update(FrameStages& stages) {
   rendered_ = true;
   stages.ran(kShadowMapsStage, msSince(t0), layout_.layers,
              std::to_string(layout_.layers) + (layout_.layers == 1 ? " layer of " : " layers of ") +
-                 std::to_string(kMapSize) + " x " +
-                 std::to_string(kMapSize) + (layout_.lenses ? ", lens layers beside" : ""));
+                 std::to_string(kMapSize) + " x " + std::to_string(kMapSize) +
+                 (layout_.lenses ? ", lens layers beside" : ""));
 }
 
 void ShadowPass::render() {

@@ -63,8 +63,8 @@ class ShadowPass {
  private:
   struct Layer {
     Mat4 view{1.0}, proj{1.0};
-    Vec3 origin{0};         // the light camera's origin (camera-relative rendering)
-    double texel_m = 0;     // a texel's size at unit distance (point) or everywhere (directional), metres
+    Vec3 origin{0};      // the light camera's origin (camera-relative rendering)
+    double texel_m = 0;  // a texel's size at unit distance (point) or everywhere (directional), metres
     bool perspective = false;
     double near_m = 0, far_m = 0;  // point: the depth range
   };

@@ -29,9 +29,11 @@ inline Scene shadowScene(const std::string& occluder, const std::string& light, 
     "environment": [
       {"type": "ground", "name": "floor", "point": [0, 0, 0], "normal": [0, 1, 0], "size": [6, 6],
        "material": {"color": [0.7, 0.7, 0.7]}},
-      )" + (occluder == "sphere" ? sphere : quad) + R"(],
+      )" + (occluder == "sphere" ? sphere : quad) +
+                           R"(],
     "lights": [)" + light + R"(, {"type": "ambient", "color": [0.2, 0.2, 0.2]}],
-    "elements": [)" + elements + R"(],
+    "elements": [)" + elements +
+                           R"(],
     "render": {"background": [0, 0, 0]}})";
   Scene s = buildScene(parseScene(text, "shadow-scene", ""));
   s.updateBounds();

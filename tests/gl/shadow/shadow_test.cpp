@@ -38,8 +38,8 @@ struct Agreement {
 // Each pixel whose reference path ends on the ground (y = 0) after `bounces` reflections: in shadow per the
 // reference (shadow ray transmittance below 1/2) and per the raster picture (its light's term, recovered from
 // the colour, below half the unshadowed term).
-Agreement agreement(const Scene& s, const RayScene& rays, const Frame& ref, const gl::RasterFrame& raster,
-                    int bounces, double reflectance, int band = kEdgeBand) {
+Agreement agreement(const Scene& s, const RayScene& rays, const Frame& ref, const gl::RasterFrame& raster, int bounces,
+                    double reflectance, int band = kEdgeBand) {
   const int w = ref.width, h = ref.height;
   const Light& light = s.lights[0];
   const ShadowRays shadow_rays(rays);
@@ -140,11 +140,12 @@ TEST_P(ShadowTest, AShadowSeenInAMirrorAgreesWithTheReference) {
   const Vec3 eye(0, 3.2, 1.6), m(1.1, 0.5, 0.6), shadow_centre(0.35, 0, 0);
   const Vec3 n = glm::normalize(glm::normalize(eye - m) + glm::normalize(shadow_centre - m));
   char mirror[600];
-  std::snprintf(mirror, sizeof mirror,
-                R"({"name": "m", "type": "mirror", "pose": {"position": [%.6f, %.6f, %.6f], "normal": [%.6f, %.6f, %.6f],
+  std::snprintf(
+      mirror, sizeof mirror,
+      R"({"name": "m", "type": "mirror", "pose": {"position": [%.6f, %.6f, %.6f], "normal": [%.6f, %.6f, %.6f],
                 "up": [0, 1, 0]}, "outline": {"shape": "rectangle", "width": 0.8, "height": 0.8},
                 "surface": {"type": "plane"}, "tessellation": 7, "material": {"reflectance": 0.9}})",
-                m.x, m.y, m.z, n.x, n.y, n.z);
+      m.x, m.y, m.z, n.x, n.y, n.z);
   const Scene s = test::shadowScene("sphere", lightJson("directional", Vec3(0.5, -1, 0.2)), mirror, 320, 240);
   RayScene rays(s);
   const Frame ref = Tracer(rays, TraceOptions{}).render();
@@ -192,7 +193,8 @@ TEST_P(ShadowTest, ALensTransmitsItsFresnelShareInBoth) {
     const double term = raster.color[i].x / kGroundAlbedo - kAmbient;  // the light's term, cos = 1
     worst = std::max(worst, std::abs(term - t_lens));
   }
-  std::printf("[ shadows ] under the lens: %d pixels, raster term within %.2e of (1 - R0)^2 = %.6f\n", under, worst, t_lens);
+  std::printf("[ shadows ] under the lens: %d pixels, raster term within %.2e of (1 - R0)^2 = %.6f\n", under, worst,
+              t_lens);
   EXPECT_GT(under, 100);
   EXPECT_LE(worst, kTermTol);
 }

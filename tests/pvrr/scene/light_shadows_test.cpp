@@ -16,7 +16,8 @@ const std::string kName = "scenes/lights.json";
 std::string sceneWithLights(const std::string& lights) {
   return R"({"version": 1, "observer": {"eye": [0, 1.2, 0], "target": [0, 1.2, -1]},
              "environment": [{"type": "box", "centre": [0, 0.5, -3], "size": [1, 1, 1]}],
-             "lights": [)" + lights + "]}";
+             "lights": [)" +
+         lights + "]}";
 }
 
 std::string errorOf(const std::string& text) {
@@ -32,7 +33,8 @@ std::string errorOf(const std::string& text) {
 TEST(LightShadows, OnUnlessTheSceneSaysOtherwise) {
   const SceneDesc d = parseScene(sceneWithLights(R"({"type": "directional", "direction": [0, -1, 0]},
       {"type": "point", "position": [0, 2, 0], "shadows": false}, {"type": "point", "position": [0, 2, 1], "shadows": true},
-      {"type": "ambient"})"), kName, "");
+      {"type": "ambient"})"),
+                                 kName, "");
   ASSERT_EQ(d.lights.size(), 4u);
   EXPECT_TRUE(d.lights[0].shadows);
   EXPECT_FALSE(d.lights[1].shadows);

@@ -86,8 +86,8 @@ TEST(ShadowRays, MirrorsBlockAndLensesTransmitByFresnel) {
   ShadowRays shadows(rays);
   const double r0 = (0.5 / 2.5) * (0.5 / 2.5);  // normal incidence at n = 1.5
   EXPECT_NEAR(lensShadowTransmittance(s.elements[1]), (1 - r0) * (1 - r0), 1e-12);
-  EXPECT_EQ(shadows.transmittance(s.lights[0], Vec3(1.0, 0, 1.0)), Vec3(0.0));   // under the mirror (its back)
-  EXPECT_EQ(shadows.transmittance(s.lights[0], Vec3(1.0, 0, 1.3)), Vec3(1.0));   // beside it
+  EXPECT_EQ(shadows.transmittance(s.lights[0], Vec3(1.0, 0, 1.0)), Vec3(0.0));  // under the mirror (its back)
+  EXPECT_EQ(shadows.transmittance(s.lights[0], Vec3(1.0, 0, 1.3)), Vec3(1.0));  // beside it
   EXPECT_NEAR(shadows.transmittance(s.lights[0], Vec3(-1.0, 0, 1.0)).x, (1 - r0) * (1 - r0), 1e-12);  // the lens
   // The mirror's front faces down: light from below is blocked as well.
   Light up = s.lights[0];
