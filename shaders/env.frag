@@ -11,6 +11,7 @@ uniform sampler2D u_texture;   // GL_SRGB8_ALPHA8: decoded to linear before filt
 uniform vec3 u_view_origin;    // the point rays come from (the camera, or the virtual viewpoint), relative
 #include "outputs.glsl"
 #include "shading.glsl"
+#include "shadow_lookup.glsl"
 #if defined(FACETED)
 flat in vec3 v_face_normal;
 flat in vec3 v_face_light;
@@ -21,7 +22,13 @@ void main() {
 #if defined(TEXTURED)
   albedo *= texture(u_texture, v_uv).rgb;
 #endif
-#if defined(FACETED)
+#if defined(SHADOWS) && defined(FACETED)
+  o_color = vec4(albedo * shadowedLight(v_pos, v_face_normal), 1.0);
+#elif defined(SHADOWS)
+  vec3 n = normalize(v_normal);
+  if (dot(n, v_pos - u_view_origin) > 0.0) n = -n;
+  o_color = vec4(albedo * shadowedLight(v_pos, n), 1.0);
+#elif defined(FACETED)
   o_color = vec4(albedo * (v_face_light + pointLights(v_pos, v_face_normal)), 1.0);
 #else
   vec3 n = normalize(v_normal);

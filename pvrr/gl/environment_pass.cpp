@@ -4,6 +4,7 @@
 
 #include "pvrr/gl/gl.h"
 #include "pvrr/gl/impostor_maps.h"
+#include "pvrr/gl/shadow_pass.h"
 #include "pvrr/method/view_volume.h"
 
 namespace pvrr::gl {
@@ -104,6 +105,15 @@ std::vector<size_t> EnvironmentPass::drawOrder(const std::vector<std::array<Vec3
   return order;
 }
 
+void EnvironmentPass::drawCasters(const Program& p, const Mat4& view_proj, const Vec3& origin) const {
+  p.use();
+  p.set("u_view_proj", toFloat(view_proj));
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    p.set("u_offset", glm::vec3(scene.meshes[m].anchor - origin));
+    gl::draw(env_meshes[m]);
+  }
+}
+
 CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& origin, bool reversed_depth,
                                 const Vec3* rays_from, bool planes, bool with_seen, bool peel) const {
   const Mat4 vp = relativeViewProj(proj, view, origin);
@@ -142,6 +152,7 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
     p->set("u_view_origin", rays_from ? glm::vec3(*rays_from - origin) : glm::vec3(0.0f));
     if (textured) p->set("u_texture", 0);
     setLights(*p, scene, origin);
+    if (shadows_) shadows_->bind(*p, origin);
   }
   glActiveTexture(GL_TEXTURE0);
   // Back faces of closed convex meshes that near clipping cannot cut open (RendererOptions::cull_back_faces,

@@ -12,6 +12,8 @@
 
 namespace pvrr::gl {
 
+class ShadowPass;
+
 // The uniforms of shaders/shading.glsl, for a pass whose camera origin is `origin`.
 void setLights(const Program& p, const Scene& scene, const Vec3& origin);
 
@@ -36,6 +38,12 @@ class EnvironmentPass {
   CullCount draw(const Mat4& view, const Mat4& proj, const Vec3& origin, bool reversed_depth = false,
                  const Vec3* rays_from = nullptr, bool planes = false, bool with_seen = false, bool peel = false) const;
 
+  // The environment meshes as shadow casters (shaders/shadow_caster.vert; pvrr/gl/shadow_pass.h): positions
+  // only, every face, into whatever target is bound; view_proj acts on points relative to `origin`.
+  void drawCasters(const Program& p, const Mat4& view_proj, const Vec3& origin) const;
+  // The shadow maps the meshes' shading reads in every pass (null: none). Set by the renderer.
+  void setShadows(const ShadowPass* shadows) { shadows_ = shadows; }
+
  private:
   // The environment meshes' bounding boxes relative to `origin`.
   std::vector<std::array<Vec3, 2>> boxes(const Vec3& origin) const;
@@ -51,6 +59,7 @@ class EnvironmentPass {
   std::vector<bool> env_textured;  // per environment mesh: its material has a texture
   std::vector<std::array<Vec3, 2>> env_bounds;  // per environment mesh: its bounding box, relative to its anchor
   std::vector<Texture> textures;  // environment textures, in Scene::textures order
+  const ShadowPass* shadows_ = nullptr;
 };
 
 }  // namespace pvrr::gl

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "pvrr/gl/shadow_pass.h"
+
 namespace pvrr::gl {
 
 // A program's defines, plus the scene's light counts (shaders/shading.glsl) and NO_SEEN_POINTS when
@@ -38,6 +40,7 @@ const Program& Programs::env(bool faceted, bool textured, bool planes, bool with
   if (faceted) d.push_back("#define FACETED");
   if (textured) d.push_back("#define TEXTURED");
   if (planes) d.push_back("#define PLANES");
+  for (const std::string& s : shadowDefines(scene_)) d.push_back(s);
   return built("env.vert", "env.frag", d);
 }
 
@@ -89,6 +92,14 @@ const Program& Programs::cubeGeometry(bool lens, bool peel) const {
   if (lens) d.push_back("#define LENS");
   if (peel) d.push_back("#define PEEL");
   return built("element.vert", "element_impostor.frag", d);
+}
+
+const Program& Programs::shadowCaster(bool lens) const {
+  std::unique_ptr<Program>& p = shadow_casters_[lens];
+  if (!p)
+    p = std::make_unique<Program>("shadow_caster.vert", "shadow_caster.frag",
+                                  lens ? std::vector<std::string>{"#define LENS"} : std::vector<std::string>{});
+  return *p;
 }
 
 const Program& Programs::mask() const {

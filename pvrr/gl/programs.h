@@ -27,7 +27,8 @@ class Programs {
   // RGB dispersion need.
   const Program& planesVariant(const std::string& vert, const std::string& frag, std::vector<std::string> d) const;
 
-  // Environment meshes (shaders/env.frag): FACETED (one normal per triangle), TEXTURED (a material with a
+  // Environment meshes (shaders/env.frag), with the shadow maps' defines when a light casts shadows
+  // (shadowDefines, pvrr/gl/shadow_pass.h): FACETED (one normal per triangle), TEXTURED (a material with a
   // texture; without, no texture is sampled: llvmpipe samples inside a uniform branch all the same).
   // PEEL: the second layer of an impostor's distance map (shaders/outputs.glsl).
   const Program& env(bool faceted, bool textured, bool planes, bool with_seen = false, bool peel = false) const;
@@ -53,6 +54,9 @@ class Programs {
   // An element drawn into another element's impostor cubes (CUBE_GEOMETRY): a mirror's exact surface point
   // and normal, a lens's mesh point; and its index.
   const Program& cubeGeometry(bool lens, bool peel) const;
+  // A shadow map's casters (shaders/shadow_caster.*; pvrr/gl/shadow_pass.h): depth only, or (lens) depth and
+  // the lens's transmittance. No scene defines.
+  const Program& shadowCaster(bool lens) const;
   // The depth mask of a first pass's unread texels (shaders/map_mask.*; no scene defines).
   const Program& mask() const;
 
@@ -63,6 +67,7 @@ class Programs {
   bool seen_points_;
   mutable std::map<std::string, std::unique_ptr<Program>> built_;
   mutable std::unique_ptr<Program> mask_;
+  mutable std::unique_ptr<Program> shadow_casters_[2];
 };
 
 }  // namespace pvrr::gl

@@ -5,6 +5,7 @@
 //   cube_pass.h          envmap and impostor modes: cube maps (with impostor mode's peeled second layers)
 //   impostor_maps.h      impostor mode's height and surface maps, and its texture-unit plan
 //   environment_pass.h   sky and environment meshes, in every pass
+//   shadow_pass.h        the lights' shadow maps, read by the environment's shading in every pass
 //   element_mesh.h, gl_objects.h, programs.h   element vertices, GL objects, programs built on first use
 //   stage_notes.h        the stage names and the texts of their notes
 #include "pvrr/gl/renderer.h"
@@ -16,6 +17,7 @@
 #include "pvrr/gl/gl.h"
 #include "pvrr/gl/pvrr_pass.h"
 #include "pvrr/method/map_limits.h"
+#include "pvrr/gl/shadow_pass.h"
 
 namespace pvrr::gl {
 
@@ -64,6 +66,7 @@ struct Renderer::Impl {
   RendererOptions options;
   Programs programs;
   EnvironmentPass environment;
+  std::unique_ptr<ShadowPass> shadows;  // made with the first context() (it needs the texture-unit count)
   MeshPool meshes;
   ElementGridCache grid_cache;
   int max_texture_size = 0, max_texture_units = 0;
@@ -83,6 +86,8 @@ struct Renderer::Impl {
       glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture_size);
       glGetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &max_texture_units);
       limits = queryGlLimits();
+      shadows = std::make_unique<ShadowPass>(scene, programs, environment, max_texture_units);
+      environment.setShadows(shadows.get());
     }
     return {scene, rays, options, programs, environment, meshes, grid_cache, max_texture_size, max_texture_units};
   }
@@ -137,6 +142,7 @@ RasterFrame Renderer::Impl::render(RenderMode mode, FrameCache* cache) {
                  limits);
   meshes.rewind();
   ModePass& pass = passFor(mode);
+  shadows->update(out.stages);  // before the first passes, whose environment reads the maps too
   // The CPU stages and the first passes (and the nested passes of elements seen in other elements' maps).
   pass.prepare(mode, out.stages, cache);
   const auto t0 = Clock::now();

@@ -50,6 +50,9 @@ struct Light {
   Vec3 direction{0, -1, 0};  // directional: the direction light travels (unit)
   Vec3 position{0};          // point
   Vec3 radiance{1};          // linear RGB, intensity folded in; point lights fall off as 1/d^2 (d in m)
+  // Directional, point: occluders between a surface and the light shadow it (LightDesc::shadows). Off unless
+  // set, so that a scene built in code keeps its unshadowed picture.
+  bool shadows = false;
 };
 
 struct Observer {

@@ -87,6 +87,9 @@ struct LightDesc {
   Vec3 position{0};
   Vec3 color{1};
   double intensity = 1;  // directional, point; ambient: radiance added is albedo * color * intensity
+  // Directional, point: whether what lies between a surface and the light shadows it ("shadows"; on unless
+  // a scene says otherwise). Ambient light has no direction and casts none.
+  bool shadows = true;
 };
 inline constexpr NameTable<LightDesc::Type, 3> kLightTypeNames = {{{LightDesc::Type::Directional, "directional"},
                                                                    {LightDesc::Type::Point, "point"},

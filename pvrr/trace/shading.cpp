@@ -32,7 +32,8 @@ Vec3 sampleTexture(const Texture& t, Vec2 uv) {
   return glm::mix(c0, c1, ay);
 }
 
-Vec3 shadeDiffuse(const Scene& scene, const DiffuseMaterial& m, const Vec3& p, const Vec3& n, Vec2 uv) {
+Vec3 shadeDiffuse(const Scene& scene, const DiffuseMaterial& m, const Vec3& p, const Vec3& n, Vec2 uv,
+                  const ShadowRays* shadows) {
   Vec3 albedo = m.color;
   if (m.texture >= 0) albedo *= sampleTexture(scene.textures[size_t(m.texture)], uv);
   Vec3 light(0.0);
@@ -41,13 +42,16 @@ Vec3 shadeDiffuse(const Scene& scene, const DiffuseMaterial& m, const Vec3& p, c
       case Light::Type::Ambient:
         light += l.radiance;
         break;
-      case Light::Type::Directional:
-        light += std::max(0.0, -glm::dot(n, l.direction)) * l.radiance;
+      case Light::Type::Directional: {
+        const double cos_l = -glm::dot(n, l.direction);
+        if (cos_l > 0) light += cos_l * l.radiance * (shadows ? shadows->transmittance(l, p) : Vec3(1.0));
         break;
+      }
       case Light::Type::Point: {
         Vec3 to = l.position - p;
         double d2 = glm::dot(to, to);
-        if (d2 > 0) light += std::max(0.0, glm::dot(n, to) / std::sqrt(d2)) / d2 * l.radiance;
+        const double cos_l = d2 > 0 ? glm::dot(n, to) / std::sqrt(d2) : 0.0;
+        if (cos_l > 0) light += cos_l / d2 * l.radiance * (shadows ? shadows->transmittance(l, p) : Vec3(1.0));
         break;
       }
     }

@@ -3,11 +3,14 @@
 //
 //   colour = albedo(uv) * ( sum ambient  +  sum_directional max(0, n.(-dir)) L  +  sum_point max(0, n.l) L / d^2 )
 //
-// n is the geometric normal turned towards the viewer (two-sided). No shadows: the raster path has none,
-// and the reference must differ from it only in geometry. Colours are linear RGB; textures are decoded
+// n is the geometric normal turned towards the viewer (two-sided). With `shadows` given, each directional
+// and point light's term is multiplied by its transmittance to p (pvrr/trace/shadow_rays.h; 1 for a light
+// with shadows off); the raster path multiplies by its shadow maps' estimate of the same
+// (shaders/shadow_lookup.glsl). Colours are linear RGB; textures are decoded
 // from sRGB before bilinear filtering with repeat wrapping (what GL does for GL_SRGB8 + GL_LINEAR).
 #pragma once
 #include "pvrr/scene/scene.h"
+#include "pvrr/trace/shadow_rays.h"
 
 namespace pvrr {
 
@@ -16,6 +19,7 @@ namespace pvrr {
 inline constexpr double kMirrorBackAlbedo = 0.05;
 
 Vec3 sampleTexture(const Texture& t, Vec2 uv);
-Vec3 shadeDiffuse(const Scene& scene, const DiffuseMaterial& m, const Vec3& p, const Vec3& n_facing, Vec2 uv);
+Vec3 shadeDiffuse(const Scene& scene, const DiffuseMaterial& m, const Vec3& p, const Vec3& n_facing, Vec2 uv,
+                  const ShadowRays* shadows = nullptr);
 
 }  // namespace pvrr

@@ -80,7 +80,9 @@ TraceResult Tracer::traceImpl(const Vec3& o_in, const Vec3& d_in, double wavelen
     if (hit.kind == HitKind::Environment) {
       const EnvMesh& mesh = scene_.meshes[size_t(hit.mesh)];
       Vec3 n = glm::dot(hit.normal, d) > 0 ? -hit.normal : hit.normal;
-      r.color = throughput * shadeDiffuse(scene_, scene_.materials[size_t(mesh.material)], hit.point, n, hit.uv);
+      const ShadowRays shadows(rays_);
+      r.color =
+          throughput * shadeDiffuse(scene_, scene_.materials[size_t(mesh.material)], hit.point, n, hit.uv, &shadows);
       r.seen = hit.point;
       seg.event = "diffuse";
       if (path) path->push_back(seg);

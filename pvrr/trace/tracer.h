@@ -1,5 +1,7 @@
 // The reference: a Whitted ray tracer on the exact element surfaces, the ground truth for every accuracy
-// figure. Environment shading is pvrr/trace/shading.h, the same model the raster path uses.
+// figure. Environment shading is pvrr/trace/shading.h, the same model the raster path uses, with shadow rays
+// (pvrr/trace/shadow_rays.h) for the lights whose shadows are on. A mirror's dark back is shaded unshadowed,
+// as the raster path shades it.
 //
 // Lens model (shared with the raster path): light passing a lens is weighted by the exact Fresnel
 // transmittance (1 - R) of each interface it crosses; the light a lens surface reflects is not added.

@@ -1,0 +1,35 @@
+// The reference's shadow rays (Light::shadows): how much of a directional or point light reaches a point of
+// the environment along the straight segment towards the light.
+//
+// What blocks and what transmits:
+// - an environment surface blocks fully;
+// - a mirror blocks fully, from the front or the back (the light it reflects elsewhere is a caustic, not
+//   modelled here);
+// - a lens transmits: each of its interfaces that the segment crosses passes (1 - R0), R0 the Fresnel
+//   reflectance at normal incidence at the lens's index at the d line (R0 = ((n - 1) / (n + 1))^2), so a
+//   segment through both faces keeps (1 - R0)^2 (lensShadowTransmittance). Normal incidence, not the ray's
+//   own angle: the raster path's shadow maps hold one transmittance per lens (shaders/shadow_lookup.glsl),
+//   and the two agree by construction. The segment is not bent by the lens (where the light it refracts
+//   lands is a caustic).
+// The segment starts at the point itself (t > RayScene::epsilon()) and ends at a point light (t < its
+// distance) or never (a directional light).
+#pragma once
+#include "pvrr/trace/ray_scene.h"
+
+namespace pvrr {
+
+// (1 - R0)^2: what a lens passes of light crossing both its faces near normal incidence.
+double lensShadowTransmittance(const Element& lens);
+
+class ShadowRays {
+ public:
+  explicit ShadowRays(const RayScene& rays) : rays_(rays) {}
+  // The fraction of light `l` that reaches `p`, per channel (grey: lenses attenuate every channel alike);
+  // 1 for a light with shadows off and for an ambient light.
+  Vec3 transmittance(const Light& l, const Vec3& p) const;
+
+ private:
+  const RayScene& rays_;
+};
+
+}  // namespace pvrr
