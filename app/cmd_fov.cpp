@@ -11,6 +11,7 @@
 #include "app/commands.h"
 #include "app/fov_plot.h"
 #include "app/fov_regulation.h"
+#include "app/progress.h"
 #include "pvrr/analysis/fov.h"
 #include "pvrr/base/atomic_file.h"
 #include "pvrr/base/error.h"
@@ -107,10 +108,14 @@ int cmdFov(const std::vector<std::string>& argv) {
 
   const VehicleFrame frame(vehicle);
   RayScene rays(scene);
+  Progress progress("fov", 3.0);  // the surface's figures, then each eye's footprint
   const SurfaceFigures figures = surfaceFigures(rays, index, 0.5 * (vehicle.eye_left + vehicle.eye_right), options);
+  progress.update(1);
   std::vector<EyeFootprint> feet;
   if (eyes_opt != "right") feet.push_back(traceFootprint(rays, index, frame, vehicle.eye_left, "left", options));
+  progress.update(2);
   if (eyes_opt != "left") feet.push_back(traceFootprint(rays, index, frame, vehicle.eye_right, "right", options));
+  progress.finish();
   std::vector<const EyeFootprint*> eyes;
   int road = 0;
   for (const EyeFootprint& f : feet) {
