@@ -6,6 +6,7 @@
 #include <cstring>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <png.h>
 #include <vector>
 
 #include "pvrr/base/error.h"
@@ -20,6 +21,7 @@ constexpr uint32_t kGlbMagic = 0x46546C67;      // "glTF" little endian
 constexpr uint32_t kChunkJson = 0x4E4F534A;     // "JSON"
 constexpr uint32_t kChunkBin = 0x004E4942;      // "BIN\0"
 constexpr int kModeTriangles = 4;
+constexpr unsigned kMaxImageSide = 8192;  // a texture's side, pixels: 8192 x 8192 RGB is 192 MB decoded
 
 uint32_t u32At(const std::string& d, size_t at) {
   uint32_t v = 0;
@@ -338,6 +340,33 @@ class GltfChecker {
   }
 
   // ------------------------------------------------------------------------------------------------------
+  // VTK's PNG reader crashes on a damaged PNG (a CRC error, data cut short): the image is decoded here first,
+  // with libpng, which VTK uses too. JPEG is refused: its decoder is not guarded here.
+  void checkPng(const std::string& bytes, const std::string& where) const {
+    if (bytes.compare(0, 3, "\xFF\xD8\xFF") == 0) fail(where, "a JPEG image; pvrr reads PNG textures only (convert it)");
+    if (bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") != 0) fail(where, "not a PNG image");
+    png_image png;
+    std::memset(&png, 0, sizeof png);
+    png.version = PNG_IMAGE_VERSION;
+    if (!png_image_begin_read_from_memory(&png, bytes.data(), bytes.size())) {
+      const std::string reason = png.message;
+      png_image_free(&png);
+      fail(where, "the PNG image cannot be read (libpng: " + reason + ")");
+    }
+    if (png.width == 0 || png.height == 0 || png.width > kMaxImageSide || png.height > kMaxImageSide) {
+      png_image_free(&png);
+      fail(where, "a PNG image of " + std::to_string(png.width) + " x " + std::to_string(png.height) +
+                      " pixels (at most " + std::to_string(kMaxImageSide) + " on a side)");
+    }
+    png.format = PNG_FORMAT_RGB;
+    std::vector<unsigned char> pixels(PNG_IMAGE_SIZE(png));
+    if (!png_image_finish_read(&png, nullptr, pixels.data(), 0, nullptr)) {
+      const std::string reason = png.message;
+      png_image_free(&png);
+      fail(where, "the PNG image cannot be decoded (libpng: " + reason + ")");
+    }
+  }
+
   void checkImagesAndTextures() const {
     const json& images = array("images");
     for (size_t i = 0; i < images.size(); ++i) {
@@ -352,9 +381,7 @@ class GltfChecker {
         const std::string& buffer = buffers_[size_t(index(view, "buffer", "", "buffers"))];
         bytes = buffer.substr(integer(view, "byteOffset", "", 0), integer(view, "byteLength", "", 0));
       }
-      const bool png = bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0;
-      const bool jpeg = bytes.compare(0, 3, "\xFF\xD8\xFF") == 0;
-      if (!png && !jpeg) fail(where, "not a PNG or JPEG image");
+      checkPng(bytes, where);
     }
     const json& textures = array("textures");
     for (size_t i = 0; i < textures.size(); ++i) {

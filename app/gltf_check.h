@@ -23,7 +23,7 @@ struct GltfCounts {
 // bufferView and accessor within its buffer, float accessors finite, every index (nodes, meshes, materials,
 // textures, images, samplers, skins, accessors) in range, the node graph a forest, mesh primitives triangle
 // lists (mode 4) whose indices are below their POSITION count, base colour factors finite in [0, 1], images
-// PNG or JPEG, and at least one triangle.
+// PNG decodable by libpng (JPEG refused), and at least one triangle.
 GltfCounts checkGltfData(const std::string& data, const std::string& path, const GltfUriReader& read_uri);
 
 }  // namespace pvrr::app

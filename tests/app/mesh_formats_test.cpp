@@ -169,6 +169,21 @@ TEST(MeshFormats, IndexOutOfRangeIsRefusedInOneLine) {
                 {"car.glb: meshes[0].primitives[0].indices: element 7: vertex index 9999 is out of range (POSITION has 24 vertices)"});
 }
 
+// A damaged texture made VTK's PNG reader crash the process (libpng: "IHDR: CRC error", then SIGSEGV).
+TEST(MeshFormats, DamagedOrJpegTextureIsRefusedInOneLine) {
+  Glb g = carGlb();
+  const auto& view = g.doc["bufferViews"][g.doc["images"][0]["bufferView"].get<size_t>()];
+  const size_t png = g.bin_start + view.value("byteOffset", size_t(0));
+  std::string damaged = g.bytes;
+  damaged[png + 20] ^= 0x5A;  // inside IHDR: its CRC no longer matches
+  expectOneLine(messageOf([&] { checkGltfData(damaged, "car.glb", kNoFiles); }),
+                {"car.glb: images[0]: the PNG image cannot be read (libpng: IHDR: CRC error)"});
+  std::string jpeg = g.bytes;
+  jpeg.replace(png, 3, "\xFF\xD8\xFF");
+  expectOneLine(messageOf([&] { checkGltfData(jpeg, "car.glb", kNoFiles); }),
+                {"car.glb: images[0]: a JPEG image; pvrr reads PNG textures only"});
+}
+
 TEST(MeshFormats, GltfStructureErrorsNameTheJsonPath) {
   const nlohmann::json base = carGlb().doc;
   const auto refusal = [&](const std::function<void(nlohmann::json&)>& edit) {
