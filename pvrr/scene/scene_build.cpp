@@ -364,12 +364,6 @@ Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
   for (size_t i = 0; i < desc.environment.size(); ++i) {
     const EnvObjectDesc& o = desc.environment[i];
     const std::string what = file + ": environment[" + std::to_string(i) + "]" + (o.name.empty() ? "" : " (" + o.name + ")");
-    DiffuseMaterial mat;
-    mat.color = o.material.color;
-    if (o.material.texture) {
-      mat.texture = int(scene.textures.size());
-      scene.textures.push_back(makeTexture(*o.material.texture, what));
-    }
     const double uv_scale = o.material.texture_fit ? 0.0 : o.material.texture_scale_m.x;
     EnvMesh mesh;
     std::vector<MeshPart> parts;
@@ -386,6 +380,12 @@ Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
     if (!parts.empty()) {  // a file with its own materials (glTF): one mesh per part, the file's materials
       addMeshParts(scene, mesh, parts, what);
       continue;
+    }
+    DiffuseMaterial mat;
+    mat.color = o.material.color;
+    if (o.material.texture) {
+      mat.texture = int(scene.textures.size());
+      scene.textures.push_back(makeTexture(*o.material.texture, what));
     }
     mesh.material = int(scene.materials.size());
     scene.materials.push_back(mat);
