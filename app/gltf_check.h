@@ -22,7 +22,8 @@ struct GltfCounts {
 // version 2, the lengths), the JSON, asset.version 2.x, no required extension, every buffer's bytes,
 // bufferView and accessor within its buffer, float accessors finite, every index (nodes, meshes, materials,
 // textures, images, samplers, skins, accessors) in range, the node graph a forest, mesh primitives triangle
-// lists (mode 4) whose indices are below their POSITION count, base colour factors finite in [0, 1], images
+// lists (mode 4) whose indices are below their POSITION count, NORMAL a VEC3 and TEXCOORD_n a VEC2, no skins
+// or morph targets, base colour factors finite in [0, 1], images
 // PNG decodable by libpng (JPEG refused), and at least one triangle.
 GltfCounts checkGltfData(const std::string& data, const std::string& path, const GltfUriReader& read_uri);
 

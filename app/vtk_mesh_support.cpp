@@ -91,12 +91,12 @@ MeshData meshFromPolyData(vtkPolyData* pd, const std::string& path, const Scoped
       throw Error(path + ": vertex " + std::to_string(i) + " is not finite");
     m.positions.emplace_back(p[0], p[1], p[2]);
   }
-  if (auto* n = t->GetPointData()->GetNormals())
+  if (auto* n = t->GetPointData()->GetNormals(); n && n->GetNumberOfComponents() == 3)
     for (vtkIdType i = 0; i < n->GetNumberOfTuples(); ++i) {
       double* v = n->GetTuple3(i);
       m.normals.emplace_back(v[0], v[1], v[2]);
     }
-  if (auto* tc = t->GetPointData()->GetTCoords())
+  if (auto* tc = t->GetPointData()->GetTCoords(); tc && tc->GetNumberOfComponents() == 2)
     for (vtkIdType i = 0; i < tc->GetNumberOfTuples(); ++i) {
       double* v = tc->GetTuple2(i);
       m.uvs.emplace_back(v[0], v[1]);

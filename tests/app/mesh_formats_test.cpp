@@ -209,6 +209,14 @@ TEST(MeshFormats, GltfStructureErrorsNameTheJsonPath) {
                 {"car.gltf: accessors[0]: 100000 elements of 12 bytes from byte 0 run past the end of bufferViews[0]"});
   expectOneLine(refusal([](nlohmann::json& d) { d["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"][0] = 2; }),
                 {"car.gltf: materials[0].pbrMetallicRoughness.baseColorFactor: expected numbers in [0, 1]"});
+  expectOneLine(refusal([](nlohmann::json& d) {
+                  d["accessors"][d["meshes"][0]["primitives"][0]["attributes"]["NORMAL"].get<size_t>()]["type"] = "VEC2";
+                }),
+                {"car.gltf: meshes[0].primitives[0].attributes.NORMAL: expected a VEC3 float accessor"});
+  expectOneLine(refusal([](nlohmann::json& d) { d["skins"] = {{{"joints", {0}}}}; }),
+                {"car.gltf: skins: skinned meshes are not read by pvrr"});
+  expectOneLine(refusal([](nlohmann::json& d) { d["meshes"][0]["primitives"][1]["targets"] = nlohmann::json::array(); }),
+                {"car.gltf: meshes[0].primitives[1].targets: morph targets are not read by pvrr"});
   expectOneLine(refusal([](nlohmann::json& d) { d["extensionsRequired"] = {"KHR_draco_mesh_compression"}; }),
                 {"car.gltf: extensionsRequired: the file needs the extension \"KHR_draco_mesh_compression\""});
   expectOneLine(refusal([](nlohmann::json& d) { d["meshes"] = nlohmann::json::array(); d["nodes"][0].erase("mesh"); }),
