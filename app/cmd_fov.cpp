@@ -11,6 +11,7 @@
 #include "app/commands.h"
 #include "app/fov_plot.h"
 #include "app/fov_regulation.h"
+#include "app/progress.h"
 #include "app/view/save_view.h"
 #include "pvrr/analysis/fov.h"
 #include "pvrr/analysis/fov_aim.h"
@@ -298,10 +299,14 @@ int cmdFov(const std::vector<std::string>& argv) {
   if (aim && regs.empty()) usageError("fov", "--aim needs a regulation (--regulation ID or vehicle.regulations)");
 
   const VehicleFrame frame(vehicle);
+  Progress progress("fov", 3.0);  // the surface's figures, its Annex 7 radius, then the footprints
   const SurfaceFigures figures =
       surfaceFigures(RayScene(scene), index, 0.5 * (vehicle.eye_left + vehicle.eye_right), options);
+  progress.update(1);
   const Annex7Radius annex7 = annex7Radius(el);
+  progress.update(2);
   const FovRun run = runFov(scene, index, frame, eyes_opt, regs, options);
+  progress.finish();
   int road = 0;
   for (const EyeFootprint& f : run.feet) road += f.count(RayFate::Road);
   if (road == 0) {

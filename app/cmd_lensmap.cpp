@@ -11,6 +11,7 @@
 #include "app/args.h"
 #include "app/commands.h"
 #include "app/lensmap_plot.h"
+#include "app/progress.h"
 #include "pvrr/analysis/lensmap.h"
 #include "pvrr/base/error.h"
 #include "pvrr/base/format.h"
@@ -246,9 +247,12 @@ int cmdLensmap(const std::vector<std::string>& argv) {
   LensmapResult r;
   DistortionGrid grid;
   try {
+    Progress progress("lensmap", 2.0);  // the map (one multithreaded call), then the distortion grid
     const Lensmap map(rays, index, options);
     r = map.run();
+    progress.update(1);
     grid = distortionGrid(map, options.gaze_max_deg);
+    progress.finish();
   } catch (const Error& e) {
     throw Error(scene_path + ": " + el_path + ": " + e.what());
   }

@@ -14,6 +14,7 @@
 #include <random>
 
 #include "app/args.h"
+#include "app/progress.h"
 #include "app/report.h"
 #include "pvrr/base/error.h"
 #include "pvrr/gl/context.h"
@@ -234,16 +235,9 @@ RenderedFrame renderFrame(LoadedScene& ls, RenderMode mode, const std::string& g
     to.dispersion = scene.render.dispersion;
     to.spectral_samples = scene.render.spectral_samples;
     Tracer tracer(rays, to);
-    const auto t0 = std::chrono::steady_clock::now();
-    bool shown = false;
-    Frame f = tracer.render([&](double frac) {
-      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      if (s > 1.0 && isatty(2)) {
-        std::fprintf(stderr, "\rray tracing: %3d%%", int(100 * frac));
-        shown = true;
-      }
-    });
-    if (shown) std::fprintf(stderr, "\rray tracing: done \n");
+    Progress progress("ray tracing", 1.0);
+    Frame f = tracer.render([&](double frac) { progress.update(frac); });
+    progress.finish();
     static_cast<Frame&>(out) = std::move(f);  // with its stage "ray-trace"
     out.gl_backend = "none (CPU, Embree)";
     return out;

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "app/args.h"
+#include "app/progress.h"
 #include "app/report.h"
 #include "pvrr/base/error.h"
 #include "pvrr/base/image.h"
@@ -213,8 +214,12 @@ int cmdCompare(const std::vector<std::string>& argv) {
   const std::string gl_name = backend ? *backend : gl::glBackendName(gl::glBackendFromEnvironment(gl::GlBackend::Auto));
   gl::parseGlBackend(gl_name);
 
+  // Units: the reference 1, the 2x2 supersampled reference 4, each mode 1.
+  Progress progress("compare", 5.0 + double(modes.size()));
+  size_t modes_done = 0;
   RenderSession none;
   RenderedFrame ref = renderFrame(ls, RenderMode::Raytrace, gl_name, &none);
+  progress.update(1);
   const int w = ref.width, h = ref.height;
   json metrics = {{"scene", scene_path}, {"size", {w, h}}, {"reference", {{"frame_ms", ref.frame_ms}}}};
   json definitions = json::object();
@@ -223,6 +228,7 @@ int cmdCompare(const std::vector<std::string>& argv) {
   writeLinearPng(*out_dir + "/reference.png", w, h, ref.color);
   const std::vector<Vec3> ref_ss = supersampledReference(ls, gl_name);
   metrics["reference"]["psnr_supersampled_db"] = elementPsnr(ref, ref_ss, ref.color);
+  progress.update(5);
 
   // The zooming region (issue 5), from the CPU vertex stages of every element: the same patches, viewpoints
   // and view volumes as the pvrr mode's.
@@ -254,6 +260,7 @@ int cmdCompare(const std::vector<std::string>& argv) {
     double frame_ms = 0;
     const RenderedFrame f = timedFrame(ls, mode, gl_name, frames, &frame_ms);
     gl_used = f.gl_backend;
+    progress.clear();
     std::vector<double> err;
     const ErrorStats st = compareToReference(ref, f, &err);
     writeLinearPng(*out_dir + "/" + m + ".png", w, h, f.color);
@@ -323,7 +330,9 @@ int cmdCompare(const std::vector<std::string>& argv) {
                     100 * fs.fraction_blue_bends_more, fs.pixels);
       }
     }
+    progress.update(5.0 + double(++modes_done));
   }
+  progress.finish();
   metrics["gl"] = gl_used;
   metrics["modes"] = jm;
   metrics["peak_rss_mb"] = peakRssMb();

@@ -7,6 +7,7 @@
 
 #include "app/args.h"
 #include "app/plot.h"
+#include "app/progress.h"
 #include "app/report.h"
 #include "pvrr/base/error.h"
 
@@ -35,14 +36,6 @@ std::vector<int> intList(const Args& a, const std::string& name, std::vector<int
   }
   if (out.empty()) usageError("sweep", "--" + name + ": empty list");
   return out;
-}
-
-void progress(size_t done, size_t total) {
-  if (!isatty(2)) return;
-  const int width = 30, filled = int(width * done / std::max<size_t>(total, 1));
-  std::fprintf(stderr, "\r[%s%s] %zu/%zu", std::string(size_t(filled), '#').c_str(), std::string(size_t(width - filled), ' ').c_str(),
-               done, total);
-  if (done == total) std::fprintf(stderr, "\n");
 }
 
 }  // namespace
@@ -81,7 +74,7 @@ int cmdSweep(const std::vector<std::string>& argv) {
   std::vector<SweepRow> rows;
   const size_t total = vary_sets.size() * tess.size() * maps.size() * modes.size();
   size_t done = 0;
-  progress(0, total);
+  Progress progress("sweep", double(total));
   for (const auto& vary : vary_sets) {
     std::vector<std::string> base_sets = a.all("set");
     base_sets.insert(base_sets.end(), vary.begin(), vary.end());
@@ -120,10 +113,11 @@ int cmdSweep(const std::vector<std::string>& argv) {
           r.max_arcmin = st.max_arcmin;
           r.psnr_db = st.psnr_db;
           rows.push_back(r);
-          progress(++done, total);
+          progress.update(double(++done));
         }
       }
   }
+  progress.finish();
   writeFileAtomic(*out + "/sweep.csv", sweepCsv(rows));
   writeSweepPlots(*out, rows);
   std::printf("%s/sweep.csv\n%s/error_vs_time.png\n%s/error_vs_time.svg\n%s/error_vs_vertices.png\n", out->c_str(), out->c_str(),

@@ -1,19 +1,17 @@
-// Everything that talks to VTK: reading OBJ/PLY environment meshes, writing PLY and VTP.
+// Everything that talks to VTK: reading environment meshes (OBJ and PLY here; glTF and STL in their own
+// files), writing PLY and VTP.
 #include <vtkCellArray.h>
 #include <vtkDoubleArray.h>
 #include <vtkFloatArray.h>
 #include <vtkIntArray.h>
 #include <vtkNew.h>
 #include <vtkOBJReader.h>
-#include <vtkObjectFactory.h>
-#include <vtkOutputWindow.h>
 #include <vtkPLYReader.h>
 #include <vtkPLYWriter.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
-#include <vtkTriangleFilter.h>
 #include <vtkXMLPolyDataWriter.h>
 
 #include <filesystem>
@@ -22,6 +20,7 @@
 
 #include "app/mesh_check.h"
 #include "app/report.h"
+#include "app/vtk_mesh_support.h"
 #include "pvrr/base/error.h"
 
 namespace fs = std::filesystem;
@@ -68,62 +67,15 @@ void writeAtomicWith(Writer* w, const std::string& path) {
   });
 }
 
-// Collects what VTK would print (its errors and warnings go to a global output window, stderr by default)
-// while an instance is alive, so that a reader's failure becomes one pvrr::Error instead of VTK's log lines.
-class CapturedVtkOutput : public vtkOutputWindow {
- public:
-  static CapturedVtkOutput* New();
-  vtkTypeMacro(CapturedVtkOutput, vtkOutputWindow);
-  void DisplayText(const char* t) override { text += t ? t : ""; }
-  void DisplayErrorText(const char* t) override { DisplayText(t); }
-  void DisplayWarningText(const char* t) override { DisplayText(t); }
-  void DisplayGenericWarningText(const char* t) override { DisplayText(t); }
-  void DisplayDebugText(const char* t) override { DisplayText(t); }
-  std::string text;
-};
-vtkStandardNewMacro(CapturedVtkOutput);
-
-class ScopedVtkCapture {
- public:
-  ScopedVtkCapture() : previous_(vtkOutputWindow::GetInstance()) {
-    vtkOutputWindow::SetInstance(window_);
-  }
-  ~ScopedVtkCapture() { vtkOutputWindow::SetInstance(previous_); }
-  ScopedVtkCapture(const ScopedVtkCapture&) = delete;
-  ScopedVtkCapture& operator=(const ScopedVtkCapture&) = delete;
-  // The last line of VTK's last message (the reason, without VTK's source file and object address).
-  std::string reason() const {
-    std::string t = window_->text;
-    while (!t.empty() && (t.back() == '\n' || t.back() == ' ')) t.pop_back();
-    const size_t nl = t.rfind('\n');
-    if (nl != std::string::npos) t = t.substr(nl + 1);
-    const size_t obj = t.find("): ");
-    if (obj != std::string::npos) t = t.substr(obj + 3);
-    return t;
-  }
-  bool any() const { return !window_->text.empty(); }
-
- private:
-  vtkSmartPointer<vtkOutputWindow> previous_;
-  vtkNew<CapturedVtkOutput> window_;
-};
-
-std::string readWholeFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path + ": cannot open the mesh file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) throw Error(path + ": cannot read the mesh file");
-  return ss.str();
-}
-
 }  // namespace
 
 MeshData readMeshFile(const std::string& path) {
   std::error_code ec;
   if (!fs::exists(path, ec)) throw Error(path + ": no such file");
-  if (fs::is_directory(path, ec)) throw Error(path + ": is a directory, expected an .obj or .ply mesh");
+  if (fs::is_directory(path, ec)) throw Error(path + ": is a directory, expected a mesh file (.obj, .ply, .gltf, .glb, .stl)");
   const std::string ext = lowerExtension(path);
+  if (ext == ".gltf" || ext == ".glb") return readGltfMesh(path);
+  if (ext == ".stl") return readStlMesh(path);
   // Our own checks first: VTK's readers accept bad indices and nan, and crash on some malformed PLY files.
   if (ext == ".obj") checkObjText(readWholeFile(path), path);
   else if (ext == ".ply") checkPlyData(readWholeFile(path), path);
@@ -140,51 +92,9 @@ MeshData readMeshFile(const std::string& path) {
     r->Update();
     pd = r->GetOutput();
   } else {
-    throw Error(path + ": expected an .obj or .ply mesh");
+    throw Error(path + ": expected a mesh file (.obj, .ply, .gltf, .glb, .stl)");
   }
-  if (!pd || pd->GetNumberOfPoints() == 0 || pd->GetNumberOfPolys() == 0)
-    throw Error(path + ": no triangles could be read" + (vtk_output.any() ? " (VTK: " + vtk_output.reason() + ")" : ""));
-  // Defence behind the checks above: every face of what VTK read refers to one of its points.
-  {
-    vtkCellArray* faces = pd->GetPolys();
-    faces->InitTraversal();
-    vtkNew<vtkIdList> ids;
-    for (vtkIdType f = 0; faces->GetNextCell(ids); ++f)
-      for (vtkIdType k = 0; k < ids->GetNumberOfIds(); ++k)
-        if (ids->GetId(k) < 0 || ids->GetId(k) >= pd->GetNumberOfPoints())
-          throw Error(path + ": face " + std::to_string(f) + ": vertex index " + std::to_string(ids->GetId(k)) +
-                      " is out of range (the file has " + std::to_string(pd->GetNumberOfPoints()) + " vertices)");
-  }
-  vtkNew<vtkTriangleFilter> tri;
-  tri->SetInputData(pd);
-  tri->Update();
-  vtkPolyData* t = tri->GetOutput();
-  MeshData m;
-  if (!t || t->GetNumberOfPoints() == 0 || t->GetNumberOfPolys() == 0) throw Error(path + ": no triangles could be read");
-  for (vtkIdType i = 0; i < t->GetNumberOfPoints(); ++i) {
-    double p[3];
-    t->GetPoint(i, p);
-    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
-      throw Error(path + ": vertex " + std::to_string(i) + " is not finite");
-    m.positions.emplace_back(p[0], p[1], p[2]);
-  }
-  if (auto* n = t->GetPointData()->GetNormals())
-    for (vtkIdType i = 0; i < n->GetNumberOfTuples(); ++i) {
-      double* v = n->GetTuple3(i);
-      m.normals.emplace_back(v[0], v[1], v[2]);
-    }
-  if (auto* tc = t->GetPointData()->GetTCoords())
-    for (vtkIdType i = 0; i < tc->GetNumberOfTuples(); ++i) {
-      double* v = tc->GetTuple2(i);
-      m.uvs.emplace_back(v[0], v[1]);
-    }
-  vtkCellArray* polys = t->GetPolys();
-  polys->InitTraversal();
-  vtkNew<vtkIdList> ids;
-  while (polys->GetNextCell(ids))
-    if (ids->GetNumberOfIds() == 3)
-      m.triangles.emplace_back(uint32_t(ids->GetId(0)), uint32_t(ids->GetId(1)), uint32_t(ids->GetId(2)));
-  return m;
+  return meshFromPolyData(pd, path, vtk_output);
 }
 
 void writeTessellation(const std::string& path, const cad::Tessellation& t) {

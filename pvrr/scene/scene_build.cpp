@@ -161,9 +161,64 @@ PrescriptionRadii prescriptionRadii(double sphere_d, double cylinder_d, double b
 
 namespace {
 
+// The material parts a loader returned cover its triangles in order, with finite colours and whole images.
+void checkMeshParts(const MeshData& md, const std::string& where) {
+  size_t next = 0;
+  for (size_t i = 0; i < md.parts.size(); ++i) {
+    const MeshPart& p = md.parts[i];
+    const std::string at = where + ": part " + std::to_string(i) + " (" + p.name + "): ";
+    if (p.first_triangle != next || p.triangle_count == 0 || p.triangle_count > md.triangles.size() - next)
+      throw Error(at + "its triangles do not follow the previous part's");
+    next += p.triangle_count;
+    if (!isFinite(p.base_color) || glm::any(glm::lessThan(p.base_color, Vec3(0))))
+      throw Error(at + "the base colour is not a finite colour >= 0");
+    if (p.texture && (p.texture->width <= 0 || p.texture->height <= 0 ||
+                      p.texture->rgb.size() != size_t(p.texture->width) * size_t(p.texture->height) * 3))
+      throw Error(at + "the base colour texture's pixels do not match its size");
+  }
+  if (!md.parts.empty() && next != md.triangles.size()) throw Error(where + ": the material parts miss triangles");
+}
+
+// One environment mesh per material part of a loaded mesh, each holding only the vertices its triangles use,
+// with the part's material (added to the scene).
+void addMeshParts(Scene& scene, const EnvMesh& whole, const std::vector<MeshPart>& parts, const std::string& what) {
+  for (const MeshPart& p : parts) {
+    EnvMesh sub;
+    sub.name = whole.name + "/" + p.name;
+    sub.anchor = whole.anchor;
+    std::vector<uint32_t> remap(whole.positions.size(), UINT32_MAX);
+    for (size_t t = p.first_triangle; t < p.first_triangle + p.triangle_count; ++t) {
+      glm::u32vec3 tri;
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t v = whole.triangles[t][k];
+        if (remap[v] == UINT32_MAX) {
+          remap[v] = uint32_t(sub.positions.size());
+          sub.positions.push_back(whole.positions[v]);
+          sub.normals.push_back(whole.normals[v]);
+          sub.uvs.push_back(whole.uvs[v]);
+        }
+        tri[k] = remap[v];
+      }
+      sub.triangles.push_back(tri);
+    }
+    DiffuseMaterial mat;
+    mat.color = p.base_color;
+    if (p.texture) {
+      mat.texture = int(scene.textures.size());
+      scene.textures.push_back(*p.texture);
+      scene.textures.back().name = what + ": " + p.name;
+    }
+    sub.material = int(scene.materials.size());
+    scene.materials.push_back(mat);
+    scene.meshes.push_back(std::move(sub));
+  }
+}
+
 // An environment mesh from a file (MeshLoader), posed by the object's position, rotation and scale, with
 // normals from the file or, without them, from the faces. `what` names the object in messages.
-EnvMesh loadedMesh(const EnvObjectDesc& o, const MeshLoader& load_mesh, const std::string& what) {
+// The file's material parts (MeshData::parts) are checked and moved to `parts`.
+EnvMesh loadedMesh(const EnvObjectDesc& o, const MeshLoader& load_mesh, const std::string& what,
+                   std::vector<MeshPart>& parts) {
   EnvMesh mesh;
   if (!load_mesh) throw Error(what + ": no mesh reader is available in this program");
   MeshData md;
@@ -183,6 +238,8 @@ EnvMesh loadedMesh(const EnvObjectDesc& o, const MeshLoader& load_mesh, const st
         throw Error(what + ": " + o.file + ": triangle " + std::to_string(t) + ": vertex index " +
                     std::to_string(md.triangles[t][k]) + " is out of range (the mesh has " +
                     std::to_string(md.positions.size()) + " vertices)");
+  checkMeshParts(md, what + ": " + o.file);
+  parts = std::move(md.parts);
   mesh.anchor = o.position;
   for (size_t v = 0; v < md.positions.size(); ++v) {
     const Vec3 p = o.rotation * (o.scale * md.positions[v]);
@@ -307,14 +364,9 @@ Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
   for (size_t i = 0; i < desc.environment.size(); ++i) {
     const EnvObjectDesc& o = desc.environment[i];
     const std::string what = file + ": environment[" + std::to_string(i) + "]" + (o.name.empty() ? "" : " (" + o.name + ")");
-    DiffuseMaterial mat;
-    mat.color = o.material.color;
-    if (o.material.texture) {
-      mat.texture = int(scene.textures.size());
-      scene.textures.push_back(makeTexture(*o.material.texture, what));
-    }
     const double uv_scale = o.material.texture_fit ? 0.0 : o.material.texture_scale_m.x;
     EnvMesh mesh;
+    std::vector<MeshPart> parts;
     switch (o.type) {
       case EnvObjectDesc::Type::Box: mesh = makeBoxMesh(o.position, o.size, o.rotation, uv_scale); break;
       case EnvObjectDesc::Type::Sphere: mesh = makeSphereMesh(o.position, o.radius_m); break;
@@ -322,9 +374,19 @@ Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
       case EnvObjectDesc::Type::Quad:
         mesh = makeQuadMesh(o.position, o.normal, o.v_axis, o.size.x, o.size.y, uv_scale);
         break;
-      case EnvObjectDesc::Type::Mesh: mesh = loadedMesh(o, load_mesh, what); break;
+      case EnvObjectDesc::Type::Mesh: mesh = loadedMesh(o, load_mesh, what, parts); break;
     }
     mesh.name = o.name.empty() ? std::string(nameOf(o.type)) + std::to_string(i) : o.name;
+    if (!parts.empty()) {  // a file with its own materials (glTF): one mesh per part, the file's materials
+      addMeshParts(scene, mesh, parts, what);
+      continue;
+    }
+    DiffuseMaterial mat;
+    mat.color = o.material.color;
+    if (o.material.texture) {
+      mat.texture = int(scene.textures.size());
+      scene.textures.push_back(makeTexture(*o.material.texture, what));
+    }
     mesh.material = int(scene.materials.size());
     scene.materials.push_back(mat);
     scene.meshes.push_back(std::move(mesh));

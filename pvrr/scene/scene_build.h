@@ -3,6 +3,7 @@
 // VTK, which pvrr/ does not depend on).
 #pragma once
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "pvrr/scene/scene.h"
@@ -10,12 +11,24 @@
 
 namespace pvrr {
 
+// A run of a mesh file's triangles with a material of its own (a glTF primitive): the file's material
+// replaces the scene object's material for these triangles (docs/scene-format.md, environment meshes).
+struct MeshPart {
+  std::string name;
+  size_t first_triangle = 0, triangle_count = 0;
+  Vec3 base_color{1};              // linear RGB albedo (glTF's base colour factor)
+  std::optional<Texture> texture;  // glTF's base colour texture (sRGB RGB8, rows top-down), multiplied by it
+};
+
 // Reads a mesh file: positions in file coordinates, normals (may be empty: then computed from faces) and
-// texture coordinates (may be empty).
+// texture coordinates (may be empty; v = 0 at the bottom of a texture image, as for every pvrr texture).
 struct MeshData {
   std::vector<Vec3> positions, normals;
   std::vector<Vec2> uvs;
   std::vector<glm::u32vec3> triangles;
+  // Empty: the whole mesh takes the scene object's material. Otherwise the parts cover the triangles in
+  // order, and each becomes an environment mesh of its own with the file's material.
+  std::vector<MeshPart> parts;
 };
 using MeshLoader = std::function<MeshData(const std::string& path)>;
 

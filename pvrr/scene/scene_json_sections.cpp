@@ -215,7 +215,7 @@ EnvObjectDesc readEnvObject(const Ctx& c, const json* j, const std::string& path
   d.material = readMaterial(c, o.get("material"), o.at("material"));
   d.type = type;
   if (type == Type::Mesh) {
-    d.file = o.file("file", {".obj", ".ply"}, "OBJ or PLY mesh");
+    d.file = o.file("file", {".obj", ".ply", ".gltf", ".glb", ".stl"}, "OBJ, PLY, glTF or STL mesh");
     d.scale = Vec3(c.unit_m);
     if (o.has("transform")) {
       Obj t(c, o.get("transform"), o.at("transform"),

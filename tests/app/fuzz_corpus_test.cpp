@@ -9,7 +9,9 @@
 #include <string>
 #include <vector>
 
+#include "app/gltf_check.h"
 #include "app/mesh_check.h"
+#include "app/stl_check.h"
 #include "cad/cad_import.h"
 #include "pvrr/base/error.h"
 #include "pvrr/base/image.h"
@@ -80,6 +82,33 @@ TEST(FuzzCorpus, MeshInputsAreCheckedOrRefusedWithAnError) {
     }
     if (p.extension() == ".ply") {
       EXPECT_NO_THROW(pvrr::app::checkPlyData(data, p.string())) << p;
+    }
+  }
+}
+
+TEST(FuzzCorpus, GltfInputsAreCheckedOrRefusedWithAnError) {
+  const auto files = corpus("gltf");
+  EXPECT_GE(files.size(), 2u);
+  const pvrr::app::GltfUriReader no_files = [](const std::string& uri) -> std::string {
+    throw pvrr::Error("no such file " + uri);
+  };
+  for (const fs::path& p : files) {
+    const std::string data = slurp(p);
+    acceptedOrRefused(p, [&] { (void)pvrr::app::checkGltfData(data, "fuzz.glb", no_files); });
+    if (p.extension() == ".glb" || p.extension() == ".gltf") {  // the seeds are valid, self-contained files
+      EXPECT_NO_THROW((void)pvrr::app::checkGltfData(data, p.string(), no_files)) << p;
+    }
+  }
+}
+
+TEST(FuzzCorpus, StlInputsAreCheckedOrRefusedWithAnError) {
+  const auto files = corpus("stl");
+  EXPECT_GE(files.size(), 2u);
+  for (const fs::path& p : files) {
+    const std::string data = slurp(p);
+    acceptedOrRefused(p, [&] { (void)pvrr::app::checkStlData(data, "fuzz.stl"); });
+    if (p.extension() == ".stl") {
+      EXPECT_NO_THROW((void)pvrr::app::checkStlData(data, p.string())) << p;
     }
   }
 }

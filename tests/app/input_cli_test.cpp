@@ -113,7 +113,7 @@ TEST_F(InputCli, ObjWithoutFacesIsRefused) {
 TEST_F(InputCli, MeshPathThatIsADirectoryIsRefused) {
   fs::create_directories(dir_ / "folder.obj");
   expectRefusal(render(sceneWithMesh("folder.obj")),
-                {"scene.json: environment[0].file: expected an existing OBJ or PLY mesh", "folder.obj"});
+                {"scene.json: environment[0].file: expected an existing OBJ, PLY, glTF or STL mesh", "folder.obj"});
 }
 
 TEST_F(InputCli, ValidObjWithNegativeIndicesAndNormalsStillRenders) {

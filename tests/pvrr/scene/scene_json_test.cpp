@@ -257,7 +257,7 @@ TEST(SceneJson, MissingReferencedFileIsNamed) {
   const std::string text = edited(R"({"type": "box", "name": "crate", "centre": [0, 0.5, -3], "size": [1, 1, 1]})",
                                   R"({"type": "mesh", "file": "meshes/nothere.obj"})");
   const std::string m = errorOf(text, {}, dir.string());
-  expectContains(m, kName + ": environment[0].file: expected an existing OBJ or PLY mesh");
+  expectContains(m, kName + ": environment[0].file: expected an existing OBJ, PLY, glTF or STL mesh");
   expectContains(m, (dir / "meshes" / "nothere.obj").string());
   expectContains(m, "got \"meshes/nothere.obj\"");
   // With the file present, the stored path is resolved against the scene's folder.
