@@ -118,7 +118,8 @@ void CubePass::prepare(RenderMode frame_mode, FrameStages& stages, FrameCache* c
       t.ran = false;
       t.reason = "cube maps reused: drawn " + std::to_string(reused_frames) +
                  " frame(s) ago, and nothing they show has changed since (the environment, every element's pose, "
-                 "the mode and map settings; the cubes do not depend on the eye); " + t.note;
+                 "the mode and map settings; the cubes do not depend on the eye); " +
+                 t.note;
       t.note.clear();
       t.ms = 0;
     } else {

@@ -54,10 +54,10 @@ class CubePass : public ModePass {
 
   RenderContext ctx;
   ImpostorMaps maps;
-  std::optional<CubeKey> drawn_key;  // the cubes' key; empty before the first draw
-  bool layer1_drawn = false;         // the second layers' cubes were drawn with drawn_key too
-  int reused_frames = 0;             // frames drawn from the cubes since they were drawn
-  bool cubes_reused = false;         // this frame's cubes are the last frame's
+  std::optional<CubeKey> drawn_key;                 // the cubes' key; empty before the first draw
+  bool layer1_drawn = false;                        // the second layers' cubes were drawn with drawn_key too
+  int reused_frames = 0;                            // frames drawn from the cubes since they were drawn
+  bool cubes_reused = false;                        // this frame's cubes are the last frame's
   std::vector<std::unique_ptr<CubeTarget>> cubes;   // one per element
   std::vector<std::unique_ptr<CubeTarget>> cubes1;  // impostor mode's second layers (impostorLayers), one per element
   // This frame's plan (prepare):

@@ -19,12 +19,13 @@ Keyframe sampleAnimation(const AnimationDesc& a, double t_s) {
   if (!(t_s > k.front().time_s)) return {t_s, k.front().offset_m, k.front().rotation_deg};
   if (t_s >= k.back().time_s) return {t_s, k.back().offset_m, k.back().rotation_deg};
   // The first key after t: t lies in [k[i - 1], k[i]).
-  const size_t i = size_t(std::upper_bound(k.begin(), k.end(), t_s,
-                                           [](double t, const Keyframe& key) { return t < key.time_s; }) -
-                          k.begin());
+  const size_t i =
+      size_t(std::upper_bound(k.begin(), k.end(), t_s, [](double t, const Keyframe& key) { return t < key.time_s; }) -
+             k.begin());
   const Keyframe &a0 = k[i - 1], &a1 = k[i];
   const double w = interpolationWeight(a.interpolation, (t_s - a0.time_s) / (a1.time_s - a0.time_s));
-  return {t_s, a0.offset_m + w * (a1.offset_m - a0.offset_m), a0.rotation_deg + w * (a1.rotation_deg - a0.rotation_deg)};
+  return {t_s, a0.offset_m + w * (a1.offset_m - a0.offset_m),
+          a0.rotation_deg + w * (a1.rotation_deg - a0.rotation_deg)};
 }
 
 Mat3 rotationFromDeg(const Vec3& deg) {

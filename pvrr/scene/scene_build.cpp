@@ -397,16 +397,18 @@ void updateAttachedElements(Scene& scene, const SceneDesc& desc) {
   for (size_t i = 0; i < scene.elements.size() && i < desc.elements.size(); ++i) {
     Element& el = scene.elements[i];
     const ElementDesc& d = desc.elements[i];
-    const Mat4 pose = d.animation ? motionAt(*d.animation, d.pose.position, scene.time_s) * poseMatrix(d.pose)
-                                  : poseMatrix(d.pose);
+    const Mat4 pose =
+        d.animation ? motionAt(*d.animation, d.pose.position, scene.time_s) * poseMatrix(d.pose) : poseMatrix(d.pose);
     el.local_to_world = el.attached_to_observer ? obs * pose : pose;
     el.world_to_local = glm::inverse(el.local_to_world);
   }
 }
 
 bool isAnimated(const SceneDesc& desc) {
-  return std::any_of(desc.environment.begin(), desc.environment.end(), [](const EnvObjectDesc& o) { return bool(o.animation); }) ||
-         std::any_of(desc.elements.begin(), desc.elements.end(), [](const ElementDesc& e) { return bool(e.animation); });
+  return std::any_of(desc.environment.begin(), desc.environment.end(),
+                     [](const EnvObjectDesc& o) { return bool(o.animation); }) ||
+         std::any_of(desc.elements.begin(), desc.elements.end(),
+                     [](const ElementDesc& e) { return bool(e.animation); });
 }
 
 namespace {
@@ -416,7 +418,8 @@ void moveMesh(const EnvMesh& placed, const Mat4& m, EnvMesh& out) {
   const Mat3 r(m);
   out.anchor = Vec3(m * Vec4(placed.anchor, 1.0));
   for (size_t i = 0; i < placed.positions.size(); ++i) out.positions[i] = glm::vec3(r * Vec3(placed.positions[i]));
-  for (size_t i = 0; i < placed.normals.size(); ++i) out.normals[i] = glm::vec3(glm::normalize(r * Vec3(placed.normals[i])));
+  for (size_t i = 0; i < placed.normals.size(); ++i)
+    out.normals[i] = glm::vec3(glm::normalize(r * Vec3(placed.normals[i])));
 }
 
 }  // namespace

@@ -505,8 +505,9 @@ double readEyeRotationCentre(const Ctx& c, const json* j, const std::string& pat
 ElementDesc readElement(const Ctx& c, const json* j, const std::string& path, size_t index) {
   const std::string what = "an element {\"type\": " + alternatives<ElementDesc::Type>() + ", ...}";
   const ElementDesc::Type type = peekChoice<ElementDesc::Type>(c, j, path, what, "type");
-  std::vector<std::string> keys = {"name", "type", "pose", "attached_to_observer", "outline", "tessellation",
-                                   "patches", "max_patch_fov_deg", "material", "animation", "dynamic"};
+  std::vector<std::string> keys = {"name",     "type",         "pose",    "attached_to_observer",
+                                   "outline",  "tessellation", "patches", "max_patch_fov_deg",
+                                   "material", "animation",    "dynamic"};
   if (type == ElementDesc::Type::Mirror) keys.push_back("surface");
   else keys.insert(keys.end(), {"front", "back", "centre_thickness", "min_edge_thickness", "prescription", "eye"});
   Obj o(c, j, path, what, keys);

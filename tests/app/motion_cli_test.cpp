@@ -54,8 +54,10 @@ TEST(MotionCli, BadTimeArgumentsAreOneLineRefusals) {
 
 TEST(MotionCli, CompareOverTimeReportsEveryFrameAndTheWorst) {
   const fs::path dir = test::freshTestDir("motion-compare");
-  const auto r = runPvrr("compare models/overtaking-car.json --modes pvrr,impostor --size 96x72 --frames 3 --fps 2 "
-                         "--gl osmesa --out '" + dir.string() + "'");
+  const auto r = runPvrr(
+      "compare models/overtaking-car.json --modes pvrr,impostor --size 96x72 --frames 3 --fps 2 "
+      "--gl osmesa --out '" +
+      dir.string() + "'");
   ASSERT_EQ(r.code, 0) << r.err;
   const json m = json::parse(test::slurp(dir / "metrics.json"));
   const json& ot = m["over_time"];

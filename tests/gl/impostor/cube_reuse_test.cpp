@@ -55,7 +55,8 @@ class CubeReuseTest : public ::testing::TestWithParam<gl::GlBackend> {
     gl::FrameCache cache;
     const Vec3 eye = s.observer.eye, target0 = s.observer.target;
     for (int i = 0; i < 4; ++i) {
-      s.observer.target = eye + Vec3(glm::rotate(Mat4(1.0), radians(2.0 * i), s.observer.up) * Vec4(target0 - eye, 0.0));
+      s.observer.target =
+          eye + Vec3(glm::rotate(Mat4(1.0), radians(2.0 * i), s.observer.up) * Vec4(target0 - eye, 0.0));
       updateAttachedElements(s, desc);
       rays.updateElementPoses();
       if (i > 0) cache.environment_changed = false;
@@ -65,8 +66,12 @@ class CubeReuseTest : public ::testing::TestWithParam<gl::GlBackend> {
       const std::string note = firstPass(a, &ran);
       const bool expect_reuse = i > 0 && !c.attached;
       EXPECT_EQ(ran, !expect_reuse) << "frame " << i << ": " << note;
-      if (expect_reuse) EXPECT_NE(note.find("cube maps reused"), std::string::npos) << note;
-      if (i > 0 && c.attached) EXPECT_NE(note.find("moved (attached to the observer)"), std::string::npos) << note;
+      if (expect_reuse) {
+        EXPECT_NE(note.find("cube maps reused"), std::string::npos) << note;
+      }
+      if (i > 0 && c.attached) {
+        EXPECT_NE(note.find("moved (attached to the observer)"), std::string::npos) << note;
+      }
       firstPass(b, &ran);
       EXPECT_TRUE(ran) << "without a frame cache every frame draws its cubes";
     }
@@ -82,10 +87,9 @@ class CubeReuseTest : public ::testing::TestWithParam<gl::GlBackend> {
 TEST_P(CubeReuseTest, OrbitWithReuseMatchesRedrawingEveryFrame) {
   auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
-  for (const OrbitCase& c : {OrbitCase{"car-mirror", RenderMode::Impostor, false},
-                             OrbitCase{"car-mirror", RenderMode::Envmap, false},
-                             OrbitCase{"mirror-pair", RenderMode::Impostor, false},
-                             OrbitCase{"spectacle-lens", RenderMode::Impostor, true}})
+  for (const OrbitCase& c :
+       {OrbitCase{"car-mirror", RenderMode::Impostor, false}, OrbitCase{"car-mirror", RenderMode::Envmap, false},
+        OrbitCase{"mirror-pair", RenderMode::Impostor, false}, OrbitCase{"spectacle-lens", RenderMode::Impostor, true}})
     orbit(c);
 }
 

@@ -130,9 +130,10 @@ TEST(Animation, BadAnimationsGiveOneLineNamingThePath) {
   EXPECT_EQ(errorOf(edited("\"interpolation\": \"linear\"", "\"interpolation\": \"smoth\"")),
             "t.json: environment[0].animation.interpolation: expected one of \"linear\" or \"smooth\", got \"smoth\"; "
             "did you mean \"smooth\"?");
-  EXPECT_NE(errorOf(edited("\"keys\": [{\"time_s\": 0}, {\"time_s\": 1, \"rotation_deg\": [0, 10, 0]}]", "\"keys\": []"))
-                .find("t.json: elements[0].animation.keys: expected a non-empty array of keys"),
-            std::string::npos);
+  EXPECT_NE(
+      errorOf(edited("\"keys\": [{\"time_s\": 0}, {\"time_s\": 1, \"rotation_deg\": [0, 10, 0]}]", "\"keys\": []"))
+          .find("t.json: elements[0].animation.keys: expected a non-empty array of keys"),
+      std::string::npos);
   EXPECT_NE(errorOf(edited("\"size\": [1.8, 1.4, 4.2],", "\"size\": [1.8, 1.4, 4.2], \"dynamic\": false,"))
                 .find("t.json: environment[0].dynamic: expected true (an animated object is dynamic)"),
             std::string::npos);
