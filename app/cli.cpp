@@ -29,6 +29,7 @@ const std::map<std::string, Command>& commands() {
        {cmdRender, "render a scene to PNG (default: models/car-mirror.json -> out/car-mirror.png)",
         "pvrr render [SCENE] [--mode pvrr|raster|envmap|impostor|raytrace] [--size WxH] [--out FILE.png]\n"
         "            [--gl auto|egl|osmesa] [--set PATH=VALUE]... [--stats FILE.json] [--frames N] [--orbit DEG]\n"
+        "            [--time T] [--fps F]\n"
         "  Renders SCENE (default models/car-mirror.json) and prints the output path and the frame time: for one\n"
         "  frame, the steady time (one more frame, not written, every stage run again) and the first, cold frame's\n"
         "  (stats: frame_ms_steady, frame_ms_first).\n"
@@ -41,7 +42,10 @@ const std::map<std::string, Command>& commands() {
         "  second frame on, maps are drawn with a margin, and later frames reuse them while the view stays\n"
         "  inside it (render.map_reuse_margin_deg).\n"
         "  The stats' \"memory\" holds the resident memory after frame 100 (the first frame when N < 100), at\n"
-        "  the end, their difference (rss_growth_mb), the peak, and 20 samples over the run."}},
+        "  the end, their difference (rss_growth_mb), the peak, and 20 samples over the run.\n"
+        "  --time T poses an animated scene (\"animation\" blocks) at T seconds (default 0); with --frames N, frame i\n"
+        "  is at T + i / F (--fps, default 30). A frame where something moved builds the renderer and the ray\n"
+        "  scene again (stats: time_s, fps, animated, frames_rebuilt)."}},
       {"view",
        {cmdView, "open a design-review window: the scene live, head and eye moved by mouse and keys",
         "pvrr view [SCENE] [--mode pvrr|raster|envmap|impostor] [--gl auto|glx|egl] [--size WxH] [--set "
@@ -92,10 +96,14 @@ const std::map<std::string, Command>& commands() {
        {cmdCompare, "render the reference and each mode; write images, error heat maps and metrics.json",
         "pvrr compare SCENE [--modes pvrr,envmap,impostor,raster] [--size WxH] [--frames N] [--gl B] [--set "
         "PATH=VALUE]... --out DIR\n"
+        "             [--time T] [--fps F]\n"
         "  Writes DIR/reference.png, DIR/MODE.png, DIR/MODE-error.png and DIR/metrics.json: per mode the frame\n"
         "  time, stages and angular error (median, p95, max), split into the zooming region and the rest\n"
         "  (\"regions\"); with rgb dispersion also per colour channel (\"channels\") and the fringes' sign\n"
-        "  (\"fringe\"). metrics.json's \"definitions\" says how each figure is measured."}},
+        "  (\"fringe\"). metrics.json's \"definitions\" says how each figure is measured.\n"
+        "  --time T: the scene's animation posed at T seconds. --fps F: over time, --frames N instants T + i / F;\n"
+        "  metrics.json's \"over_time\" holds each frame's error per mode and each mode's worst frame (largest\n"
+        "  p95), DIR/frames.csv the rows frame,time_s,mode,pixels,median_arcmin,p95_arcmin,max_arcmin,psnr_db."}},
       {"sweep",
        {cmdSweep, "compare over a grid of tessellations and map sizes; write sweep.csv and error-vs-time plots",
         "pvrr sweep SCENE [--tessellation N1,N2,...] [--map-size S1,S2,...] [--vary PATH=V1,V2,...]... [--modes "

@@ -263,13 +263,23 @@ RenderedFrame renderFrame(LoadedScene& ls, RenderMode mode, const std::string& g
   return out;
 }
 
+bool poseSceneAt(LoadedScene& ls, double t_s, RenderSession* session) {
+  if (!isAnimated(ls.desc) || !applyAnimation(ls.scene, ls.desc, t_s)) return false;
+  session->renderer.reset();  // before the ray scene it refers to
+  session->rays.reset();
+  session->cache = gl::FrameCache{};
+  return true;
+}
+
 int cmdRender(const std::vector<std::string>& argv) {
-  Args a("render", argv, {"mode", "size", "out", "gl", "set", "stats", "frames", "orbit"}, {}, {"set"});
+  Args a("render", argv, {"mode", "size", "out", "gl", "set", "stats", "frames", "orbit", "time", "fps"}, {}, {"set"});
   if (a.positional().size() > 1) usageError("render", "expected at most one scene file");
   const std::string scene_path = a.positional().empty() ? kDefaultScene : a.positional()[0];
   const auto size = a.getSize("size");
   const int frames = a.getInt("frames", 1, 1);
   const double orbit_deg = a.getDouble("orbit", 0.0);
+  const double time0_s = a.getDouble("time", 0.0), fps = a.getDouble("fps", 30.0);
+  if (!(fps > 0)) usageError("render", "--fps: expected a number > 0, got \"" + *a.get("fps") + "\"");
   LoadedScene ls = loadScene(scene_path, a.all("set"), size ? size->first : 0, size ? size->second : 0);
   const auto mode_arg = a.get("mode");
   // Validated before any work.
@@ -296,6 +306,8 @@ int cmdRender(const std::vector<std::string>& argv) {
   double rss_baseline_mb = 0;
   json rss_samples = json::array();  // [frame, MB] at about 20 points of the run, to tell growth from settling
   const int sample_every = std::max(1, frames / 20);
+  const bool animated = isAnimated(ls.desc);
+  int rebuilt = 0;  // frames whose renderer and ray scene were built again because something moved
   for (int i = 0; i < frames; ++i) {
     if (frames > 1 && orbit_deg != 0) {
       // Turn the head about the vertical axis through the eye.
@@ -310,6 +322,8 @@ int cmdRender(const std::vector<std::string>& argv) {
       session.cache.environment_changed = false;
     }
     if (i > 0 && orbit_deg == 0) session.cache.environment_changed = false;
+    // Time advances by 1 / fps a frame from --time (after the orbit: attached elements take both).
+    if (poseSceneAt(ls, time0_s + double(i) / fps, &session) && i > 0) ++rebuilt;
     session.read_back = i + 1 == frames;  // only the last frame is written out
     last = renderFrame(ls, mode, gl_name, &session);
     if (i + 1 == rss_frame) rss_baseline_mb = currentRssMb();
@@ -359,11 +373,17 @@ int cmdRender(const std::vector<std::string>& argv) {
                 last.height, nameOf(mode), spread.c_str(),
                 (frames > 1 ? "; first frame " + fmt("%.3f", first_ms) + " ms (cold)" : std::string()).c_str());
   }
+  if (animated && frames == 1) std::printf("animation: t = %.4g s\n", time0_s);
+  if (animated && frames > 1)
+    std::printf("animation: t = %.4g s to %.4g s at %.4g fps; %d of %d frame(s) after the first built the renderer "
+                "and the ray scene again (something moved)\n",
+                time0_s, time0_s + double(frames - 1) / fps, fps, rebuilt, frames - 1);
   printQuality(last.elements, "");
   if (auto stats = a.get("stats")) {
     json j = {{"scene", scene_path}, {"mode", nameOf(mode)}, {"size", {last.width, last.height}}, {"gl", last.gl_backend},
               {"frame_ms", frame_ms}, {"frame_ms_mean", mean_ms}, {"frame_ms_max", max_ms}, {"frames", frames},
-              {"frame_ms_first", first_ms},
+              {"frame_ms_first", first_ms}, {"time_s", time0_s}, {"fps", fps}, {"animated", animated},
+              {"frames_rebuilt", rebuilt},
               {"stages", stagesJson(last.stages)},
               {"elements", last.elements}, {"peak_rss_mb", peakRssMb()}};
     // Resident memory (MB) after frame `after_frame` and after the last frame, before the PNG is written.

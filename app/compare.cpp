@@ -14,6 +14,7 @@
 #include "app/progress.h"
 #include "app/report.h"
 #include "pvrr/base/error.h"
+#include "pvrr/base/format.h"
 #include "pvrr/base/image.h"
 #include "pvrr/optics/spectrum.h"
 
@@ -168,6 +169,9 @@ const char* kDefinitions[][2] = {
                 "the same way scores higher"},
     {"psnr_supersampled_db", "the same against the reference traced at twice the size, each pixel the linear mean "
                              "of its 2 x 2: closer to the true picture (reference.frame_ms is the one-ray frame's)"},
+    {"over_time", "with --fps: the reference and each mode at the instants time_s + i / fps, i < --frames (the "
+                  "scene's animation posed at each); per frame and mode the angular error and PSNR as above, and "
+                  "the worst frame: the one with the largest p95 angular error (DIR/frames.csv holds the same rows)"},
     {"fringe", "over dispersive lens pixels: the deviation of a channel is the angle between the eye ray and the line from "
                "the lens point to that channel's seen point; blue bends more than red where deviation(B) > deviation(R); "
                "pixels where the two differ by less than 0.01 arcmin are left out"}};
@@ -189,15 +193,71 @@ std::vector<Vec3> supersampledReference(const LoadedScene& ls, const std::string
   return out;
 }
 
+// Compare over time (--fps): the reference and every mode at each instant t_i = time0 + i / fps, i < frames;
+// per mode the angular error of each frame and the worst frame (largest p95). One renderer (one GL context)
+// draws every mode, each with its own frame cache (on, as pvrr render --frames runs), while nothing moves; a
+// frame where something moved builds the renderer and the ray scene again. Sets frames.csv's rows in `csv`.
+json compareOverTime(LoadedScene& ls, const std::vector<RenderMode>& modes, const std::string& gl_name, int frames,
+                     double time0_s, double fps, std::string* csv) {
+  RenderSession session;
+  std::vector<gl::FrameCache> caches(modes.size());
+  json per_frame = json::array();
+  std::vector<std::pair<int, ErrorStats>> worst(modes.size(), {-1, ErrorStats{}});
+  *csv = "frame,time_s,mode,pixels,median_arcmin,p95_arcmin,max_arcmin,psnr_db\n";
+  for (int i = 0; i < frames; ++i) {
+    const double t = time0_s + double(i) / fps;
+    const bool moved = poseSceneAt(ls, t, &session);
+    for (gl::FrameCache& c : caches) {
+      if (moved) c = gl::FrameCache{};
+      else if (i > 0) c.environment_changed = false;
+    }
+    RenderSession none;
+    const RenderedFrame ref = renderFrame(ls, RenderMode::Raytrace, gl_name, &none);
+    json jf = {{"frame", i}, {"time_s", t}, {"moved", moved}, {"modes", json::object()}};
+    for (size_t k = 0; k < modes.size(); ++k) {
+      const std::string m = nameOf(modes[k]);
+      session.cache = std::move(caches[k]);
+      const RenderedFrame f = renderFrame(ls, modes[k], gl_name, &session);
+      caches[k] = std::move(session.cache);
+      const ErrorStats st = compareToReference(ref, f);
+      jf["modes"][m] = {{"pixels", st.pixels},
+                        {"angular_error_arcmin", {{"median", st.median_arcmin}, {"p95", st.p95_arcmin}, {"max", st.max_arcmin}}},
+                        {"psnr_db", st.psnr_db}};
+      *csv += std::to_string(i) + "," + fmt("%.6g", t) + "," + m + "," + std::to_string(st.pixels) + "," +
+              fmt("%.6g", st.median_arcmin) + "," + fmt("%.6g", st.p95_arcmin) + "," + fmt("%.6g", st.max_arcmin) +
+              "," + fmt("%.6g", st.psnr_db) + "\n";
+      if (worst[k].first < 0 || st.p95_arcmin > worst[k].second.p95_arcmin) worst[k] = {i, st};
+    }
+    per_frame.push_back(jf);
+  }
+  json jw = json::object();
+  for (size_t k = 0; k < modes.size(); ++k) {
+    const std::string m = nameOf(modes[k]);
+    const ErrorStats& st = worst[k].second;
+    const double t = time0_s + double(worst[k].first) / fps;
+    jw[m] = {{"frame", worst[k].first}, {"time_s", t},
+             {"angular_error_arcmin", {{"median", st.median_arcmin}, {"p95", st.p95_arcmin}, {"max", st.max_arcmin}}},
+             {"psnr_db", st.psnr_db}};
+    std::printf("%-8s over %d frames (t = %.4g .. %.4g s): worst frame %d (t = %.4g s): median %.4f' p95 %.4f' max %.3f'\n",
+                m.c_str(), frames, time0_s, time0_s + double(frames - 1) / fps, worst[k].first, t, st.median_arcmin,
+                st.p95_arcmin, st.max_arcmin);
+  }
+  return {{"time_s", time0_s}, {"fps", fps}, {"frames", per_frame}, {"worst_frame", jw}};
+}
+
 }  // namespace
 
 int cmdCompare(const std::vector<std::string>& argv) {
-  Args a("compare", argv, {"modes", "size", "frames", "out", "gl", "set"}, {}, {"set"});
+  Args a("compare", argv, {"modes", "size", "frames", "out", "gl", "set", "fps", "time"}, {}, {"set"});
   if (a.positional().size() != 1) usageError("compare", "expected one scene file");
   auto out_dir = a.get("out");
   if (!out_dir) usageError("compare", "--out DIR is required");
   const auto size = a.getSize("size");
   const int frames = a.getInt("frames", 5, 1);
+  // --fps: over time, --frames instants from --time; otherwise --frames times each mode's frame at --time.
+  const bool over_time = a.has("fps");
+  const double time0_s = a.getDouble("time", 0.0), fps = a.getDouble("fps", 30.0);
+  if (!(fps > 0)) usageError("compare", "--fps: expected a number > 0, got \"" + *a.get("fps") + "\"");
   std::vector<RenderMode> modes;
   {
     std::stringstream ss(a.get("modes", "pvrr,envmap"));
@@ -213,6 +273,8 @@ int cmdCompare(const std::vector<std::string>& argv) {
   const auto backend = a.get("gl");
   const std::string gl_name = backend ? *backend : gl::glBackendName(gl::glBackendFromEnvironment(gl::GlBackend::Auto));
   gl::parseGlBackend(gl_name);
+  RenderSession posing;
+  poseSceneAt(ls, time0_s, &posing);
 
   // Units: the reference 1, the 2x2 supersampled reference 4, each mode 1.
   Progress progress("compare", 5.0 + double(modes.size()));
@@ -258,7 +320,7 @@ int cmdCompare(const std::vector<std::string>& argv) {
   for (const RenderMode mode : modes) {
     const std::string m = nameOf(mode);
     double frame_ms = 0;
-    const RenderedFrame f = timedFrame(ls, mode, gl_name, frames, &frame_ms);
+    const RenderedFrame f = timedFrame(ls, mode, gl_name, over_time ? 1 : frames, &frame_ms);
     gl_used = f.gl_backend;
     progress.clear();
     std::vector<double> err;
@@ -335,6 +397,12 @@ int cmdCompare(const std::vector<std::string>& argv) {
   progress.finish();
   metrics["gl"] = gl_used;
   metrics["modes"] = jm;
+  metrics["time_s"] = time0_s;
+  if (over_time) {
+    std::string csv;
+    metrics["over_time"] = compareOverTime(ls, modes, gl_name, frames, time0_s, fps, &csv);
+    writeFileAtomic(*out_dir + "/frames.csv", csv);
+  }
   metrics["peak_rss_mb"] = peakRssMb();
   writeFileAtomic(*out_dir + "/metrics.json", metrics.dump(2) + "\n");
   std::printf("reference %.1f ms; wrote %s/metrics.json\n", ref.frame_ms, out_dir->c_str());

@@ -36,6 +36,11 @@ struct RenderSession {
   bool read_back = true;
 };
 
+// Poses an animated scene at time t_s (applyAnimation); if anything moved, the session's renderer and ray
+// scene, which hold the scene's geometry, are dropped to be built again, with a fresh frame cache. Returns
+// whether anything moved. A scene without animation stays as it is.
+bool poseSceneAt(LoadedScene& ls, double t_s, RenderSession* session);
+
 // A --mode or --modes value: a raster mode (isRasterMode), or also raytrace where `raytrace_ok`. Throws
 // pvrr::Error "mode: expected one of pvrr, raster, envmap, impostor, raytrace; got ..." for another value.
 RenderMode parseModeOption(const std::string& text, bool raytrace_ok);

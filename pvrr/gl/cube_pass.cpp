@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "pvrr/base/format.h"
 #include "pvrr/gl/gl.h"
 
 namespace pvrr::gl {
@@ -16,7 +17,34 @@ bool CubePass::inCubes(size_t m) const {
   return follow > 0 && (ctx.scene.elements[m].type == ElementType::Mirror || lens_in_cubes);
 }
 
-void CubePass::prepare(RenderMode frame_mode, FrameStages& stages, FrameCache*) {
+CubePass::CubeKey CubePass::keyNow(size_t formats) const {
+  CubeKey k;
+  k.mode = mode;
+  k.map_size = ctx.options.map_size;
+  k.layers = layers;
+  k.follow = follow;
+  k.formats = formats;
+  k.lens_in_cubes = lens_in_cubes;
+  for (const Element& el : ctx.scene.elements) k.poses.push_back(el.local_to_world);
+  return k;
+}
+
+std::string CubePass::staleReason(const FrameCache* cache, const CubeKey& k) const {
+  if (!cache) return "no frame cache (a single frame)";
+  if (cache->environment_changed) return "the environment changed (or a new frame cache)";
+  if (!drawn_key) return "first frame";
+  const CubeKey& d = *drawn_key;
+  if (d.mode != k.mode || d.map_size != k.map_size || d.layers != k.layers || d.follow != k.follow ||
+      d.formats != k.formats || d.lens_in_cubes != k.lens_in_cubes || d.poses.size() != k.poses.size())
+    return "the mode or the map settings changed";
+  for (size_t e = 0; e < k.poses.size(); ++e)
+    if (d.poses[e] != k.poses[e])
+      return "element \"" + ctx.scene.elements[e].name + "\" moved" +
+             (ctx.scene.elements[e].attached_to_observer ? " (attached to the observer)" : "");
+  return "";
+}
+
+void CubePass::prepare(RenderMode frame_mode, FrameStages& stages, FrameCache* cache) {
   const Scene& scene = ctx.scene;
   mode = frame_mode;
   noteCpuStagesSkipped(stages, scene, mode);
@@ -41,9 +69,21 @@ void CubePass::prepare(RenderMode frame_mode, FrameStages& stages, FrameCache*) 
     if (scene.elements[e].type == ElementType::Lens) s.height_maps += maps.updateLensMaps(e);
     else s.surface_maps += maps.updateMirrorMaps(e);
   }
+  // Reuse: the cubes drawn last, if nothing they show has changed since (they do not depend on the eye).
+  CubeKey key = keyNow(formats.size());
+  const std::string stale = staleReason(cache, key);
+  cubes_reused = stale.empty() && cubes.size() == n_el;
+  if (!cubes_reused) {
+    drawn_key = std::move(key);
+    layer1_drawn = false;
+    reused_frames = 0;
+  } else {
+    ++reused_frames;
+  }
   // The elements other cubes show: each mesh uploaded once (MeshPool slots).
   cube_mesh.assign(n_el, 0);
-  for (size_t m = 0; m < n_el; ++m) {
+  const bool cube_draws = !cubes_reused || (layers > 1 && !layer1_drawn);  // what draws into cubes this frame
+  for (size_t m = 0; m < n_el && cube_draws; ++m) {
     if (!inCubes(m)) continue;
     const ElementFrame f = prepareElement(scene, int(m), &ctx.grid_cache.get(scene, int(m)));
     cube_mesh[m] = ctx.meshes.next();
@@ -55,7 +95,7 @@ void CubePass::prepare(RenderMode frame_mode, FrameStages& stages, FrameCache*) 
     glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
   }
   glActiveTexture(GL_TEXTURE0);
-  for (size_t e = 0; e < n_el; ++e) {
+  for (size_t e = 0; e < n_el && !cubes_reused; ++e) {
     if (cubes[e]->size != ctx.options.map_size || cubes[e]->colors.size() != formats.size())
       cubes[e]->create(ctx.options.map_size, formats);
     // The second layer's targets exist from here on: the element programs bind them.
@@ -72,6 +112,20 @@ void CubePass::prepare(RenderMode frame_mode, FrameStages& stages, FrameCache*) 
   s.lens_in_cubes = lens_in_cubes;
   s.lens_count = maps.lensCount();
   noteCubeFirstPass(stages, scene, mode, ctx.options.cull_back_faces, s);
+  for (StageTiming& t : stages.stages) {
+    if (t.name != stage::kFirstPass) continue;
+    if (cubes_reused) {  // the plan's note stays, as what the reused cubes hold
+      t.ran = false;
+      t.reason = "cube maps reused: drawn " + std::to_string(reused_frames) +
+                 " frame(s) ago, and nothing they show has changed since (the environment, every element's pose, "
+                 "the mode and map settings; the cubes do not depend on the eye); " +
+                 t.note;
+      t.note.clear();
+      t.ms = 0;
+    } else {
+      appendNote(t.note, "drawn: " + stale);
+    }
+  }
 }
 
 void CubePass::drawCubeElement(size_t m, const Mat4& view_proj, const Vec3& origin, const MeshBuffers& mesh, bool peel) {
@@ -230,14 +284,19 @@ std::string CubePass::drawSecondLayers(const PassCamera& eye, const Framebuffer&
   }
   glActiveTexture(GL_TEXTURE0);
   CullCount layer_culled;
-  for (size_t e = 0; e < n_el; ++e) layer_culled.add(drawCubes(e, 1).first);
+  const bool layer1_reused = layer1_drawn;  // drawn with the first layers' key (prepare voids it with them)
+  for (size_t e = 0; e < n_el && !layer1_reused; ++e) layer_culled.add(drawCubes(e, 1).first);
+  layer1_drawn = true;
   target.bind();
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   for (size_t e = 0; e < n_el; ++e)
     if (left[e] > 0) drawElement(e, 1, eye);
   glFinish();
-  return secondLayersNote(msSince(t_layers), cullNote(layer_culled, ctx.options.cull_back_faces), total);
+  return secondLayersNote(msSince(t_layers),
+                          layer1_reused ? std::string("reused, drawn in an earlier frame")
+                                        : cullNote(layer_culled, ctx.options.cull_back_faces),
+                          total);
 }
 
 }  // namespace pvrr::gl

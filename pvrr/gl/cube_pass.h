@@ -5,6 +5,7 @@
 // them; and each element's second-pass draw from its cubes.
 #pragma once
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -36,8 +37,27 @@ class CubePass : public ModePass {
   // The probe, and where some pixel needs them, the second layers' cubes and second draws; returns the note.
   std::string drawSecondLayers(const PassCamera& eye, const Framebuffer& target);
 
+  // Cube-map reuse across frames. The cubes show the scene from each element's centre: they depend on the
+  // environment, every element's pose (the centres, and the elements drawn in other cubes), the mode and
+  // the map settings, never on the eye. What the cubes drawn last were drawn with:
+  struct CubeKey {
+    RenderMode mode = RenderMode::Envmap;
+    int map_size = 0, layers = 1, follow = 0;
+    size_t formats = 0;
+    bool lens_in_cubes = false;
+    std::vector<Mat4> poses;  // each element's local_to_world
+  };
+  CubeKey keyNow(size_t formats) const;
+  // Why the cubes drawn last cannot serve this frame (to be drawn again), or "" when they can. Reuse needs
+  // a frame cache whose environment has not changed (FrameCache::environment_changed).
+  std::string staleReason(const FrameCache* cache, const CubeKey& key) const;
+
   RenderContext ctx;
   ImpostorMaps maps;
+  std::optional<CubeKey> drawn_key;                 // the cubes' key; empty before the first draw
+  bool layer1_drawn = false;                        // the second layers' cubes were drawn with drawn_key too
+  int reused_frames = 0;                            // frames drawn from the cubes since they were drawn
+  bool cubes_reused = false;                        // this frame's cubes are the last frame's
   std::vector<std::unique_ptr<CubeTarget>> cubes;   // one per element
   std::vector<std::unique_ptr<CubeTarget>> cubes1;  // impostor mode's second layers (impostorLayers), one per element
   // This frame's plan (prepare):

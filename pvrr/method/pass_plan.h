@@ -42,6 +42,9 @@ struct FrameCache {
   Mat4 view{1.0};                    // the observer's view matrix of the cached frame
   Mat4 projection{1.0};              // and its projection: what it sees of each element (ElementFrame::in_view)
   std::vector<ElementFrame> elements;
+  // Set by the caller: whether the environment may have changed since the last frame drawn with this cache.
+  // false also lets envmap and impostor modes reuse their cube maps, while no element moved
+  // (pvrr/gl/cube_pass.h).
   bool environment_changed = true;
   // Map reuse (PassPlanOptions::map_reuse_margin_deg): the top-level maps the renderer last rendered, in map
   // slot order, with the (widened) volume and the longer side each was rendered with. Empty when that

@@ -126,7 +126,13 @@ struct Scene {
   std::vector<Light> lights;
   std::vector<Element> elements;
   RenderSettings render;
-  // Axis-aligned bounds of the environment (world), for far planes and escape distances.
+  // Animation (pvrr/scene/animation.h, applyAnimation in scene_build.h): the instant the animated objects and
+  // elements are posed at, and per environment mesh its placed copy (before any motion) if it is animated,
+  // else an empty mesh.
+  double time_s = 0;
+  std::vector<EnvMesh> placed_meshes;
+  // Axis-aligned bounds of the environment (world), for far planes and escape distances. With animation:
+  // of every pose the animated meshes take at their keys, so that they do not change with time.
   Vec3 bounds_min{0}, bounds_max{0};
   void updateBounds();
   double boundsRadius() const { return 0.5 * glm::length(bounds_max - bounds_min); }

@@ -1,5 +1,6 @@
 #include "pvrr/scene/scene_build.h"
 
+#include <algorithm>
 #include <filesystem>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -347,6 +348,8 @@ void buildLens(Element& el, const ElementDesc& e, const std::string& file, size_
 
 }  // namespace
 
+void animatedBounds(Scene& scene, const SceneDesc& desc);  // below, with applyAnimation
+
 Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
   Scene scene;
   scene.source_path = desc.source;
@@ -389,6 +392,7 @@ Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
     }
     mesh.material = int(scene.materials.size());
     scene.materials.push_back(mat);
+    scene.placed_meshes.push_back(o.animation ? mesh : EnvMesh{});
     scene.meshes.push_back(std::move(mesh));
   }
 
@@ -445,7 +449,8 @@ Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
   RenderSettings& rs = scene.render;
   static_cast<RenderDesc&>(rs) = desc.render;
   if (rs.output.empty()) rs.output = "out/" + scene.name + ".png";
-  scene.updateBounds();
+  animatedBounds(scene, desc);
+  applyAnimation(scene, desc, 0.0);
   rs.far_distance_m = std::max(1e3, 100.0 * scene.boundsRadius());
   return scene;
 }
@@ -454,9 +459,68 @@ void updateAttachedElements(Scene& scene, const SceneDesc& desc) {
   const Mat4 obs = observerToWorld(scene.observer);
   for (size_t i = 0; i < scene.elements.size() && i < desc.elements.size(); ++i) {
     Element& el = scene.elements[i];
-    const Mat4 pose = poseMatrix(desc.elements[i].pose);
+    const ElementDesc& d = desc.elements[i];
+    const Mat4 pose =
+        d.animation ? motionAt(*d.animation, d.pose.position, scene.time_s) * poseMatrix(d.pose) : poseMatrix(d.pose);
     el.local_to_world = el.attached_to_observer ? obs * pose : pose;
     el.world_to_local = glm::inverse(el.local_to_world);
+  }
+}
+
+bool isAnimated(const SceneDesc& desc) {
+  return std::any_of(desc.environment.begin(), desc.environment.end(),
+                     [](const EnvObjectDesc& o) { return bool(o.animation); }) ||
+         std::any_of(desc.elements.begin(), desc.elements.end(),
+                     [](const ElementDesc& e) { return bool(e.animation); });
+}
+
+namespace {
+
+// `placed` moved rigidly by m: the anchor in double, the positions and normals rotated.
+void moveMesh(const EnvMesh& placed, const Mat4& m, EnvMesh& out) {
+  const Mat3 r(m);
+  out.anchor = Vec3(m * Vec4(placed.anchor, 1.0));
+  for (size_t i = 0; i < placed.positions.size(); ++i) out.positions[i] = glm::vec3(r * Vec3(placed.positions[i]));
+  for (size_t i = 0; i < placed.normals.size(); ++i)
+    out.normals[i] = glm::vec3(glm::normalize(r * Vec3(placed.normals[i])));
+}
+
+}  // namespace
+
+bool applyAnimation(Scene& scene, const SceneDesc& desc, double t_s) {
+  bool moved = false;
+  scene.time_s = t_s;
+  for (size_t i = 0; i < desc.environment.size() && i < scene.meshes.size(); ++i) {
+    const EnvObjectDesc& o = desc.environment[i];
+    if (!o.animation) continue;
+    EnvMesh& mesh = scene.meshes[i];
+    const Vec3 anchor = mesh.anchor;
+    const std::vector<glm::vec3> positions = mesh.positions;
+    moveMesh(scene.placed_meshes[i], motionAt(*o.animation, o.position, t_s), mesh);
+    moved = moved || anchor != mesh.anchor || positions != mesh.positions;
+  }
+  std::vector<Mat4> poses;
+  for (const Element& el : scene.elements) poses.push_back(el.local_to_world);
+  updateAttachedElements(scene, desc);
+  for (size_t e = 0; e < poses.size(); ++e) moved = moved || poses[e] != scene.elements[e].local_to_world;
+  return moved;
+}
+
+// The bounds of the scene as built, widened by every pose its animated meshes take at their keys (the
+// elements' positions change the bounds little; the scene at t = 0 holds them).
+void animatedBounds(Scene& scene, const SceneDesc& desc) {
+  scene.updateBounds();
+  for (size_t i = 0; i < desc.environment.size() && i < scene.meshes.size(); ++i) {
+    const EnvObjectDesc& o = desc.environment[i];
+    if (!o.animation) continue;
+    EnvMesh moved = scene.placed_meshes[i];
+    for (const Keyframe& k : o.animation->keys) {
+      moveMesh(scene.placed_meshes[i], motionAt(*o.animation, o.position, k.time_s), moved);
+      for (const glm::vec3& p : moved.positions) {
+        scene.bounds_min = glm::min(scene.bounds_min, moved.anchor + Vec3(p));
+        scene.bounds_max = glm::max(scene.bounds_max, moved.anchor + Vec3(p));
+      }
+    }
   }
 }
 

@@ -37,8 +37,17 @@ using MeshLoader = std::function<MeshData(const std::string& path)>;
 Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh = {});
 
 // The pose of an element attached to the observer follows the observer: recomputes local_to_world for
-// every attached element after the observer moved (pvrr render --orbit).
+// every attached element after the observer moved (pvrr render --orbit), and of every animated element at
+// scene.time_s.
 void updateAttachedElements(Scene& scene, const SceneDesc& desc);
+
+// Whether any environment object or element of the scene is animated.
+bool isAnimated(const SceneDesc& desc);
+
+// Poses the animated environment meshes (from Scene::placed_meshes, rigidly: anchor, positions and normals)
+// and elements at time t_s (seconds) and sets scene.time_s; the bounds stay (they hold every key's pose).
+// Returns whether any of them moved from where it was. buildScene poses the scene at t = 0.
+bool applyAnimation(Scene& scene, const SceneDesc& desc, double t_s);
 
 // Spectacle prescription -> surface radii (our sign convention, cad/sag.h). `base_curve_d` is the
 // object-side surface power; t the centre thickness (m). Back vertex power = sphere (+ cylinder).

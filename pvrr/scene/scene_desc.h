@@ -20,6 +20,7 @@
 
 #include "pvrr/base/math.h"
 #include "pvrr/base/names.h"
+#include "pvrr/scene/animation.h"
 #include "pvrr/scene/render_desc.h"
 
 namespace pvrr {
@@ -114,6 +115,9 @@ struct EnvObjectDesc {
   Vec3 u_axis{1, 0, 0};
   Vec3 v_axis{0, 0, -1};
   double radius_m = 0;  // sphere
+  // Keyframed motion from the placed pose above, about `position` (pvrr/scene/animation.h); absent: it stays.
+  std::optional<AnimationDesc> animation;
+  bool dynamic = false;  // it may move (every animated object is dynamic)
 };
 inline constexpr NameTable<EnvObjectDesc::Type, 5> kEnvObjectTypeNames = {{{EnvObjectDesc::Type::Mesh, "mesh"},
                                                                             {EnvObjectDesc::Type::Ground, "ground"},
@@ -233,6 +237,10 @@ struct ElementDesc {
   // Lens: the wearer's eye behind it (the `eye` block; pvrr lensmap): its centre of rotation on the lens axis,
   // this far behind the eye-side vertex (12 mm vertex distance + 13.5 mm by default).
   double eye_rotation_centre_m = kDefaultEyeRotationCentre_m;
+  // Keyframed motion from `pose`, about pose.position, in the frame of the pose (the observer's when
+  // attached) (pvrr/scene/animation.h); absent: it stays.
+  std::optional<AnimationDesc> animation;
+  bool dynamic = false;  // it may move (every animated element is dynamic)
 };
 inline constexpr NameTable<ElementDesc::Type, 2> kElementTypeNames = {
     {{ElementDesc::Type::Mirror, "mirror"}, {ElementDesc::Type::Lens, "lens"}}};

@@ -199,11 +199,46 @@ void planeAxes(const Obj& o, const std::string& hint_key, const Vec3& u_hint, bo
   d.v_axis = glm::cross(d.normal, d.u_axis);
 }
 
+// --- animation ---
+
+// {"interpolation": "linear" | "smooth", "keys": [{"time_s", "offset", "rotation_deg"}, ...]}: at least one
+// key, times finite and strictly increasing; offsets in the file's unit.
+AnimationDesc readAnimation(const Ctx& c, const json* j, const std::string& path) {
+  Obj o(c, j, path, "an animation {\"interpolation\": " + alternatives<Interpolation>() + ", \"keys\": [...]}",
+        {"interpolation", "keys"});
+  AnimationDesc a;
+  a.interpolation = o.choice<Interpolation>("interpolation", Interpolation::Linear);
+  const json* keys = o.get("keys");
+  const std::string what = "a non-empty array of keys [{\"time_s\", \"offset\", \"rotation_deg\"}, ...]";
+  if (!keys || !keys->is_array() || keys->empty()) o.expected("keys", what);
+  for (size_t i = 0; i < keys->size(); ++i) {
+    const std::string kp = indexPath(o.at("keys"), i);
+    Obj k(c, &(*keys)[i], kp, "a key {\"time_s\": seconds, \"offset\": [x, y, z], \"rotation_deg\": [x, y, z]}",
+          {"time_s", "offset", "rotation_deg"});
+    Keyframe key;
+    key.time_s = k.number("time_s", kAny, "a time in seconds");
+    if (!a.keys.empty() && !(key.time_s > a.keys.back().time_s))
+      c.fail(k.at("time_s"), "expected a time after the previous key's " + fmt(a.keys.back().time_s) + " s, got " +
+                                 show(k.get("time_s")));
+    key.offset_m = k.point("offset", Vec3(0));
+    key.rotation_deg = k.vec3("rotation_deg", VecKind::Point, Vec3(0));
+    a.keys.push_back(key);
+  }
+  return a;
+}
+
+// "animation" and "dynamic" of an environment object or element.
+void readMotion(const Ctx& c, const Obj& o, std::optional<AnimationDesc>& animation, bool& dynamic) {
+  if (o.has("animation")) animation = readAnimation(c, o.get("animation"), o.at("animation"));
+  dynamic = o.boolean("dynamic", animation.has_value());
+  if (animation && !dynamic) o.expected("dynamic", "true (an animated object is dynamic) or no \"dynamic\"");
+}
+
 EnvObjectDesc readEnvObject(const Ctx& c, const json* j, const std::string& path, size_t index) {
   const std::string what = "an environment object {\"type\": " + alternatives<EnvObjectDesc::Type>() + ", ...}";
   using Type = EnvObjectDesc::Type;
   const Type type = peekChoice<Type>(c, j, path, what, "type");
-  std::vector<std::string> keys = {"type", "name", "material"};
+  std::vector<std::string> keys = {"type", "name", "material", "animation", "dynamic"};
   if (type == Type::Mesh) keys.insert(keys.end(), {"file", "transform"});
   if (type == Type::Ground) keys.insert(keys.end(), {"point", "normal", "size", "u_axis"});
   if (type == Type::Box) keys.insert(keys.end(), {"centre", "size", "rotation_deg", "axis_angle"});
@@ -214,6 +249,7 @@ EnvObjectDesc readEnvObject(const Ctx& c, const json* j, const std::string& path
   d.name = o.string("name", nameOf(type) + std::to_string(index));
   d.material = readMaterial(c, o.get("material"), o.at("material"));
   d.type = type;
+  readMotion(c, o, d.animation, d.dynamic);
   if (type == Type::Mesh) {
     d.file = o.file("file", {".obj", ".ply", ".gltf", ".glb", ".stl"}, "OBJ, PLY, glTF or STL mesh");
     d.scale = Vec3(c.unit_m);
@@ -472,8 +508,9 @@ double readEyeRotationCentre(const Ctx& c, const json* j, const std::string& pat
 ElementDesc readElement(const Ctx& c, const json* j, const std::string& path, size_t index) {
   const std::string what = "an element {\"type\": " + alternatives<ElementDesc::Type>() + ", ...}";
   const ElementDesc::Type type = peekChoice<ElementDesc::Type>(c, j, path, what, "type");
-  std::vector<std::string> keys = {"name", "type", "pose", "attached_to_observer", "outline", "tessellation",
-                                   "patches", "max_patch_fov_deg", "material"};
+  std::vector<std::string> keys = {"name",     "type",         "pose",    "attached_to_observer",
+                                   "outline",  "tessellation", "patches", "max_patch_fov_deg",
+                                   "material", "animation",    "dynamic"};
   if (type == ElementDesc::Type::Mirror) keys.push_back("surface");
   else keys.insert(keys.end(), {"front", "back", "centre_thickness", "min_edge_thickness", "prescription", "eye"});
   Obj o(c, j, path, what, keys);
@@ -481,6 +518,7 @@ ElementDesc readElement(const Ctx& c, const json* j, const std::string& path, si
   e.type = type;
   e.name = o.string("name", "element" + std::to_string(index));
   e.attached_to_observer = o.boolean("attached_to_observer", false);
+  readMotion(c, o, e.animation, e.dynamic);
 
   {
     Obj p(c, o.get("pose"), o.at("pose"), "a pose {\"position\", \"normal\", \"up\"}", {"position", "normal", "up"});
