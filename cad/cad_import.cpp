@@ -554,7 +554,7 @@ static void requireImportSurvives(const std::string& path, bool step) {
   }
   // A child that never ends (a reader stuck on a lock another thread held at the fork) must not hang the
   // import: after kChildSeconds it is killed and the import runs in-process, as without the child.
-  constexpr double kChildSeconds = 120;
+  constexpr double kChildSeconds = 30;
   int status = 0;
   for (double waited = 0;; waited += 2e-3) {
     const pid_t r = ::waitpid(child, &status, WNOHANG);
