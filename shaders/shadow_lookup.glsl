@@ -2,7 +2,7 @@
 // term of shaders/shading.glsl times the fraction of its shadow map's filter taps that see the point lit,
 // and times a lens's transmittance where the point lies behind the nearest lens (SHADOW_LENSES). The
 // reference's counterpart is pvrr/trace/shadow_rays.h.
-// Filter: 3 x 3 taps one texel apart, each a hardware 2 x 2 bilinear comparison (PCF over 4 x 4 texels).
+// Filter: 3 x 3 bilinear comparisons one texel apart (PCF over 4 x 4 texels), read by four gathers (shadowPcf).
 // Receivers are moved off their surface along the normal by kShadowNormalOffset texels of their layer (in
 // metres: the layer's texel size, times the distance for a point light), against self-shadowing.
 // Positions are relative to the current pass's camera origin, as in shading.glsl. Every per-light uniform is
@@ -28,10 +28,10 @@ uniform float u_point_shadow_tan_half;                // tan of each face's half
 #endif
 
 // The 3 x 3 bilinear taps one texel apart, from four gathers of the 4 x 4 texels they cover (the same sum:
-// columns i0 - 1 .. i0 + 2 weigh 1 - f.x, 1, 1, f.x, rows likewise). Not nine filtered lookups: llvmpipe's
-// bilinear depth comparison cost about 30 ms a 640 x 480 frame, and textureGrad (explicit derivatives, lod
-// per pixel) over 60 ms more (docs/performance.md "Shadows"); a gather needs no derivatives, so it is
-// defined in the light loop's non-uniform control flow too.
+// columns i0 - 1 .. i0 + 2 weigh 1 - f.x, 1, 1, f.x, rows likewise). Not nine filtered lookups: textureGrad
+// (explicit derivatives) makes llvmpipe sample with a lod per pixel, its slow path: about twice the gathers'
+// time; texture() and sixteen texelFetch were slower too (docs/performance.md "Shadows"). A gather needs no
+// derivatives, so it is defined in the light loop's non-uniform control flow too.
 float shadowPcf(sampler2DArrayShadow s, vec3 uvz, float layer) {
   vec2 t = uvz.xy / u_shadow_texel - 0.5;  // texel space: texel i's centre at i
   vec2 i0 = floor(t), f = t - i0;
