@@ -2,7 +2,7 @@
 // term of shaders/shading.glsl times the fraction of its shadow map's filter taps that see the point lit,
 // and times a lens's transmittance where the point lies behind the nearest lens (SHADOW_LENSES). The
 // reference's counterpart is pvrr/trace/shadow_rays.h.
-// Filter: 3 x 3 taps one texel apart, each a hardware 2 x 2 bilinear comparison (PCF over 4 x 4 texels).
+// Filter: 3 x 3 bilinear comparisons one texel apart (PCF over 4 x 4 texels), read by four gathers (shadowPcf).
 // Receivers are moved off their surface along the normal by kShadowNormalOffset texels of their layer (in
 // metres: the layer's texel size, times the distance for a point light), against self-shadowing.
 // Positions are relative to the current pass's camera origin, as in shading.glsl. Every per-light uniform is
@@ -27,10 +27,24 @@ uniform vec2 u_point_shadow_near_far[NUM_POINT_LIGHTS];
 uniform float u_point_shadow_tan_half;                // tan of each face's half angle (a little over 1)
 #endif
 
+// The 3 x 3 bilinear taps one texel apart, from four gathers of the 4 x 4 texels they cover (the same sum:
+// columns i0 - 1 .. i0 + 2 weigh 1 - f.x, 1, 1, f.x, rows likewise). Not nine filtered lookups: textureGrad
+// (explicit derivatives) makes llvmpipe sample with a lod per pixel, its slow path: about twice the gathers'
+// time; texture() and sixteen texelFetch were slower too (docs/performance.md "Shadows"). A gather needs no
+// derivatives, so it is defined in the light loop's non-uniform control flow too.
 float shadowPcf(sampler2DArrayShadow s, vec3 uvz, float layer) {
-  float sum = 0.0;
-  for (int dy = -1; dy <= 1; ++dy)
-    for (int dx = -1; dx <= 1; ++dx) sum += textureGrad(s, vec4(uvz.xy + vec2(dx, dy) * u_shadow_texel, layer, uvz.z), vec2(0.0), vec2(0.0));
+  vec2 t = uvz.xy / u_shadow_texel - 0.5;  // texel space: texel i's centre at i
+  vec2 i0 = floor(t), f = t - i0;
+  // Each gather at the corner between its 2 x 2 texels: (x, y, z, w) = (c0 r1, c1 r1, c1 r0, c0 r0).
+  vec4 g00 = textureGather(s, vec3(i0 * u_shadow_texel, layer), uvz.z);
+  vec4 g10 = textureGather(s, vec3((i0 + vec2(2.0, 0.0)) * u_shadow_texel, layer), uvz.z);
+  vec4 g01 = textureGather(s, vec3((i0 + vec2(0.0, 2.0)) * u_shadow_texel, layer), uvz.z);
+  vec4 g11 = textureGather(s, vec3((i0 + vec2(2.0, 2.0)) * u_shadow_texel, layer), uvz.z);
+  vec2 e = 1.0 - f;
+  float sum = dot(g00, vec4(e.x, 1.0, 1.0, e.x * e.y) * vec4(1.0, 1.0, e.y, 1.0)) +
+              dot(g10, vec4(1.0, f.x, f.x * e.y, e.y)) +
+              dot(g01, vec4(e.x * f.y, f.y, 1.0, e.x)) +
+              dot(g11, vec4(f.y, f.x * f.y, f.x, 1.0));
   return sum * (1.0 / 9.0);
 }
 

@@ -54,7 +54,9 @@ ShadowLayout shadowLayout(const Scene& scene) {
 std::vector<std::string> shadowDefines(const Scene& scene) {
   const ShadowLayout layout = shadowLayout(scene);
   if (layout.layers == 0) return {};
-  std::vector<std::string> d = {"#define SHADOWS", "#define SHADOW_LAYERS " + std::to_string(layout.layers)};
+  // GL 4.0's textureGather of a shadow sampler (shaders/shadow_lookup.glsl shadowPcf), in a GLSL 3.30 shader.
+  std::vector<std::string> d = {"#extension GL_ARB_gpu_shader5 : require", "#define SHADOWS",
+                                "#define SHADOW_LAYERS " + std::to_string(layout.layers)};
   if (layout.lenses) d.push_back("#define SHADOW_LENSES");
   return d;
 }

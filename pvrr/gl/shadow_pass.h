@@ -6,9 +6,9 @@
 // - A directional light: one orthographic map along the light, fitted to the scene's bounding sphere.
 // - A point light: six perspective maps, one per axis direction, each a little wider than 90 degrees so that
 //   the filter's taps near a face's edge stay on that face.
-// All maps are the layers of one GL_TEXTURE_2D_ARRAY of depths, compared in hardware (sampler2DArrayShadow,
-// bilinear: 2 x 2 texels) and filtered by 3 x 3 such taps one texel apart (PCF over a 4 x 4 texel
-// footprint; measured in docs/accuracy.md "Shadows").
+// All maps are the layers of one GL_TEXTURE_2D_ARRAY of depths, compared in hardware (sampler2DArrayShadow)
+// and filtered as 3 x 3 bilinear taps one texel apart (PCF over a 4 x 4 texel footprint, read by four
+// gathers; measured in docs/accuracy.md "Shadows", its cost in docs/performance.md "Shadows").
 // Casters: the environment meshes and the mirrors (opaque); the lenses go into their own depth layers with
 // their transmittance (1 - R0)^2 beside (pvrr/trace/shadow_rays.h): a point behind the nearest lens from the
 // light gets that lens's transmittance, behind an opaque caster nothing. The maps are rendered when the
