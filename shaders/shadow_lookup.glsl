@@ -32,6 +32,7 @@ uniform float u_point_shadow_tan_half;                // tan of each face's half
 // (explicit derivatives) makes llvmpipe sample with a lod per pixel, its slow path: about twice the gathers'
 // time; texture() and sixteen texelFetch were slower too (docs/performance.md "Shadows"). A gather needs no
 // derivatives, so it is defined in the light loop's non-uniform control flow too.
+#if defined(SHADOW_GATHER)
 float shadowPcf(sampler2DArrayShadow s, vec3 uvz, float layer) {
   vec2 t = uvz.xy / u_shadow_texel - 0.5;  // texel space: texel i's centre at i
   vec2 i0 = floor(t), f = t - i0;
@@ -47,6 +48,17 @@ float shadowPcf(sampler2DArrayShadow s, vec3 uvz, float layer) {
               dot(g11, vec4(f.y, f.x * f.y, f.x, 1.0));
   return sum * (1.0 / 9.0);
 }
+#else
+// A GL without shadow gathers (before 4.0 and without GL_ARB_gpu_shader5): the same filter as nine bilinear
+// comparisons, with zero explicit derivatives (the maps have one level; defined in non-uniform control flow).
+float shadowPcf(sampler2DArrayShadow s, vec3 uvz, float layer) {
+  float sum = 0.0;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx)
+      sum += textureGrad(s, vec4(uvz.xy + vec2(dx, dy) * u_shadow_texel, layer, uvz.z), vec2(0.0), vec2(0.0));
+  return sum * (1.0 / 9.0);
+}
+#endif
 
 // The fraction of the light reaching the point at map coordinates uvz of layer `layer`.
 float shadowAt(vec3 uvz, float layer) {
