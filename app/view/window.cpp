@@ -178,7 +178,7 @@ bool Window::closeRequested() const { return glfwWindowShouldClose(window_); }
 
 void Window::framebufferSize(int* width, int* height) const { glfwGetFramebufferSize(window_, width, height); }
 
-void Window::present(unsigned texture, int width, int height) {
+void beginPresentPass(int width, int height) {
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   glViewport(0, 0, width, height);
   glDisable(GL_DEPTH_TEST);
@@ -186,6 +186,10 @@ void Window::present(unsigned texture, int width, int height) {
   glDisable(GL_CULL_FACE);
   glDisable(GL_SCISSOR_TEST);
   glDisable(GL_FRAMEBUFFER_SRGB);
+}
+
+void Window::present(unsigned texture, int width, int height) {
+  beginPresentPass(width, height);
   glUseProgram(program_);
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_2D, texture);

@@ -26,6 +26,11 @@ unsigned buildProgram(const char* vertex_source, const char* fragment_source, co
 // that draws every pixel of the window once.
 extern const char* const kFullScreenVs;
 
+// The GL state of a present pass: the window's framebuffer, the full viewport, no depth test, blending,
+// culling, scissor or sRGB conversion (the present shaders encode sRGB themselves). Used by Window::present
+// and Wipe::present.
+void beginPresentPass(int width, int height);
+
 class Window {
  public:
   // Opens a width x height window (framebuffer pixels). `vsync`: swap interval 1, else 0 (scripted runs, which

@@ -102,13 +102,7 @@ void Wipe::uploadHeat(const std::vector<std::uint8_t>& rgba) {
 }
 
 void Wipe::present(unsigned frame, int width, int height, double split_px, bool overlay) {
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  glViewport(0, 0, width, height);
-  glDisable(GL_DEPTH_TEST);
-  glDisable(GL_BLEND);
-  glDisable(GL_CULL_FACE);
-  glDisable(GL_SCISSOR_TEST);
-  glDisable(GL_FRAMEBUFFER_SRGB);
+  beginPresentPass(width, height);
   glUseProgram(program_);
   const unsigned textures[4] = {frame, window_.srgbTable(), reference_, heat_};
   const char* names[4] = {"u_frame", "u_srgb", "u_reference", "u_heat"};
