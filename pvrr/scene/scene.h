@@ -127,9 +127,11 @@ struct Scene {
   std::vector<Element> elements;
   RenderSettings render;
   // Animation (pvrr/scene/animation.h, applyAnimation in scene_build.h): the instant the animated objects and
-  // elements are posed at, and per environment mesh its placed copy (before any motion) if it is animated,
-  // else an empty mesh.
+  // elements are posed at; and per environment mesh (parallel to `meshes`; an object whose file has its own
+  // materials became several meshes) the index of the scene file's environment object it was built from, and
+  // its placed copy (before any motion) if that object is animated, else an empty mesh.
   double time_s = 0;
+  std::vector<size_t> mesh_object;
   std::vector<EnvMesh> placed_meshes;
   // Axis-aligned bounds of the environment (world), for far planes and escape distances. With animation:
   // of every pose the animated meshes take at their keys, so that they do not change with time.

@@ -182,7 +182,8 @@ void checkMeshParts(const MeshData& md, const std::string& where) {
 
 // One environment mesh per material part of a loaded mesh, each holding only the vertices its triangles use,
 // with the part's material (added to the scene).
-void addMeshParts(Scene& scene, const EnvMesh& whole, const std::vector<MeshPart>& parts, const std::string& what) {
+void addMeshParts(Scene& scene, const EnvMesh& whole, const std::vector<MeshPart>& parts, const std::string& what,
+                  size_t object, bool animated) {
   for (const MeshPart& p : parts) {
     EnvMesh sub;
     sub.name = whole.name + "/" + p.name;
@@ -211,6 +212,8 @@ void addMeshParts(Scene& scene, const EnvMesh& whole, const std::vector<MeshPart
     }
     sub.material = int(scene.materials.size());
     scene.materials.push_back(mat);
+    scene.mesh_object.push_back(object);
+    scene.placed_meshes.push_back(animated ? sub : EnvMesh{});
     scene.meshes.push_back(std::move(sub));
   }
 }
@@ -381,7 +384,7 @@ Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
     }
     mesh.name = o.name.empty() ? std::string(nameOf(o.type)) + std::to_string(i) : o.name;
     if (!parts.empty()) {  // a file with its own materials (glTF): one mesh per part, the file's materials
-      addMeshParts(scene, mesh, parts, what);
+      addMeshParts(scene, mesh, parts, what, i, o.animation.has_value());
       continue;
     }
     DiffuseMaterial mat;
@@ -392,6 +395,7 @@ Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
     }
     mesh.material = int(scene.materials.size());
     scene.materials.push_back(mat);
+    scene.mesh_object.push_back(i);
     scene.placed_meshes.push_back(o.animation ? mesh : EnvMesh{});
     scene.meshes.push_back(std::move(mesh));
   }
@@ -490,13 +494,13 @@ void moveMesh(const EnvMesh& placed, const Mat4& m, EnvMesh& out) {
 bool applyAnimation(Scene& scene, const SceneDesc& desc, double t_s) {
   bool moved = false;
   scene.time_s = t_s;
-  for (size_t i = 0; i < desc.environment.size() && i < scene.meshes.size(); ++i) {
-    const EnvObjectDesc& o = desc.environment[i];
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    const EnvObjectDesc& o = desc.environment[scene.mesh_object[m]];
     if (!o.animation) continue;
-    EnvMesh& mesh = scene.meshes[i];
+    EnvMesh& mesh = scene.meshes[m];
     const Vec3 anchor = mesh.anchor;
     const std::vector<glm::vec3> positions = mesh.positions;
-    moveMesh(scene.placed_meshes[i], motionAt(*o.animation, o.position, t_s), mesh);
+    moveMesh(scene.placed_meshes[m], motionAt(*o.animation, o.position, t_s), mesh);
     moved = moved || anchor != mesh.anchor || positions != mesh.positions;
   }
   std::vector<Mat4> poses;
@@ -510,12 +514,12 @@ bool applyAnimation(Scene& scene, const SceneDesc& desc, double t_s) {
 // elements' positions change the bounds little; the scene at t = 0 holds them).
 void animatedBounds(Scene& scene, const SceneDesc& desc) {
   scene.updateBounds();
-  for (size_t i = 0; i < desc.environment.size() && i < scene.meshes.size(); ++i) {
-    const EnvObjectDesc& o = desc.environment[i];
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    const EnvObjectDesc& o = desc.environment[scene.mesh_object[m]];
     if (!o.animation) continue;
-    EnvMesh moved = scene.placed_meshes[i];
+    EnvMesh moved = scene.placed_meshes[m];
     for (const Keyframe& k : o.animation->keys) {
-      moveMesh(scene.placed_meshes[i], motionAt(*o.animation, o.position, k.time_s), moved);
+      moveMesh(scene.placed_meshes[m], motionAt(*o.animation, o.position, k.time_s), moved);
       for (const glm::vec3& p : moved.positions) {
         scene.bounds_min = glm::min(scene.bounds_min, moved.anchor + Vec3(p));
         scene.bounds_max = glm::max(scene.bounds_max, moved.anchor + Vec3(p));

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "pvrr/base/error.h"
+#include "pvrr/scene/animation.h"
 #include "pvrr/scene/scene_build.h"
 
 namespace pvrr {
@@ -68,6 +69,36 @@ TEST(MeshParts, EachPartBecomesAMeshWithTheFilesMaterial) {
   ASSERT_EQ(red.texture, 0);
   EXPECT_EQ(s.textures[0].width, 2);
   EXPECT_EQ(s.textures[0].rgb[3], 0);
+}
+
+// An animated object with parts becomes several meshes: every part moves with it, and an animated object
+// after it moves its own mesh (the meshes are matched to the file's objects, not by position in the list).
+TEST(MeshParts, AnimatedPartsAndTheObjectsAfterThemMove) {
+  SceneDesc d = oneMeshScene();
+  AnimationDesc slide;
+  slide.keys = {Keyframe{0, Vec3(0), Vec3(0)}, Keyframe{1, Vec3(0, 0, -4), Vec3(0)}};
+  d.environment[0].animation = slide;
+  EnvObjectDesc box;
+  box.type = EnvObjectDesc::Type::Box;
+  box.name = "box";
+  box.position = Vec3(0, 5, 0);
+  box.size = Vec3(1);
+  AnimationDesc lift;
+  lift.keys = {Keyframe{0, Vec3(0), Vec3(0)}, Keyframe{1, Vec3(0, 2, 0), Vec3(0)}};
+  box.animation = lift;
+  d.environment.push_back(box);
+  Scene s = buildScene(d, [](const std::string&) { return twoParts(); });
+  ASSERT_EQ(s.meshes.size(), 3u);
+  const auto centre = [](const EnvMesh& m) {
+    Vec3 sum(0);
+    for (const glm::vec3& p : m.positions) sum += m.anchor + Vec3(p);
+    return sum / double(m.positions.size());
+  };
+  const Vec3 part0 = centre(s.meshes[0]), part1 = centre(s.meshes[1]), cube = centre(s.meshes[2]);
+  EXPECT_TRUE(applyAnimation(s, d, 0.5));
+  EXPECT_NEAR(glm::length(centre(s.meshes[0]) - (part0 + Vec3(0, 0, -2))), 0.0, 1e-5);
+  EXPECT_NEAR(glm::length(centre(s.meshes[1]) - (part1 + Vec3(0, 0, -2))), 0.0, 1e-5);
+  EXPECT_NEAR(glm::length(centre(s.meshes[2]) - (cube + Vec3(0, 1, 0))), 0.0, 1e-5);
 }
 
 TEST(MeshParts, PartsThatDoNotCoverTheTrianglesAreRefused) {
