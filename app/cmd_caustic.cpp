@@ -337,15 +337,12 @@ int cmdCaustic(const std::vector<std::string>& argv) {
 
   const json j = resultJson(scene_path, scene, rec, full, o, b, res, s);
   const std::string dir = *out;
-  {
-    OutputTransaction tx;
-    writePng((fs::path(dir) / "caustic.png").string(), heatMap(res, s, rec.name));
-    writeLinearPng((fs::path(dir) / "caustic-colour.png").string(), rec.rect.cells_u, rec.rect.cells_v,
-                   colourPicture(res.grid));
-    writeFileAtomic((fs::path(dir) / "caustic.csv").string(), gridCsv(res));
-    writeFileAtomic((fs::path(dir) / "caustic.json").string(), j.dump(2) + "\n");
-    tx.commit();
-  }
+  // All or nothing: the command runs inside cli.cpp's OutputTransaction.
+  writePng((fs::path(dir) / "caustic.png").string(), heatMap(res, s, rec.name));
+  writeLinearPng((fs::path(dir) / "caustic-colour.png").string(), rec.rect.cells_u, rec.rect.cells_v,
+                 colourPicture(res.grid));
+  writeFileAtomic((fs::path(dir) / "caustic.csv").string(), gridCsv(res));
+  writeFileAtomic((fs::path(dir) / "caustic.json").string(), j.dump(2) + "\n");
   std::printf(
       "%s: caustic on %s: peak %.4g W/m^2 at (%.4f, %.4f, %.4f) m, %.4g W on the window; %lld photons "
       "(%d wavelength sample%s), %.0f ms -> %s\n",

@@ -18,6 +18,7 @@
 
 #include "pvrr/base/error.h"
 #include "pvrr/base/names.h"
+#include "pvrr/scene/animation.h"
 #include "pvrr/scene/scene_desc.h"
 #include "pvrr/scene/scene_json.h"
 
@@ -359,9 +360,7 @@ inline Mat3 readRotation(const Obj& o) {
   if (o.has("rotation_deg") && o.has("axis_angle"))
     o.ctx().fail(o.at("axis_angle"), "expected either \"rotation_deg\" or \"axis_angle\", got both");
   if (o.has("rotation_deg")) {
-    const Vec3 deg = o.vec3("rotation_deg", VecKind::Point);
-    return rotationAbout(Vec3(0, 0, 1), radians(deg.z)) * rotationAbout(Vec3(0, 1, 0), radians(deg.y)) *
-           rotationAbout(Vec3(1, 0, 0), radians(deg.x));
+    return rotationFromDeg(o.vec3("rotation_deg", VecKind::Point));
   }
   if (o.has("axis_angle")) {
     Obj aa(o.ctx(), o.get("axis_angle"), o.at("axis_angle"), "an object {\"axis\": [x, y, z], \"angle_deg\": a}",

@@ -351,7 +351,7 @@ CausticResult depositPhotons(const PhotonBundle& bundle, const ReceiverRect& rec
       const double s = (e.x + e.y + e.z) / 3.0;
       if (s < 0.5 * peak) continue;
       wsum += s;
-      acc += s * (std::sqrt(res.grid.variance[k]) / s);
+      acc += std::sqrt(res.grid.variance[k]);  // the cell's standard error, weighted by its irradiance s
     }
     res.spot_rel_stderr = acc / wsum;
   }
