@@ -8,10 +8,13 @@
 // starting from the ray point at the depth the interpolated texture coordinate shows. The map's viewpoint is
 // fitted to the element's rays, so the search starts next to the answer and has little parallax to cross.
 // Where it ends off the map's surface (no convergence, outside the map, a texel the pass left unread, or across
-// a depth edge) the fragment keeps the interpolated coordinate. Atomic counters count, in the second pass, the
+// a depth edge) the fragment keeps the interpolated coordinate. A refined mirror has one channel, and its
+// vertices carry in the channel sets it leaves free (pvrr/gl/pvrr_pass.cpp uploadPatch): v_st1 = its normalised
+// surface parameters (s, t) and the depth of its exact hit along the map's forward, v_st2 and v_w1 = the
+// surface's exact derivatives along s and t (local frame): texture reads the fragment need not make. Atomic counters count, in the second pass, the
 // fragments whose view ray missed the exact surface (the triangles' silhouette overhang, or beyond the
 // outline) and those whose search failed; pvrr/gl/pvrr_pass.cpp counts the fragments drawn with a query and
-// reads both into the second pass's note.
+// reads both into the second pass's note once the frame has finished.
 #include "surface_maps.glsl"
 #if defined(REFINE) && (CHANNELS != 1 || defined(LENS))
 #error "REFINE: a mirror's one channel only"
@@ -37,48 +40,63 @@ float linearDepth(float window_z) { return u_depth_lin.y / (2.0 * window_z - 1.0
 // The map's texture coordinate of volume coordinate st, half a texel inside its region (as mapST).
 vec2 mapTexST(vec2 st) { return min(st * u_st_scale, u_st_max); }
 
+// The linear depth of the map at texture coordinate tc, bilinear between the four texels' window depths (as
+// GL_LINEAR filters them: exact between texels for a plane), and whether those texels lie on one surface: none
+// left unread (at the near plane), no depth edge between them. One gather serves both.
+float mapDepthChecked(vec2 tc, out bool on_surface) {
+  vec4 z = textureGather(u_map_depth, tc);  // texels (0, 1), (1, 1), (1, 0), (0, 0) of the bilinear footprint
+  vec2 w = fract(tc * vec2(textureSize(u_map_depth, 0)) - 0.5);
+  float zb = mix(mix(z.w, z.z, w.x), mix(z.x, z.y, w.x), w.y);
+  vec4 dz = u_depth_lin.y / (2.0 * z - 1.0 + u_depth_lin.x);
+  float lo = min(min(dz.x, dz.y), min(dz.z, dz.w)), hi = max(max(dz.x, dz.y), max(dz.z, dz.w));
+  on_surface = hi <= lo * (1.0 + u_edge) && lo > u_depth_lin.z * 1.001;
+  return linearDepth(zb);
+}
+
 // The map's volume coordinate (s, t) in [0, 1]^2 where the ray x + t R (x relative to the map's viewpoint)
-// meets what the map shows, searched from the coordinate st0 that the interpolation gives; false where the
-// search ends off the map's surface. The steps read the filtered window depth (linear in the screen for a
-// plane, so exact between texels there); the last point is checked on its four texels: none left unread (at
-// the near plane), no depth edge between them.
-bool refineSearch(vec3 x, vec3 R, vec2 st0, out vec2 st) {
+// meets what the map shows; false where the search ends off the map's surface. It starts at the depth
+// hit_depth (along the map's forward) that the fragment's interpolated exact vertex hits give, and takes
+// REFINE steps on the difference between the ray point's depth and the map's depth in its direction: the
+// first to the depth the map shows there ([Szirmay-Kalos et al.]'s Hit()), then secant steps; the last
+// point (or the first that converged) is read with its four texels, which also tell whether it lies on one
+// surface.
+bool refineSearch(vec3 x, vec3 R, float hit_depth, out vec2 st) {
   vec4 cx = u_map_vp * vec4(x, 1.0), cr = u_map_vp * vec4(R, 0.0);
   // The ray must move along the map's forward (it does: the forward is its rays' mean direction).
   if (cr.w <= 1e-3) return false;
-  float d = linearDepth(texture(u_map_depth, mapTexST(st0)).r);
-  float t = (d - cx.w) / cr.w, t_prev = 0.0, f_prev = 0.0, f = 0.0;
-  for (int i = 0; i <= REFINE; ++i) {
+  float t = (hit_depth - cx.w) / cr.w, t_prev = 0.0, f_prev = 0.0;
+  for (int i = 0; i < REFINE; ++i) {
     vec4 c = cx + t * cr;
     if (c.w <= 0.0) return false;
     st = c.xy / c.w * 0.5 + 0.5;
     if (any(lessThan(st, vec2(0.0))) || any(greaterThan(st, vec2(1.0)))) return false;
-    d = linearDepth(texture(u_map_depth, mapTexST(st)).r);
-    f = c.w - d;
-    if (abs(f) <= REFINE_TOL * d || i == REFINE) break;
-    // The first step moves the ray point to the depth the map shows in its direction; then secant steps.
+    float d = linearDepth(texture(u_map_depth, mapTexST(st)).r), f = c.w - d;
+    if (abs(f) <= REFINE_TOL * d) break;
     float t_next = i > 0 && f != f_prev ? t - f * (t - t_prev) / (f - f_prev) : (d - cx.w) / cr.w;
     t_prev = t;
     f_prev = f;
     t = t_next;
   }
-  vec4 z = textureGather(u_map_depth, mapTexST(st));
-  vec4 dz = u_depth_lin.y / (2.0 * z - 1.0 + u_depth_lin.x);
-  float lo = min(min(dz.x, dz.y), min(dz.z, dz.w)), hi = max(max(dz.x, dz.y), max(dz.z, dz.w));
-  return abs(f) <= REFINE_ACCEPT * d && hi <= lo * (1.0 + u_edge) && lo > u_depth_lin.z * 1.001;
+  vec4 c = cx + t * cr;
+  if (c.w <= 0.0) return false;
+  st = c.xy / c.w * 0.5 + 0.5;
+  if (any(lessThan(st, vec2(0.0))) || any(greaterThan(st, vec2(1.0)))) return false;
+  bool on_surface;
+  float d = mapDepthChecked(mapTexST(st), on_surface);
+  return on_surface && abs(c.w - d) <= REFINE_ACCEPT * d;
 }
 
 // This fragment's exact reflected ray: its origin relative to the map's viewpoint, and its direction, from the
 // exact surface point on the view ray along `view` (unit, from u_view_origin) and the exact normal there; false
 // where the view ray misses the surface within its outline. One Gauss-Newton step of surfaceHit's from the
 // fragment's interpolated parameters: the triangle lies within its sag of the surface, so one step leaves an
-// error of the order of the sag squared over the radius of curvature. The derivatives (which only steer the step)
-// are filtered by the sampler; the position and the normal with full-precision weights (bilinear.glsl).
+// error of the order of the sag squared over the radius of curvature. The derivatives only steer the step: the
+// exact ones at the vertices, interpolated (v_st2, v_w1); the position and the normal are the maps' (filtered).
 bool exactReflection(vec3 view, out vec3 x, out vec3 R) {
   vec3 e = u_to_local * (u_view_origin - u_offset), vl = u_to_local * view;
   vec2 st = v_st1.xy * u_sm.x + u_sm.y;
   vec4 sp = texture(u_surf_p, st);  // w: 1 inside the outline
-  vec3 su = texture(u_surf_du, st).xyz, sv = texture(u_surf_dv, st).xyz;
+  vec3 su = v_st2, sv = v_w1;
   vec3 w = sp.xyz - e, r = w - dot(w, vl) * vl;
   vec3 a = su - dot(su, vl) * vl, b = sv - dot(sv, vl) * vl;
   float aa = dot(a, a), ab = dot(a, b), bb = dot(b, b);
@@ -106,7 +124,7 @@ vec2 refinedST(vec3 view, vec2 st_interpolated) {
     return st_interpolated;
   }
   vec2 st;
-  if (!refineSearch(x, R, v_st0.xy / v_st0.z, st)) {
+  if (!refineSearch(x, R, v_st1.z, st)) {
     if (u_count) atomicCounterIncrement(u_count_failed);
     return st_interpolated;
   }

@@ -255,10 +255,14 @@ Framebuffer& PvrrPass::mapTarget(size_t i, int size, bool planes) {
 void PvrrPass::uploadPatch(MeshBuffers& mb, const ElementFrame& f, const PatchView& pv, const Vec3& anchor, size_t set,
                            size_t seen_channel) const {
   const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
-  // A refined mirror (one channel) takes its vertices' surface parameters, normalised to the domain, in place
-  // of channel 1's coordinates (pvrr/impostor/surface_map.h, shaders/pvrr_refine.glsl).
+  // A refined mirror (one channel) takes, in the channel sets it leaves free (shaders/pvrr_refine.glsl): its
+  // vertices' surface parameters normalised to the domain and their exact hits' depths along the map's forward
+  // (channel 1's coordinates), and the surface's exact derivatives per normalised parameter in the element's
+  // local frame (channel 2's coordinates and channel 1's weight).
   const bool surface_params = refine_skip.size() > size_t(f.element) && refine_skip[size_t(f.element)].empty();
   const cad::ParamDomain domain = ctx.scene.elements[size_t(f.element)].frontSurface().domain();
+  const VertexDerivs* derivs = surface_params ? &surfaceDerivs(f) : nullptr;
+  const Mat4 map_vp = relativeViewProj(pv.volume.projection, pv.volume.view, pv.volume.eye);
   const size_t channels = pv.st.size();
   std::vector<float> data;
   data.reserve(gp.vertices.size() * kElementFloats);
@@ -272,18 +276,25 @@ void PvrrPass::uploadPatch(MeshBuffers& mb, const ElementFrame& f, const PatchVi
     const double q = pv.q[k];
     for (size_t j = 0; j < 3; ++j) {
       const Vec2 st = pv.st[std::min(3 * set + j, channels - 1)][k];
-      if (j == 1 && surface_params) {
+      if (j == 1 && derivs) {
         const Vec2 uv = f.grid.params[vi];
+        const double hit_depth = (map_vp * glm::dvec4(f.rays[0][vi].hit - pv.volume.eye, 1.0)).w;
         data.insert(data.end(), {float((uv.x - domain.u0) / (domain.u1 - domain.u0)),
-                                 float((uv.y - domain.v0) / (domain.v1 - domain.v0)), 1.0f});
+                                 float((uv.y - domain.v0) / (domain.v1 - domain.v0)), float(hit_depth)});
+        continue;
+      }
+      if (j == 2 && derivs) {
+        const glm::vec3 du(derivs->du[vi]);
+        data.insert(data.end(), {du.x, du.y, du.z});
         continue;
       }
       data.insert(data.end(), {float(st.x * q), float(st.y * q), float(q)});
     }
     for (size_t j = 0; j < 3; ++j) {
       // A patch drawn traced reads no map: its vertices' traced colours below are the whole picture.
-      const Vec3 w =
-          pv.draw_traced ? Vec3(0.0) : weight[j] * f.rays[std::min(3 * set + j, channels - 1)][vi].transmittance;
+      const Vec3 w = j == 1 && derivs ? derivs->dv[vi]
+                     : pv.draw_traced ? Vec3(0.0)
+                                      : weight[j] * f.rays[std::min(3 * set + j, channels - 1)][vi].transmittance;
       data.insert(data.end(), {float(w.x), float(w.y), float(w.z)});
     }
     const Vec2 st = pv.st[seen_channel][k];
@@ -511,7 +522,7 @@ std::string PvrrPass::drawElements(RenderMode, const PassCamera& eye, const Fram
     slot += f.views.size();
   }
   refine_counting = false;
-  return refinementNote();
+  return "";
 }
 
 void PvrrPass::prepareRefinement() {
@@ -539,34 +550,55 @@ void PvrrPass::prepareRefinement() {
     refine_queries.resize(frames.size());
     glGenQueries(GLsizei(frames.size() - had), refine_queries.data() + had);
   }
-  // The counters, zeroed before the frame's draws.
-  const GLuint zeros[2] = {0, 0};
-  if (!refine_counters) glGenBuffers(1, &refine_counters);
+  // The counters, zeroed before the frame's draws (allocated once; read after the frame: finishedNote).
+  if (!refine_counters) {
+    glGenBuffers(1, &refine_counters);
+    glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, refine_counters);
+    glBufferData(GL_ATOMIC_COUNTER_BUFFER, 2 * sizeof(GLuint), nullptr, GL_DYNAMIC_READ);
+  }
   glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, refine_counters);
-  glBufferData(GL_ATOMIC_COUNTER_BUFFER, sizeof(zeros), zeros, GL_DYNAMIC_READ);
+  glClearBufferData(GL_ATOMIC_COUNTER_BUFFER, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
   glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, 0, refine_counters);
   checkGlError("zeroing the refinement's counters");
 }
 
-// Units 2 to 5: the mirror's surface maps (u_to_local, u_sm), the derivatives (3, 4) filtered linearly; 6: the
-// depth of the patch view's map, filtered linearly.
+const PvrrPass::VertexDerivs& PvrrPass::surfaceDerivs(const ElementFrame& f) const {
+  if (refine_derivs.size() < ctx.scene.elements.size()) refine_derivs.resize(ctx.scene.elements.size());
+  VertexDerivs& d = refine_derivs[size_t(f.element)];
+  const Element& el = ctx.scene.elements[size_t(f.element)];
+  if (d.surface == el.surface.get() && d.params == f.grid.params) return d;
+  const cad::ParamDomain domain = el.frontSurface().domain();
+  d.surface = el.surface.get();
+  d.params = f.grid.params;
+  d.du.resize(d.params.size());
+  d.dv.resize(d.params.size());
+  for (size_t i = 0; i < d.params.size(); ++i) {
+    const cad::SurfaceDerivs s = el.surface->evaluate(d.params[i].x, d.params[i].y);
+    d.du[i] = s.du * (domain.u1 - domain.u0);
+    d.dv[i] = s.dv * (domain.v1 - domain.v0);
+  }
+  return d;
+}
+
+// The mirror's surface maps on the impostor mode's units (ImpostorMaps::setMirrorMaps; the derivatives' are bound
+// but not read), then the depth of the patch view's map; all filtered linearly.
 void PvrrPass::setRefinement(const Program& p, const ElementFrame& f) const {
   surface_maps->setMirrorMaps(p, size_t(f.element));
-  p.set("u_map_depth", 6);
+  p.set("u_map_depth", kRefineDepthUnit);
   p.set("u_count", refine_counting ? 1 : 0);
 }
 
 void PvrrPass::unsetRefinement() const {
-  for (GLuint unit : {2u, 3u, 4u, 5u, 6u}) glBindSampler(unit, 0);
+  for (int unit = kElementMapsUnit; unit <= kRefineDepthUnit; ++unit) glBindSampler(GLuint(unit), 0);
 }
 
 void PvrrPass::setRefinementView(const Program& p, const PatchView& pv, const Framebuffer& map, int side) const {
   const bool on = refineViewSkipReason(pv).empty();
   p.set("u_refine", on ? 1 : 0);
   if (!on) return;
-  glActiveTexture(GL_TEXTURE6);
+  glActiveTexture(GLenum(GL_TEXTURE0 + kRefineDepthUnit));
   glBindTexture(GL_TEXTURE_2D, map.depthTexture());
-  for (GLuint unit : {2u, 3u, 4u, 5u, 6u}) glBindSampler(unit, refine_sampler);
+  for (int unit = kElementMapsUnit; unit <= kRefineDepthUnit; ++unit) glBindSampler(GLuint(unit), refine_sampler);
   p.set("u_map_vp", toFloat(relativeViewProj(pv.volume.projection, pv.volume.view, pv.volume.eye)));
   const Mat4& P = pv.volume.projection;
   p.set("u_depth_lin", glm::vec3(float(P[2][2]), float(P[3][2]), float(pv.volume.near_m)));
@@ -575,18 +607,15 @@ void PvrrPass::setRefinementView(const Program& p, const PatchView& pv, const Fr
   p.set("u_edge", float(std::max(0.05, 57.0 * longerExtentTan(pv.volume) / std::max(side, 1))));
 }
 
-std::string PvrrPass::refinementNote() const {
+// The refinement's part of the second pass's note, read once the frame's draws have finished (the renderer's
+// glFinish), so that no draw waits on the counts: the second pass's fragments of the refined elements, those
+// that kept the interpolated coordinate, and the elements not refined with why.
+std::string PvrrPass::finishedNote(const std::string& note) const {
   const int steps = ctx.scene.render.refine;
-  if (steps <= 0) return "";
-  std::string note = "refine (" + std::to_string(steps) + " steps):";
-  std::string skipped;
+  if (steps <= 0) return note;
   bool any = false;
-  for (size_t e = 0; e < refine_skip.size(); ++e) {
-    if (refine_skip[e].empty())
-      any = true;
-    else
-      skipped += (skipped.empty() ? " " : "; ") + ctx.scene.elements[e].name + " (" + refine_skip[e] + ")";
-  }
+  const std::string skipped = refinementSkips(&any);
+  std::string refine = "refine (" + std::to_string(steps) + " steps):";
   if (any) {
     GLuint n[2] = {0, 0};
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_ATOMIC_COUNTER_BARRIER_BIT);
@@ -599,12 +628,25 @@ std::string PvrrPass::refinementNote() const {
       glGetQueryObjectuiv(refine_queries[e], GL_QUERY_RESULT, &samples);
       drawn += samples;
     }
-    note += " " + std::to_string(drawn) + " fragments drawn, " + std::to_string(n[0]) +
-            " kept the interpolated coordinate (search ended off the map's surface), " + std::to_string(n[1]) +
-            " kept it where the view ray missed the exact surface";
+    refine += " " + std::to_string(drawn) + " fragments drawn, " + std::to_string(n[0]) +
+              " kept the interpolated coordinate (search ended off the map's surface), " + std::to_string(n[1]) +
+              " kept it where the view ray missed the exact surface";
   }
-  if (!skipped.empty()) note += std::string(any ? ";" : "") + " not refined:" + skipped;
-  return note;
+  if (!skipped.empty()) refine += std::string(any ? ";" : "") + " not refined:" + skipped;
+  return note.empty() ? refine : note + "; " + refine;
+}
+
+// The elements not refined, with why ("" when none); *any: whether some element is refined.
+std::string PvrrPass::refinementSkips(bool* any) const {
+  std::string skipped;
+  *any = false;
+  for (size_t e = 0; e < refine_skip.size(); ++e) {
+    if (refine_skip[e].empty())
+      *any = true;
+    else
+      skipped += (skipped.empty() ? " " : "; ") + ctx.scene.elements[e].name + " (" + refine_skip[e] + ")";
+  }
+  return skipped;
 }
 
 }  // namespace pvrr::gl

@@ -26,6 +26,7 @@ class PvrrPass : public ModePass {
   void prepare(RenderMode mode, FrameStages& stages, FrameCache* cache) override;
   bool additiveDraws() const override;
   std::string drawElements(RenderMode mode, const PassCamera& eye, const Framebuffer& target) override;
+  std::string finishedNote(const std::string& note) const override;
   std::vector<ElementFrame> takeElements() override { return std::move(frames); }
 
  private:
@@ -52,7 +53,15 @@ class PvrrPass : public ModePass {
   void setRefinement(const Program& p, const ElementFrame& f) const;
   void unsetRefinement() const;
   void setRefinementView(const Program& p, const PatchView& pv, const Framebuffer& map, int side) const;
-  std::string refinementNote() const;
+  std::string refinementSkips(bool* any) const;
+  // The exact derivatives of refined element f's surface at its grid vertices (per normalised parameter, local
+  // frame), cached while its surface and grid stay the same.
+  struct VertexDerivs {
+    const cad::Surface* surface = nullptr;
+    std::vector<Vec2> params;
+    std::vector<Vec3> du, dv;
+  };
+  const VertexDerivs& surfaceDerivs(const ElementFrame& f) const;
 
   RenderContext ctx;
   std::vector<ElementFrame> frames;     // this frame's elements as seen from the eye
@@ -70,6 +79,7 @@ class PvrrPass : public ModePass {
   unsigned refine_sampler = 0;           // linear filtering of the depth maps and the surface derivatives
   std::vector<unsigned> refine_queries;  // per element: its second-pass fragments (refined elements)
   bool refine_counting = false;          // drawing the second pass (counted), not a nested pass
+  mutable std::vector<VertexDerivs> refine_derivs;  // per element (surfaceDerivs)
 };
 
 }  // namespace pvrr::gl
