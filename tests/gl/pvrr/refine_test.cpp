@@ -1,8 +1,8 @@
 // Per-fragment refinement of pvrr mode (render.refine; shaders/pvrr_refine.glsl): each mirror fragment's exact
 // reflected ray searched in its map. Against the reference tracer: a convex mirror and a saddle (whose
 // interpolated coordinates err most between vertices), one patch and 2 x 2 patches; off and skipped elements
-// draw exactly the unrefined pixels; every refined element's fragment is counted once, refined or fallen back.
-// OSMesa and EGL.
+// draw exactly the unrefined pixels; every refined element's fragment is counted once, refined or fallen back,
+// in its own frame's note. OSMesa and EGL.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -117,6 +117,32 @@ TEST_P(RefineTest, MirrorsAndPatchesMatchTheReference) {
     EXPECT_LT(n[1] + n[2], n[0] / 10) << note;
     EXPECT_GT(n[1], 0) << note;
   }
+}
+
+// The counts are read once the frame has finished (not while its draws wait), yet each frame's note holds that
+// frame's own counts: zeroed before its draws, neither accumulated over frames nor a frame late. Three frames,
+// the second with a narrower field of view (the mirror covers more pixels), each note against its own frame.
+TEST_P(RefineTest, CountsAreEachFramesOwn) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  const cad::Outline outline = cad::Outline::rectangle(0.5, 0.4, 0.04);
+  Scene s = mirrorScene(cad::makeSphere(1.2, outline), 1);
+  s.render.refine = 2;
+  RayScene rays(s);
+  gl::Renderer r(s, rays, gl::RendererOptions{});
+  std::vector<std::string> notes;
+  std::vector<size_t> pixels;
+  for (const double fov_deg : {25.0, 20.0, 25.0}) {
+    s.observer.fov_y_rad = radians(fov_deg);
+    const gl::RasterFrame f = r.render(RenderMode::Pvrr);
+    notes.push_back(refineNote(f));
+    pixels.push_back(size_t(std::count(f.element.begin(), f.element.end(), 0)));
+    const std::array<long, 3> n = refineCounts(notes.back());
+    ASSERT_GE(n[0], 0) << notes.back();
+    EXPECT_EQ(size_t(n[0]), pixels.back()) << fov_deg << " deg: " << notes.back();
+  }
+  EXPECT_GT(pixels[1], pixels[0] + 1000);
+  EXPECT_EQ(notes[2], notes[0]);
 }
 
 // Off draws the unrefined pixels (the default, the paper's method), and so does refinement of an element it
