@@ -74,8 +74,9 @@ float mapDepthChecked(vec2 tc, out bool on_surface) {
 // surface.
 bool refineSearch(vec3 x, vec3 R, float hit_depth, out vec2 st) {
   vec4 cx = u_map_vp * vec4(x, 1.0), cr = u_map_vp * vec4(R, 0.0);
-  // The ray must move along the map's forward (it does: the forward is its rays' mean direction).
-  if (cr.w <= 1e-3) return false;
+  // The ray must move along the map's axis: forward (the forward is its rays' mean direction), or backward in a
+  // zooming-region map (its rays pass its viewpoint and meet what lies behind it, its farthest depth first).
+  if (abs(cr.w) <= 1e-3) return false;
   float t = (hit_depth - cx.w) / cr.w, t_prev = 0.0, f_prev = 0.0;
   for (int i = 0; i < REFINE; ++i) {
     vec4 c = cx + t * cr;
