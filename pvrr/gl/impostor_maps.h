@@ -51,11 +51,11 @@ class ImpostorMaps {
   // their textures, and its pose.
   void setMirrorMaps(const Program& p, size_t e) const;
   // The uniforms of a lens's impostor draw (shaders/element_impostor.frag with LENS): its height maps
-  // and outline mask on 3 units from kElementMapsUnit, their placement, its pose, its index at the R, G and B wavelengths, and
-  // the tracer's depth limit and far distance.
-  // first_unit and rotation: where a mirror's program that meets the lens in its cubes takes them
-  // (LENS_IN_CUBES: after the cubes, u_lens_to_local).
-  void setLensMaps(const Program& p, size_t e, int first_unit = kElementMapsUnit, const char* rotation = "u_to_local") const;
+  // and outline mask on 3 units from kElementMapsUnit, their placement, its pose, its index at the R, G and B
+  // wavelengths, and the tracer's depth limit and far distance. first_unit and rotation: where a mirror's program that
+  // meets the lens in its cubes takes them (LENS_IN_CUBES: after the cubes, u_lens_to_local).
+  void setLensMaps(const Program& p, size_t e, int first_unit = kElementMapsUnit,
+                   const char* rotation = "u_to_local") const;
 
   // --- the texture-unit plan ---
   size_t lensCount() const;

@@ -415,8 +415,10 @@ void PvrrPass::drawPvrrElement(const ElementFrame& f, size_t first_slot, const P
     if (refined) setRefinementView(p, pv, map, map_side[first_slot + v]);
     for (size_t set = 0; set < sets; ++set) {
       MeshBuffers& mb = ctx.meshes.slot();
-      if (refined) uploadRefinedPatch(mb, f, pv, anchor);
-      else uploadPatch(mb, f, pv, anchor, set, seen_c);
+      if (refined)
+        uploadRefinedPatch(mb, f, pv, anchor);
+      else
+        uploadPatch(mb, f, pv, anchor, set, seen_c);
       p.set("u_additive", set > 0 ? 1 : 0);
       if (set == 1) {
         glEnablei(GL_BLEND, 0);
@@ -616,7 +618,8 @@ const PvrrPass::EdgeMidpoints& PvrrPass::edgeMidpoints(const ElementFrame& f) co
   return c.mids;
 }
 
-// The mirror's surface maps on the impostor mode's units (ImpostorMaps::setMirrorMaps; only the normal is read), then the depth of the patch view's map; all filtered linearly.
+// The mirror's surface maps on the impostor mode's units (ImpostorMaps::setMirrorMaps; only the normal is read), then
+// the depth of the patch view's map; all filtered linearly.
 void PvrrPass::setRefinement(const Program& p, const ElementFrame& f) const {
   surface_maps->setMirrorMaps(p, size_t(f.element));
   p.set("u_map_depth", kRefineDepthUnit);

@@ -73,7 +73,7 @@ class PvrrPass : public ModePass {
   // process (nextFirstPassSerial), so a cache filled by another renderer never matches.
   uint64_t first_pass_serial = 0;
   unsigned mask_vao = 0, mask_vbo = 0;  // closeUnreadTexels' quads
-  std::vector<std::string> refine_skip;        // per element: why it is not refined, "" when it is
+  std::vector<std::string> refine_skip;  // per element: why it is not refined, "" when it is
   unsigned refine_counters = 0;          // the second pass's failed and missed fragments (shaders/pvrr_refine.glsl)
   unsigned refine_sampler = 0;           // linear filtering of the depth maps and the surface maps
   std::vector<unsigned> refine_queries;  // per element: its second-pass fragments (refined elements)
