@@ -602,8 +602,8 @@ const PvrrPass::EdgeMidpoints& PvrrPass::edgeMidpoints(const ElementFrame& f) co
   if (refine_mids.size() < ctx.scene.elements.size()) refine_mids.resize(ctx.scene.elements.size());
   RefineMidpoints& c = refine_mids[size_t(f.element)];
   const Element& el = ctx.scene.elements[size_t(f.element)];
-  if (c.surface == el.surface.get() && c.params == f.grid.params) return c.mids;
-  c.surface = el.surface.get();
+  if (c.surface == el.surface && c.params == f.grid.params) return c.mids;
+  c.surface = el.surface;
   c.params = f.grid.params;
   c.mids.clear();
   for (const auto& t : f.grid.triangles) {

@@ -80,7 +80,7 @@ class PvrrPass : public ModePass {
   std::unique_ptr<ImpostorMaps> surface_maps;  // the refined mirrors' surface maps (pvrr/impostor/surface_map.h)
   bool refine_counting = false;          // drawing the second pass (counted), not a nested pass
   struct RefineMidpoints {
-    const cad::Surface* surface = nullptr;  // what they were computed for
+    cad::SurfacePtr surface;  // what they were computed for (held: never a reused address)
     std::vector<Vec2> params;
     EdgeMidpoints mids;
   };
