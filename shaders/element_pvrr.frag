@@ -28,6 +28,9 @@ vec2 mapST(vec3 stq) { return min(stq.xy / stq.z * u_st_scale, u_st_max); }
 #include "pvrr_refine.glsl"
 
 void main() {
+#if defined(REFINE)
+  refineDerivatives();
+#endif
   vec3 n = normalize(v_normal);
   vec3 view = normalize(v_pos - u_view_origin);
   float cos_i = -dot(view, n);

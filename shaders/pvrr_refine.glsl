@@ -1,18 +1,24 @@
 // Per-fragment refinement of pvrr mode (render.refine; docs/method.md "Per-fragment refinement"), included by
 // element_pvrr.frag; everything here only with REFINE (the number of secant steps). A mirror fragment's exact
-// reflected ray, from the exact surface point its view ray meets and the exact normal there (the surface maps
-// of pvrr/impostor/surface_map.h, surface_maps.glsl), is searched in its patch's map: the map's depth gives,
-// for each direction from the map's viewpoint, the depth along the map's forward of what it shows; the search
-// takes secant steps on the difference between the ray point's depth and the map's depth in the ray point's
-// direction ([Szirmay-Kalos et al.]'s Hit(), with the map's perspective depth in place of a cube's distance),
-// starting from the ray point at the depth the interpolated texture coordinate shows. The map's viewpoint is
-// fitted to the element's rays, so the search starts next to the answer and has little parallax to cross.
-// Where it ends off the map's surface (no convergence, outside the map, a texel the pass left unread, or across
-// a depth edge) the fragment keeps the interpolated coordinate. Atomic counters count, in the second pass, the
-// fragments whose view ray missed the exact surface (the triangles' silhouette overhang, or beyond the
-// outline) and those whose search failed; pvrr/gl/pvrr_pass.cpp counts the fragments drawn with a query and
-// reads both into the second pass's note.
-#include "surface_maps.glsl"
+// reflected ray, from the exact surface point its view ray meets and the exact normal there, is searched in its
+// patch's map: the map's depth gives, for each direction from the map's viewpoint, the depth along the map's
+// forward of what it shows; the search takes secant steps on the difference between the ray point's depth and
+// the map's depth in the ray point's direction ([Szirmay-Kalos et al.]'s Hit(), with the map's perspective depth
+// in place of a cube's distance), starting from the ray point at the depth that the exact vertex hits give,
+// interpolated. The map's viewpoint is fitted to the element's rays, so the search starts next to the answer and
+// has little parallax to cross. Where it ends off the map's surface (no convergence, outside the map, a texel
+// the pass left unread, or across a depth edge) the fragment keeps the interpolated coordinate.
+// The exact surface point comes from each triangle's quadratic (P2) interpolant of the surface: the vertices and
+// the exact surface at the edges' midpoints (pvrr/gl/pvrr_pass.cpp uploadRefinedPatch, in doubles), whose error
+// falls with the cube of the vertex spacing where the flat triangle's falls with its square; the exact normal
+// from the mirror's normal map (pvrr/impostor/surface_map.h) at that point's surface parameters. (A P2 normal
+// as well, with no texture read, was measured: where a triangle straddles a knot line of a cubic NURBS or a
+// subdivision surface the normal's third derivative jumps and the P2 normal errs by arcminutes, docs/accuracy.md.)
+// The triangles' vertices are not shared: each carries its barycentric corner and its triangle's deviations at
+// the three midpoints, in the channel sets a refined mirror's one channel leaves free (the aliases below).
+// Atomic counters count, in the second pass, the fragments whose view ray missed the exact surface (the
+// triangles' silhouette overhang) and those whose search failed; pvrr/gl/pvrr_pass.cpp counts the fragments
+// drawn with a query and reads both into the second pass's note once the frame has finished.
 #if defined(REFINE) && (CHANNELS != 1 || defined(LENS))
 #error "REFINE: a mirror's one channel only"
 #endif
@@ -24,75 +30,118 @@ uniform mat4 u_map_vp;          // the map's camera: positions relative to its v
 uniform vec3 u_depth_lin;       // P[2][2], P[3][2] of its projection, and its near depth: the depth along the map's
                                 // forward of NDC depth z is P[3][2] / (z + P[2][2])
 uniform float u_edge;           // across a depth edge: the four texels' depths differ by more than this (relative)
-uniform vec3 u_offset;          // the element's anchor - this pass's camera origin (element.vert)
-uniform mat3 u_to_local;        // world directions -> the element's local frame (surface_maps.glsl's)
+// The triangle's P2 data (world frame, metres): the exact surface point at the midpoint of edge (i, j) of its
+// corners less the edge's mean; v_bary: the fragment's barycentric coordinates (b1, b2) of corners 1 and 2, and
+// the depth of the exact vertex hits along the map's forward; v_param: its normalised surface parameters (s, t).
+#define v_bary v_st1
+#define v_dp01 v_st2
+#define v_dp12 v_w1
+#define v_dp20 v_w2
+#define v_param v_st_seen
+uniform sampler2D u_surf_n;     // the mirror's unit normal over its parameter domain (local frame; surface_map.h)
+uniform vec2 u_sm;              // its texture coordinate = (s, t) * u_sm.x + u_sm.y
+uniform mat3 u_to_local;        // world directions -> the element's local frame (the normal map's)
 layout(binding = 0, offset = 0) uniform atomic_uint u_count_failed;
 layout(binding = 0, offset = 4) uniform atomic_uint u_count_missed;
 
 const float REFINE_TOL = 2e-5;     // converged: |depth difference| <= this * depth (the depth's float resolution)
 const float REFINE_ACCEPT = 1e-3;  // on the map's surface: at most this, after the last step
-const float REFINE_MAX_STEP = 0.02;  // of the normalised parameters: the surface step from the triangle's point
+const float REFINE_MAX_STEP = 0.25;  // of the triangle (barycentric): the surface step from the triangle's point
 
 float linearDepth(float window_z) { return u_depth_lin.y / (2.0 * window_z - 1.0 + u_depth_lin.x); }
 // The map's texture coordinate of volume coordinate st, half a texel inside its region (as mapST).
 vec2 mapTexST(vec2 st) { return min(st * u_st_scale, u_st_max); }
 
+// The linear depth of the map at texture coordinate tc, bilinear between the four texels' window depths (as
+// GL_LINEAR filters them: exact between texels for a plane), and whether those texels lie on one surface: none
+// left unread (at the near plane), no depth edge between them. One gather serves both.
+float mapDepthChecked(vec2 tc, out bool on_surface) {
+  vec4 z = textureGather(u_map_depth, tc);  // texels (0, 1), (1, 1), (1, 0), (0, 0) of the bilinear footprint
+  vec2 w = fract(tc * vec2(textureSize(u_map_depth, 0)) - 0.5);
+  float zb = mix(mix(z.w, z.z, w.x), mix(z.x, z.y, w.x), w.y);
+  vec4 dz = u_depth_lin.y / (2.0 * z - 1.0 + u_depth_lin.x);
+  float lo = min(min(dz.x, dz.y), min(dz.z, dz.w)), hi = max(max(dz.x, dz.y), max(dz.z, dz.w));
+  on_surface = hi <= lo * (1.0 + u_edge) && lo > u_depth_lin.z * 1.001;
+  return linearDepth(zb);
+}
+
 // The map's volume coordinate (s, t) in [0, 1]^2 where the ray x + t R (x relative to the map's viewpoint)
-// meets what the map shows, searched from the coordinate st0 that the interpolation gives; false where the
-// search ends off the map's surface. The steps read the filtered window depth (linear in the screen for a
-// plane, so exact between texels there); the last point is checked on its four texels: none left unread (at
-// the near plane), no depth edge between them.
-bool refineSearch(vec3 x, vec3 R, vec2 st0, out vec2 st) {
+// meets what the map shows; false where the search ends off the map's surface. It starts at the depth
+// hit_depth (along the map's forward) that the fragment's interpolated exact vertex hits give, and takes
+// REFINE steps on the difference between the ray point's depth and the map's depth in its direction: the
+// first to the depth the map shows there ([Szirmay-Kalos et al.]'s Hit()), then secant steps; the last
+// point (or the first that converged) is read with its four texels, which also tell whether it lies on one
+// surface.
+bool refineSearch(vec3 x, vec3 R, float hit_depth, out vec2 st) {
   vec4 cx = u_map_vp * vec4(x, 1.0), cr = u_map_vp * vec4(R, 0.0);
-  // The ray must move along the map's forward (it does: the forward is its rays' mean direction).
-  if (cr.w <= 1e-3) return false;
-  float d = linearDepth(texture(u_map_depth, mapTexST(st0)).r);
-  float t = (d - cx.w) / cr.w, t_prev = 0.0, f_prev = 0.0, f = 0.0;
-  for (int i = 0; i <= REFINE; ++i) {
+  // The ray must move along the map's axis: forward (the forward is its rays' mean direction), or backward in a
+  // zooming-region map (its rays pass its viewpoint and meet what lies behind it, its farthest depth first).
+  if (abs(cr.w) <= 1e-3) return false;
+  float t = (hit_depth - cx.w) / cr.w, t_prev = 0.0, f_prev = 0.0;
+  for (int i = 0; i < REFINE; ++i) {
     vec4 c = cx + t * cr;
     if (c.w <= 0.0) return false;
     st = c.xy / c.w * 0.5 + 0.5;
     if (any(lessThan(st, vec2(0.0))) || any(greaterThan(st, vec2(1.0)))) return false;
-    d = linearDepth(texture(u_map_depth, mapTexST(st)).r);
-    f = c.w - d;
-    if (abs(f) <= REFINE_TOL * d || i == REFINE) break;
-    // The first step moves the ray point to the depth the map shows in its direction; then secant steps.
+    float d = linearDepth(texture(u_map_depth, mapTexST(st)).r), f = c.w - d;
+    if (abs(f) <= REFINE_TOL * d) break;
     float t_next = i > 0 && f != f_prev ? t - f * (t - t_prev) / (f - f_prev) : (d - cx.w) / cr.w;
     t_prev = t;
     f_prev = f;
     t = t_next;
   }
-  vec4 z = textureGather(u_map_depth, mapTexST(st));
-  vec4 dz = u_depth_lin.y / (2.0 * z - 1.0 + u_depth_lin.x);
-  float lo = min(min(dz.x, dz.y), min(dz.z, dz.w)), hi = max(max(dz.x, dz.y), max(dz.z, dz.w));
-  return abs(f) <= REFINE_ACCEPT * d && hi <= lo * (1.0 + u_edge) && lo > u_depth_lin.z * 1.001;
+  vec4 c = cx + t * cr;
+  if (c.w <= 0.0) return false;
+  st = c.xy / c.w * 0.5 + 0.5;
+  if (any(lessThan(st, vec2(0.0))) || any(greaterThan(st, vec2(1.0)))) return false;
+  bool on_surface;
+  float d = mapDepthChecked(mapTexST(st), on_surface);
+  return on_surface && abs(c.w - d) <= REFINE_ACCEPT * d;
+}
+
+// The triangle's edges S1 - S0, S2 - S0 and its parameters' (s, t)1 - (s, t)0, (s, t)2 - (s, t)0: from the
+// screen derivatives of the fragment's position, parameters and barycentric coordinates, all affine on the
+// triangle (so exact up to rounding; they only steer the step). Taken in main's uniform control flow, before
+// any fragment returns.
+mat2x3 refine_edges;
+mat2 refine_param_edges;
+bool refine_flat;  // the triangle is seen edge-on: no step
+void refineDerivatives() {
+  mat2 db = mat2(dFdx(v_bary.xy), dFdy(v_bary.xy));
+  float det = determinant(db);
+  refine_flat = !(abs(det) > 1e-20);
+  mat2 inv = refine_flat ? mat2(1.0) : inverse(db);
+  refine_edges = mat2x3(dFdx(v_pos), dFdy(v_pos)) * inv;
+  refine_param_edges = mat2(dFdx(v_param.xy), dFdy(v_param.xy)) * inv;
 }
 
 // This fragment's exact reflected ray: its origin relative to the map's viewpoint, and its direction, from the
 // exact surface point on the view ray along `view` (unit, from u_view_origin) and the exact normal there; false
-// where the view ray misses the surface within its outline. One Gauss-Newton step of surfaceHit's from the
-// fragment's interpolated parameters: the triangle lies within its sag of the surface, so one step leaves an
-// error of the order of the sag squared over the radius of curvature. The derivatives (which only steer the step)
-// are filtered by the sampler; the position and the normal with full-precision weights (bilinear.glsl).
+// where the view ray misses the surface (a longer step: it passes the surface's edge, or leaves its parameter
+// domain). One Gauss-Newton step
+// from the fragment's barycentric point on the P2 surface: the triangle lies within its sag of the surface, so
+// one step leaves an error of the order of the sag squared over the radius of curvature.
 bool exactReflection(vec3 view, out vec3 x, out vec3 R) {
-  vec3 e = u_to_local * (u_view_origin - u_offset), vl = u_to_local * view;
-  vec2 st = v_st1.xy * u_sm.x + u_sm.y;
-  vec4 sp = texture(u_surf_p, st);  // w: 1 inside the outline
-  vec3 su = texture(u_surf_du, st).xyz, sv = texture(u_surf_dv, st).xyz;
-  vec3 w = sp.xyz - e, r = w - dot(w, vl) * vl;
-  vec3 a = su - dot(su, vl) * vl, b = sv - dot(sv, vl) * vl;
-  float aa = dot(a, a), ab = dot(a, b), bb = dot(b, b);
-  float c = dot(cross(su, sv), vl), det = c * c;
-  if (sp.w < 0.5 || !(det > 1e-12 * aa * bb)) return false;
-  vec2 g = vec2(dot(a, r), dot(b, r));
-  vec2 delta = -vec2(bb * g.x - ab * g.y, aa * g.y - ab * g.x) / det;
-  vec2 uv = v_st1.xy + delta;
-  // A longer step: the view ray passes the surface's edge (the triangles' silhouette overhang).
-  if (length(delta) > REFINE_MAX_STEP || any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return false;
-  vec3 pos = u_offset + (sp.xyz + su * delta.x + sv * delta.y) * u_to_local;  // relative to this camera's origin
-  vec3 n = normalize(texture(u_surf_n, uv * u_sm.x + u_sm.y).xyz * u_to_local);
+  vec2 b = v_bary.xy;
+  float b0 = 1.0 - b.x - b.y;
+  vec3 p = v_pos + 4.0 * (b0 * b.x * v_dp01 + b.x * b.y * v_dp12 + b.y * b0 * v_dp20);
+  vec3 su = refine_edges[0] + 4.0 * ((b0 - b.x) * v_dp01 + b.y * (v_dp12 - v_dp20));
+  vec3 sv = refine_edges[1] + 4.0 * (b.x * (v_dp12 - v_dp01) + (b0 - b.y) * v_dp20);
+  vec3 w = p - u_view_origin, r = w - dot(w, view) * view;
+  vec3 a = su - dot(su, view) * view, c = sv - dot(sv, view) * view;
+  float aa = dot(a, a), ac = dot(a, c), cc = dot(c, c);
+  // aa cc - ac^2 = ((su x sv) . view)^2 for vectors projected across the view, without the cancellation.
+  float k = dot(cross(su, sv), view), det = k * k;
+  if (refine_flat || !(det > 1e-12 * aa * cc)) return false;
+  vec2 g = vec2(dot(a, r), dot(c, r));
+  vec2 delta = -vec2(cc * g.x - ac * g.y, aa * g.y - ac * g.x) / det;
+  if (max(abs(delta.x), abs(delta.y)) > REFINE_MAX_STEP) return false;
+  vec3 pos = p + su * delta.x + sv * delta.y;  // relative to this camera's origin
+  vec2 st = v_param.xy + refine_param_edges * delta;
+  if (any(lessThan(st, vec2(0.0))) || any(greaterThan(st, vec2(1.0)))) return false;
+  vec3 n = normalize(texture(u_surf_n, st * u_sm.x + u_sm.y).xyz * u_to_local);
   x = pos - u_seen_offset;
-  R = reflect(normalize(pos - u_view_origin), n);
+  R = reflect(view, n);
   return true;
 }
 
@@ -106,7 +155,7 @@ vec2 refinedST(vec3 view, vec2 st_interpolated) {
     return st_interpolated;
   }
   vec2 st;
-  if (!refineSearch(x, R, v_st0.xy / v_st0.z, st)) {
+  if (!refineSearch(x, R, v_bary.z, st)) {
     if (u_count) atomicCounterIncrement(u_count_failed);
     return st_interpolated;
   }

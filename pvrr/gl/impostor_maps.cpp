@@ -57,8 +57,12 @@ int ImpostorMaps::updateMirrorMaps(size_t e) {
 
 void ImpostorMaps::setMirrorMaps(const Program& p, size_t e) const {
   const MirrorMaps& m = mirror_maps.at(e);
-  bindDataTextures(p, 2, {{"u_surf_p", m.textures[0]}, {"u_surf_du", m.textures[1]}, {"u_surf_dv", m.textures[2]},
-                          {"u_surf_n", m.textures[3]}});
+  static_assert(kSurfaceMapUnits == 4, "the four surface maps below");
+  bindDataTextures(p, kElementMapsUnit,
+                   {{"u_surf_p", m.textures[0]},
+                    {"u_surf_du", m.textures[1]},
+                    {"u_surf_dv", m.textures[2]},
+                    {"u_surf_n", m.textures[3]}});
   const double n = m.map.n;
   p.set("u_sm", glm::vec2(float((n - 1) / n), float(0.5 / n)));
   p.set("u_to_local", glm::mat3(Mat3(scene.elements[e].world_to_local)));

@@ -23,7 +23,13 @@ namespace pvrr::gl {
 // 0: one element, no mirror to meet, or more elements than kMaxCubeElements or the texture units allow (then
 // each cube shows the environment only).
 constexpr int kMaxCubeElements = 4;
-constexpr int kFirstCubeUnit = 6;  // after a cube pair (0, 1) and the element's own maps (2 to 5)
+// The element's own maps: a mirror's four surface maps (setMirrorMaps: position, du, dv, normal) or a lens's
+// three height maps (setLensMaps), from kElementMapsUnit on, after a cube pair or a pvrr map (0, 1).
+constexpr int kElementMapsUnit = 2;
+constexpr int kSurfaceMapUnits = 4;
+constexpr int kFirstCubeUnit = kElementMapsUnit + kSurfaceMapUnits;  // impostor mode: the cubes after them
+// Pvrr mode's refinement (shaders/pvrr_refine.glsl): the patch's map depth after the surface maps.
+constexpr int kRefineDepthUnit = kElementMapsUnit + kSurfaceMapUnits;
 constexpr int kPeelUnit = 1;       // the first layer's seen points while its second layer is drawn
 
 class ImpostorMaps {
@@ -40,15 +46,16 @@ class ImpostorMaps {
   // Mirror e's surface maps, rebuilt when missing or built from another surface or outline; returns 1 when
   // built.
   int updateMirrorMaps(size_t e);
-  // The uniforms of a mirror's impostor draw: its surface maps on units 2 to 5, the samples' placement in
+  // The uniforms of a mirror's impostor draw: its surface maps on kSurfaceMapUnits units from kElementMapsUnit,
+  // the samples' placement in
   // their textures, and its pose.
   void setMirrorMaps(const Program& p, size_t e) const;
   // The uniforms of a lens's impostor draw (shaders/element_impostor.frag with LENS): its height maps
-  // and outline mask on units 2 to 4, their placement, its pose, its index at the R, G and B wavelengths, and
-  // the tracer's depth limit and far distance.
-  // first_unit and rotation: where a mirror's program that meets the lens in its cubes takes them
-  // (LENS_IN_CUBES: after the cubes, u_lens_to_local).
-  void setLensMaps(const Program& p, size_t e, int first_unit = 2, const char* rotation = "u_to_local") const;
+  // and outline mask on 3 units from kElementMapsUnit, their placement, its pose, its index at the R, G and B
+  // wavelengths, and the tracer's depth limit and far distance. first_unit and rotation: where a mirror's program that
+  // meets the lens in its cubes takes them (LENS_IN_CUBES: after the cubes, u_lens_to_local).
+  void setLensMaps(const Program& p, size_t e, int first_unit = kElementMapsUnit,
+                   const char* rotation = "u_to_local") const;
 
   // --- the texture-unit plan ---
   size_t lensCount() const;

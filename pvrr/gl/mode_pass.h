@@ -49,6 +49,9 @@ class ModePass {
   // The elements into `target` (cleared depth, depth test on, GL_LESS) as seen by `eye`, before the
   // environment; returns what the second pass's note adds for them.
   virtual std::string drawElements(RenderMode mode, const PassCamera& eye, const Framebuffer& target) = 0;
+  // Once the frame's draws have finished (after glFinish): what the second pass's note adds from the GPU's
+  // counts of them, appended to drawElements' note (read here so that the frame's draws run without a wait).
+  virtual std::string finishedNote(const std::string& note) const { return note; }
   // The frame's per-element PVRR state (RasterFrame::elements), once drawn.
   virtual std::vector<ElementFrame> takeElements() { return {}; }
 };

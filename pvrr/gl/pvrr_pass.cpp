@@ -14,6 +14,11 @@ namespace pvrr::gl {
 
 namespace {
 
+// The texture units of an element's pvrr draw: its patch's map, the map's seen points, and the G and B planes of
+// an RGB map (R on kMapUnit). A refined mirror (never an RGB element: pvrr_refine.glsl) reads its surface maps
+// and its map's depth on impostor_maps.h's units.
+constexpr int kMapUnit = 0, kSeenMapUnit = 1, kPlaneUnitG = 2;
+
 // A serial number for every first pass rendered in the process (FrameCache::maps_serial).
 uint64_t nextFirstPassSerial() {
   static std::atomic<uint64_t> serial{0};
@@ -255,10 +260,6 @@ Framebuffer& PvrrPass::mapTarget(size_t i, int size, bool planes) {
 void PvrrPass::uploadPatch(MeshBuffers& mb, const ElementFrame& f, const PatchView& pv, const Vec3& anchor, size_t set,
                            size_t seen_channel) const {
   const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
-  // A refined mirror (one channel) takes its vertices' surface parameters, normalised to the domain, in place
-  // of channel 1's coordinates (pvrr/impostor/surface_map.h, shaders/pvrr_refine.glsl).
-  const bool surface_params = refine_skip.size() > size_t(f.element) && refine_skip[size_t(f.element)].empty();
-  const cad::ParamDomain domain = ctx.scene.elements[size_t(f.element)].frontSurface().domain();
   const size_t channels = pv.st.size();
   std::vector<float> data;
   data.reserve(gp.vertices.size() * kElementFloats);
@@ -272,12 +273,6 @@ void PvrrPass::uploadPatch(MeshBuffers& mb, const ElementFrame& f, const PatchVi
     const double q = pv.q[k];
     for (size_t j = 0; j < 3; ++j) {
       const Vec2 st = pv.st[std::min(3 * set + j, channels - 1)][k];
-      if (j == 1 && surface_params) {
-        const Vec2 uv = f.grid.params[vi];
-        data.insert(data.end(), {float((uv.x - domain.u0) / (domain.u1 - domain.u0)),
-                                 float((uv.y - domain.v0) / (domain.v1 - domain.v0)), 1.0f});
-        continue;
-      }
       data.insert(data.end(), {float(st.x * q), float(st.y * q), float(q)});
     }
     for (size_t j = 0; j < 3; ++j) {
@@ -305,6 +300,55 @@ void PvrrPass::uploadPatch(MeshBuffers& mb, const ElementFrame& f, const PatchVi
   uploadMesh(mb, data, kElementLayout, idx);
 }
 
+// A refined mirror's patch (one channel; shaders/pvrr_refine.glsl): every triangle with its own three vertices,
+// each with the vertex's position, normal, texture coordinates, weight and traced fallback as uploadPatch gives
+// them, its barycentric corner, exact hit depth along the map's forward and normalised surface parameters, and
+// the triangle's P2 deviations: the exact surface point at each edge's midpoint (in the parameter domain) less
+// the edge's mean, in the world frame.
+void PvrrPass::uploadRefinedPatch(MeshBuffers& mb, const ElementFrame& f, const PatchView& pv,
+                                  const Vec3& anchor) const {
+  const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
+  const Element& el = ctx.scene.elements[size_t(f.element)];
+  const EdgeMidpoints& mids = edgeMidpoints(f);
+  const cad::ParamDomain domain = el.frontSurface().domain();
+  const Mat4 map_vp = relativeViewProj(pv.volume.projection, pv.volume.view, pv.volume.eye);
+  const Vec3 weight = channelWeight(f.channels, 0);
+  std::vector<float> data;
+  data.reserve(3 * gp.triangles.size() * kElementFloats);
+  auto put = [&](const Vec3& v) { data.insert(data.end(), {float(v.x), float(v.y), float(v.z)}); };
+  for (const auto& t : gp.triangles) {
+    const uint32_t k[3] = {t.x, t.y, t.z}, vi[3] = {gp.vertices[t.x], gp.vertices[t.y], gp.vertices[t.z]};
+    Vec3 dp[3];  // edges (0, 1), (1, 2), (2, 0)
+    for (int e = 0; e < 3; ++e) {
+      const uint32_t i = vi[e], j = vi[(e + 1) % 3];
+      dp[e] = el.toWorldPoint(mids.at(edgeKey(i, j))) - 0.5 * (f.world_pos[i] + f.world_pos[j]);
+    }
+    for (int c = 0; c < 3; ++c) {
+      const VertexRay& r = f.rays[0][vi[c]];
+      put(f.world_pos[vi[c]] - anchor);
+      put(f.world_normal[vi[c]]);
+      const Vec2 st = pv.st[0][k[c]];
+      const double q = pv.q[k[c]];
+      put(Vec3(st.x * q, st.y * q, q));
+      const double hit_depth = (map_vp * glm::dvec4(r.hit - pv.volume.eye, 1.0)).w;
+      put(Vec3(c == 1 ? 1.0 : 0.0, c == 2 ? 1.0 : 0.0, hit_depth));
+      put(dp[0]);
+      put(pv.draw_traced ? Vec3(0.0) : weight * r.transmittance);
+      put(dp[1]);
+      put(dp[2]);
+      const Vec2 uv = f.grid.params[vi[c]];
+      put(Vec3((uv.x - domain.u0) / (domain.u1 - domain.u0), (uv.y - domain.v0) / (domain.v1 - domain.v0), 0.0));
+      const bool traced = usesTraced(pv, r);
+      const Vec3 colour = traced ? weight * r.traced_color : Vec3(0.0);
+      data.insert(data.end(), {float(colour.x), float(colour.y), float(colour.z), traced ? 1.0f : 0.0f});
+      put(traced ? r.traced_seen - anchor : Vec3(0.0));
+    }
+  }
+  std::vector<uint32_t> idx(data.size() / kElementFloats);
+  for (size_t i = 0; i < idx.size(); ++i) idx[i] = uint32_t(i);
+  uploadMesh(mb, data, kElementLayout, idx);
+}
+
 // Draws one element with its PVRR maps into the bound target, as seen by `cam`. More than three channels
 // (spectral): one draw per set of three, added into colour attachment 0 only (same vertices, depth test
 // LEQUAL); the seen point and the surface attachments come from the first draw.
@@ -322,10 +366,10 @@ void PvrrPass::drawPvrrElement(const ElementFrame& f, size_t first_slot, const P
   p.set("u_view_proj", toFloat(cam.view_proj));
   p.set("u_offset", glm::vec3(anchor - cam.origin));
   p.set("u_view_origin", glm::vec3(cam.rays_from));
-  p.set("u_map", 0);
-  p.set("u_seen_map", 1);
-  p.set("u_map_g", 2);
-  p.set("u_map_b", 3);
+  p.set("u_map", kMapUnit);
+  p.set("u_seen_map", kSeenMapUnit);
+  p.set("u_map_g", kPlaneUnitG);
+  p.set("u_map_b", kPlaneUnitG + 1);
   setLights(p, ctx.scene, cam.origin);
   setElementMaterial(p, el, f.element);
   if (refined) setRefinement(p, f);
@@ -351,15 +395,15 @@ void PvrrPass::drawPvrrElement(const ElementFrame& f, size_t first_slot, const P
                                           (planes == 3 ? "in planes" : "RGBA") + " but the element's channels are " +
                                           (rgb ? "RGB" : "not RGB") + " (internal error)");
     if (cam.planes && sets > 1) throw Error("renderer: additive channel draws into a planes map (internal error)");
-    glActiveTexture(GL_TEXTURE0);
+    glActiveTexture(GLenum(GL_TEXTURE0 + kMapUnit));
     glBindTexture(GL_TEXTURE_2D, map.colorTexture(0));
     if (planes == 3) {
-      glActiveTexture(GL_TEXTURE2);
+      glActiveTexture(GLenum(GL_TEXTURE0 + kPlaneUnitG));
       glBindTexture(GL_TEXTURE_2D, map.colorTexture(1));
-      glActiveTexture(GL_TEXTURE3);
+      glActiveTexture(GLenum(GL_TEXTURE0 + kPlaneUnitG + 1));
       glBindTexture(GL_TEXTURE_2D, map.colorTexture(2));
     }
-    glActiveTexture(GL_TEXTURE1);
+    glActiveTexture(GLenum(GL_TEXTURE0 + kSeenMapUnit));
     if (ctx.options.seen_points) glBindTexture(GL_TEXTURE_2D, map.colorTexture(planes));
     p.set("u_seen_offset", glm::vec3(pv.volume.eye - cam.origin));
     // The map fills the lower-left mapTexels() of its texture: (s, t) in [0, 1]^2 of the volume scale to
@@ -371,7 +415,10 @@ void PvrrPass::drawPvrrElement(const ElementFrame& f, size_t first_slot, const P
     if (refined) setRefinementView(p, pv, map, map_side[first_slot + v]);
     for (size_t set = 0; set < sets; ++set) {
       MeshBuffers& mb = ctx.meshes.slot();
-      uploadPatch(mb, f, pv, anchor, set, seen_c);
+      if (refined)
+        uploadRefinedPatch(mb, f, pv, anchor);
+      else
+        uploadPatch(mb, f, pv, anchor, set, seen_c);
       p.set("u_additive", set > 0 ? 1 : 0);
       if (set == 1) {
         glEnablei(GL_BLEND, 0);
@@ -511,7 +558,7 @@ std::string PvrrPass::drawElements(RenderMode, const PassCamera& eye, const Fram
     slot += f.views.size();
   }
   refine_counting = false;
-  return refinementNote();
+  return "";
 }
 
 void PvrrPass::prepareRefinement() {
@@ -539,34 +586,57 @@ void PvrrPass::prepareRefinement() {
     refine_queries.resize(frames.size());
     glGenQueries(GLsizei(frames.size() - had), refine_queries.data() + had);
   }
-  // The counters, zeroed before the frame's draws.
-  const GLuint zeros[2] = {0, 0};
-  if (!refine_counters) glGenBuffers(1, &refine_counters);
+  // The counters, zeroed before the frame's draws (allocated once; read after the frame: finishedNote).
+  if (!refine_counters) {
+    glGenBuffers(1, &refine_counters);
+    glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, refine_counters);
+    glBufferData(GL_ATOMIC_COUNTER_BUFFER, 2 * sizeof(GLuint), nullptr, GL_DYNAMIC_READ);
+  }
   glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, refine_counters);
-  glBufferData(GL_ATOMIC_COUNTER_BUFFER, sizeof(zeros), zeros, GL_DYNAMIC_READ);
+  glClearBufferData(GL_ATOMIC_COUNTER_BUFFER, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
   glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, 0, refine_counters);
   checkGlError("zeroing the refinement's counters");
 }
 
-// Units 2 to 5: the mirror's surface maps (u_to_local, u_sm), the derivatives (3, 4) filtered linearly; 6: the
-// depth of the patch view's map, filtered linearly.
+const PvrrPass::EdgeMidpoints& PvrrPass::edgeMidpoints(const ElementFrame& f) const {
+  if (refine_mids.size() < ctx.scene.elements.size()) refine_mids.resize(ctx.scene.elements.size());
+  RefineMidpoints& c = refine_mids[size_t(f.element)];
+  const Element& el = ctx.scene.elements[size_t(f.element)];
+  if (c.surface == el.surface && c.params == f.grid.params) return c.mids;
+  c.surface = el.surface;
+  c.params = f.grid.params;
+  c.mids.clear();
+  for (const auto& t : f.grid.triangles) {
+    const uint32_t v[3] = {t.x, t.y, t.z};
+    for (int e = 0; e < 3; ++e) {
+      const uint64_t key = edgeKey(v[e], v[(e + 1) % 3]);
+      if (c.mids.count(key)) continue;
+      const Vec2 uv = 0.5 * (c.params[v[e]] + c.params[v[(e + 1) % 3]]);
+      c.mids[key] = el.surface->evaluate(uv.x, uv.y).p;
+    }
+  }
+  return c.mids;
+}
+
+// The mirror's surface maps on the impostor mode's units (ImpostorMaps::setMirrorMaps; only the normal is read), then
+// the depth of the patch view's map; all filtered linearly.
 void PvrrPass::setRefinement(const Program& p, const ElementFrame& f) const {
   surface_maps->setMirrorMaps(p, size_t(f.element));
-  p.set("u_map_depth", 6);
+  p.set("u_map_depth", kRefineDepthUnit);
   p.set("u_count", refine_counting ? 1 : 0);
 }
 
 void PvrrPass::unsetRefinement() const {
-  for (GLuint unit : {2u, 3u, 4u, 5u, 6u}) glBindSampler(unit, 0);
+  for (int unit = kElementMapsUnit; unit <= kRefineDepthUnit; ++unit) glBindSampler(GLuint(unit), 0);
 }
 
 void PvrrPass::setRefinementView(const Program& p, const PatchView& pv, const Framebuffer& map, int side) const {
   const bool on = refineViewSkipReason(pv).empty();
   p.set("u_refine", on ? 1 : 0);
   if (!on) return;
-  glActiveTexture(GL_TEXTURE6);
+  glActiveTexture(GLenum(GL_TEXTURE0 + kRefineDepthUnit));
   glBindTexture(GL_TEXTURE_2D, map.depthTexture());
-  for (GLuint unit : {2u, 3u, 4u, 5u, 6u}) glBindSampler(unit, refine_sampler);
+  for (int unit = kElementMapsUnit; unit <= kRefineDepthUnit; ++unit) glBindSampler(GLuint(unit), refine_sampler);
   p.set("u_map_vp", toFloat(relativeViewProj(pv.volume.projection, pv.volume.view, pv.volume.eye)));
   const Mat4& P = pv.volume.projection;
   p.set("u_depth_lin", glm::vec3(float(P[2][2]), float(P[3][2]), float(pv.volume.near_m)));
@@ -575,18 +645,15 @@ void PvrrPass::setRefinementView(const Program& p, const PatchView& pv, const Fr
   p.set("u_edge", float(std::max(0.05, 57.0 * longerExtentTan(pv.volume) / std::max(side, 1))));
 }
 
-std::string PvrrPass::refinementNote() const {
+// The refinement's part of the second pass's note, read once the frame's draws have finished (the renderer's
+// glFinish), so that no draw waits on the counts: the second pass's fragments of the refined elements, those
+// that kept the interpolated coordinate, and the elements not refined with why.
+std::string PvrrPass::finishedNote(const std::string& note) const {
   const int steps = ctx.scene.render.refine;
-  if (steps <= 0) return "";
-  std::string note = "refine (" + std::to_string(steps) + " steps):";
-  std::string skipped;
+  if (steps <= 0) return note;
   bool any = false;
-  for (size_t e = 0; e < refine_skip.size(); ++e) {
-    if (refine_skip[e].empty())
-      any = true;
-    else
-      skipped += (skipped.empty() ? " " : "; ") + ctx.scene.elements[e].name + " (" + refine_skip[e] + ")";
-  }
+  const std::string skipped = refinementSkips(&any);
+  std::string refine = "refine (" + std::to_string(steps) + " steps):";
   if (any) {
     GLuint n[2] = {0, 0};
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_ATOMIC_COUNTER_BARRIER_BIT);
@@ -599,12 +666,25 @@ std::string PvrrPass::refinementNote() const {
       glGetQueryObjectuiv(refine_queries[e], GL_QUERY_RESULT, &samples);
       drawn += samples;
     }
-    note += " " + std::to_string(drawn) + " fragments drawn, " + std::to_string(n[0]) +
-            " kept the interpolated coordinate (search ended off the map's surface), " + std::to_string(n[1]) +
-            " kept it where the view ray missed the exact surface";
+    refine += " " + std::to_string(drawn) + " fragments drawn, " + std::to_string(n[0]) +
+              " kept the interpolated coordinate (search ended off the map's surface), " + std::to_string(n[1]) +
+              " kept it where the view ray missed the exact surface";
   }
-  if (!skipped.empty()) note += std::string(any ? ";" : "") + " not refined:" + skipped;
-  return note;
+  if (!skipped.empty()) refine += std::string(any ? ";" : "") + " not refined:" + skipped;
+  return note.empty() ? refine : note + "; " + refine;
+}
+
+// The elements not refined, with why ("" when none); *any: whether some element is refined.
+std::string PvrrPass::refinementSkips(bool* any) const {
+  std::string skipped;
+  *any = false;
+  for (size_t e = 0; e < refine_skip.size(); ++e) {
+    if (refine_skip[e].empty())
+      *any = true;
+    else
+      skipped += (skipped.empty() ? " " : "; ") + ctx.scene.elements[e].name + " (" + refine_skip[e] + ")";
+  }
+  return skipped;
 }
 
 }  // namespace pvrr::gl

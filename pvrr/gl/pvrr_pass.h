@@ -2,10 +2,12 @@
 // coordinates, with eye-fixed caching), the first-pass maps the plan (pvrr/method/pass_plan.h) asks for, rendered
 // deepest first, and each element's draw with its maps, in the second pass or inside another element's map.
 #pragma once
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "pvrr/gl/mode_pass.h"
@@ -26,6 +28,7 @@ class PvrrPass : public ModePass {
   void prepare(RenderMode mode, FrameStages& stages, FrameCache* cache) override;
   bool additiveDraws() const override;
   std::string drawElements(RenderMode mode, const PassCamera& eye, const Framebuffer& target) override;
+  std::string finishedNote(const std::string& note) const override;
   std::vector<ElementFrame> takeElements() override { return std::move(frames); }
 
  private:
@@ -52,7 +55,13 @@ class PvrrPass : public ModePass {
   void setRefinement(const Program& p, const ElementFrame& f) const;
   void unsetRefinement() const;
   void setRefinementView(const Program& p, const PatchView& pv, const Framebuffer& map, int side) const;
-  std::string refinementNote() const;
+  std::string refinementSkips(bool* any) const;
+  void uploadRefinedPatch(MeshBuffers& mb, const ElementFrame& f, const PatchView& pv, const Vec3& anchor) const;
+  // The exact surface point (local frame) at the parameter-domain midpoint of each edge of refined element f's
+  // grid triangles, by edgeKey of its grid vertices; cached while its surface and grid stay the same.
+  using EdgeMidpoints = std::unordered_map<uint64_t, Vec3>;
+  static uint64_t edgeKey(uint32_t i, uint32_t j) { return uint64_t(std::min(i, j)) << 32 | std::max(i, j); }
+  const EdgeMidpoints& edgeMidpoints(const ElementFrame& f) const;
 
   RenderContext ctx;
   std::vector<ElementFrame> frames;     // this frame's elements as seen from the eye
@@ -64,12 +73,18 @@ class PvrrPass : public ModePass {
   // process (nextFirstPassSerial), so a cache filled by another renderer never matches.
   uint64_t first_pass_serial = 0;
   unsigned mask_vao = 0, mask_vbo = 0;  // closeUnreadTexels' quads
-  std::vector<std::string> refine_skip;        // per element: why it is not refined, "" when it is
-  std::unique_ptr<ImpostorMaps> surface_maps;  // the refined mirrors' surface maps (pvrr/impostor/surface_map.h)
+  std::vector<std::string> refine_skip;  // per element: why it is not refined, "" when it is
   unsigned refine_counters = 0;          // the second pass's failed and missed fragments (shaders/pvrr_refine.glsl)
-  unsigned refine_sampler = 0;           // linear filtering of the depth maps and the surface derivatives
+  unsigned refine_sampler = 0;           // linear filtering of the depth maps and the surface maps
   std::vector<unsigned> refine_queries;  // per element: its second-pass fragments (refined elements)
+  std::unique_ptr<ImpostorMaps> surface_maps;  // the refined mirrors' surface maps (pvrr/impostor/surface_map.h)
   bool refine_counting = false;          // drawing the second pass (counted), not a nested pass
+  struct RefineMidpoints {
+    cad::SurfacePtr surface;  // what they were computed for (held: never a reused address)
+    std::vector<Vec2> params;
+    EdgeMidpoints mids;
+  };
+  mutable std::vector<RefineMidpoints> refine_mids;  // per element (edgeMidpoints)
 };
 
 }  // namespace pvrr::gl

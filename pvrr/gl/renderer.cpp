@@ -186,7 +186,7 @@ std::string Renderer::Impl::secondPass(RenderMode mode, ModePass& pass, CullCoun
   *culled = environment.draw(view, proj, ob.eye);
   glFinish();
   checkGlError("rendering a frame");
-  return note;
+  return pass.finishedNote(note);
 }
 
 void Renderer::Impl::readBack(RasterFrame& out) const {

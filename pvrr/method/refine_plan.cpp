@@ -21,7 +21,6 @@ std::string refineSkipReason(const Scene& scene, const ElementFrame& f, int step
 
 std::string refineViewSkipReason(const PatchView& pv) {
   if (pv.draw_traced) return "drawn from traced colours";
-  if (pv.volume.backward) return "a zooming-region map (reversed depth): not refined";
   if (pv.fit.max_angle_rad <= kExactFitRad) return "the vertex fit is exact (a plane): interpolation is exact";
   return "";
 }

@@ -18,8 +18,9 @@ constexpr double kExactFitRad = 1e-7;
 // view exact or unrefinable (refineView).
 std::string refineSkipReason(const Scene& scene, const ElementFrame& f, int steps);
 
-// Why patch view pv is not refined, or "": exact already (kExactFitRad), drawn from traced colours, or a
-// reversed (zooming region) map, whose depth holds the farthest surface.
+// Why patch view pv is not refined, or "": exact already (kExactFitRad), or drawn from traced colours. A reversed
+// (zooming region) map is refined: its rays pass its viewpoint and move backward along its axis, meeting the
+// farthest surface its reversed depth holds first (shaders/pvrr_refine.glsl).
 std::string refineViewSkipReason(const PatchView& pv);
 
 }  // namespace pvrr
