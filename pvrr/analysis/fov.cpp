@@ -274,10 +274,14 @@ ZoneResult evaluateZone(const FovZone& z, const VehicleFrame& frame, const std::
       }
     return state;
   };
-  const EyeFootprint *left = nullptr, *right = nullptr;
-  for (const EyeFootprint* e : eyes) (e->eye == "left" ? left : right) = e;
-  const std::vector<int> none(pts.size(), 0);
-  const std::vector<int> sl = left ? classify(*left) : none, sr = right ? classify(*right) : none;
+  // Several footprints of one eye (the samples of its eye ellipse): seen when any sample sees the point clear,
+  // else obstructed when any sees it through an obstructed cell.
+  std::vector<int> sl(pts.size(), 0), sr(pts.size(), 0);
+  for (const EyeFootprint* e : eyes) {
+    const std::vector<int> st = classify(*e);
+    std::vector<int>& dst = e->eye == "left" ? sl : sr;
+    for (size_t s = 0; s < pts.size(); ++s) dst[s] = (dst[s] == 1 || st[s] == 1) ? 1 : (dst[s] || st[s]) ? 2 : 0;
+  }
   int seen = 0, obs = 0;
   for (size_t s = 0; s < pts.size(); ++s) {
     int st = 0;

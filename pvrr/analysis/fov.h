@@ -102,7 +102,8 @@ struct ZoneResult {
 std::vector<Vec2> zoneInVehicle(const FovZone& z, const VehicleFrame& frame, double zone_horizon_m);
 
 // Coverage of one zone by the footprints of the eyes given (left and/or right; an eye the zone needs but not
-// given counts as seeing nothing).
+// given counts as seeing nothing). Several footprints of one eye (an eye ellipse's samples, fov_eyes.h) act as
+// one: a point is seen by that eye when any of them sees it.
 ZoneResult evaluateZone(const FovZone& z, const VehicleFrame& frame, const std::vector<const EyeFootprint*>& eyes,
                         const FovOptions& options = {});
 
