@@ -206,9 +206,9 @@ json radiusJson(const Annex7Radius& a) {
           {"max_principal_deviation", a.max_principal_deviation},
           {"max_point_deviation", a.max_point_deviation},
           {"definition",
-           "R46 Annex 7 as recalled (unverified): r_i, r'_i the spherometer radii along and across the longer central "
-           "arc at 1/3, 1/2, 2/3 of it; r_p = (r_i + r'_i) / 2; r = (r_p1 + r_p2 + r_p3) / 3 "
-           "(pvrr/analysis/fov_radius.h)"}};
+           "R46 Annex 7: r_i, r'_i the spherometer radii along and across the longer central arc at 1/3, 1/2, 2/3 "
+           "of it; r_p = (r_i + r'_i) / 2; r = (r_p1 + r_p2 + r_p3) / 3 (the points, r_p and r as Directive "
+           "2003/97/EC's text has them; the spherometer's span recalled, unverified: pvrr/analysis/fov_radius.h)"}};
 }
 
 // The ocular points in the vehicle frame, and where they come from.
