@@ -66,8 +66,9 @@ json unionJson(const std::vector<const EyeFootprint*>& feet) {
   const std::vector<Vec2> u = unionOfPolygons(polys);
   if (u.empty())
     return {{"polygons", nullptr},
-            {"note", "the union is not one loop (disjoint parts or a hole): not represented; the zones' coverage "
-                     "uses every sample's footprint"}};
+            {"note", "the union is not one simple loop (footprint outlines fold where they reach the horizon, "
+                     "or the union has a hole or parts): not represented; the zones' coverage uses every sample's "
+                     "footprint (footprint.samples)"}};
   return {{"polygons", json::array({polygonJson(u)})}};
 }
 

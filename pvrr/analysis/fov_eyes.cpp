@@ -1,5 +1,6 @@
 #include "pvrr/analysis/fov_eyes.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace pvrr {
@@ -7,6 +8,10 @@ namespace pvrr {
 namespace {
 // Samples of one eye closer than this are one sample.
 constexpr double kSameSample_m = 1e-12;
+// Loops of a union smaller than this share of its largest are slivers, dropped: two samples' footprints reach the
+// horizon (placed horizon_m away) along nearly the same arcs, and their crossings there cut slivers of ~1e-6 of the
+// footprint's area.
+constexpr double kSliverArea = 1e-5;
 }  // namespace
 
 std::vector<EyeSample> eyeEllipseSamples(const VehicleFrame& frame, const VehicleDesc::EyeEllipse& e, double scale) {
@@ -40,13 +45,27 @@ std::vector<EyeSample> eyeEllipseSamples(const VehicleFrame& frame, const Vehicl
   return out;
 }
 
+double signedArea(const std::vector<Vec2>& p) {
+  double a = 0;
+  for (size_t i = 0; i < p.size(); ++i) {
+    const Vec2 q = p[(i + 1) % p.size()];
+    a += p[i].x * q.y - p[i].y * q.x;
+  }
+  return 0.5 * a;
+}
+
 std::vector<Vec2> unionOfPolygons(const std::vector<std::vector<Vec2>>& polys) {
   if (polys.empty()) return {};
   std::vector<Vec2> acc = polys.front();
   for (size_t i = 1; i < polys.size(); ++i) {
     const std::vector<std::vector<Vec2>> loops = polygonUnion(acc, polys[i]);
-    if (loops.size() != 1) return {};
-    acc = loops.front();
+    double largest = 0;
+    for (const std::vector<Vec2>& l : loops) largest = std::max(largest, std::abs(signedArea(l)));
+    std::vector<const std::vector<Vec2>*> kept;
+    for (const std::vector<Vec2>& l : loops)
+      if (std::abs(signedArea(l)) > kSliverArea * largest) kept.push_back(&l);
+    if (kept.size() != 1 || signedArea(*kept.front()) <= 0) return {};
+    acc = *kept.front();
   }
   return acc;
 }

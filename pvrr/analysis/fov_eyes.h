@@ -24,8 +24,12 @@ struct EyeSample {
 std::vector<EyeSample> eyeEllipseSamples(const VehicleFrame& frame, const VehicleDesc::EyeEllipse& e,
                                          double scale = 1);
 
-// The union of simple counter-clockwise polygons, merged one at a time (polygonUnion); empty when a step gives
-// more than one loop (a hole, or disjoint parts), which this union does not represent.
+// The union of simple counter-clockwise polygons, merged one at a time (polygonUnion); loops below 1e-5 of a step's
+// largest are dropped (slivers where two footprints' horizon arcs nearly coincide, 1 km away); empty when a step
+// still gives more than one loop (a hole, or disjoint parts), which this union does not represent.
 std::vector<Vec2> unionOfPolygons(const std::vector<std::vector<Vec2>>& polys);
+
+// The signed area of a polygon (> 0 counter-clockwise).
+double signedArea(const std::vector<Vec2>& p);
 
 }  // namespace pvrr
