@@ -66,9 +66,10 @@ json unionJson(const std::vector<const EyeFootprint*>& feet) {
   const std::vector<Vec2> u = unionOfPolygons(polys);
   if (u.empty())
     return {{"polygons", nullptr},
-            {"note", "the union is not one simple loop (footprint outlines fold where they reach the horizon, "
-                     "or the union has a hole or parts): not represented; the zones' coverage uses every sample's "
-                     "footprint (footprint.samples)"}};
+            {"note",
+             "the union is not one simple loop (footprint outlines fold where they reach the horizon, "
+             "or the union has a hole or parts): not represented; the zones' coverage uses every sample's "
+             "footprint (footprint.samples)"}};
   return {{"polygons", json::array({polygonJson(u)})}};
 }
 
@@ -269,7 +270,8 @@ AimReport runAim(const std::string& scene_path, const std::vector<std::string>& 
   const ElementDesc& ed = ls.desc.elements[size_t(index)];
   if (ed.pivot) {
     if (ed.attached_to_observer)
-      throw Error(scene_path + ": elements[" + std::to_string(index) + "].pivot: pvrr fov --aim turns a mirror fixed "
+      throw Error(scene_path + ": elements[" + std::to_string(index) +
+                  "].pivot: pvrr fov --aim turns a mirror fixed "
                   "to the vehicle, not one attached to the observer");
     ao.pivot = *ed.pivot;
   }
@@ -317,7 +319,8 @@ AimReport runAim(const std::string& scene_path, const std::vector<std::string>& 
              {"zones", zones_after},
              {"scene", (fs::path(out) / "aimed.json").string()},
              {"definitions",
-              "rotation about the pivot (the element's pivot, default its vertex): yaw about the vehicle's up axis after pitch about "
+              "rotation about the pivot (the element's pivot, default its vertex): yaw about the vehicle's up axis "
+              "after pitch about "
               "the horizontal axis in the mirror's plane; score: the smallest over the zones of the covered fraction "
               "plus the obstructed fraction up to its allowance (1: every zone passes); zones: the aimed scene "
               "checked afresh at the command's sampling (pvrr/analysis/fov_aim.h)"}};

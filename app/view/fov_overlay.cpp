@@ -7,8 +7,8 @@
 namespace pvrr::app::view {
 
 namespace {
-// Colours (RGBA 0-255): the left eye's cells blue, the right eye's orange (as in pvrr fov's plan view), obstructed purple;
-// translucent so the road shows through.
+// Colours (RGBA 0-255): the left eye's cells blue, the right eye's orange (as in pvrr fov's plan view), obstructed
+// purple; translucent so the road shows through.
 constexpr ImU32 kLeftCell = IM_COL32(40, 110, 255, 110), kRightCell = IM_COL32(255, 140, 20, 110),
                 kObstructedCell = IM_COL32(200, 40, 200, 110);
 // Vertices nearer than this in front of the observer (or behind it) leave their cell undrawn.

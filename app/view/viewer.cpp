@@ -379,7 +379,9 @@ void Viewer::onKey(int key, int action, int mods) {
     case GLFW_KEY_E:
       overlay_ = !overlay_;
       break;
-    case GLFW_KEY_O: fov_overlay_.toggle(); break;
+    case GLFW_KEY_O:
+      fov_overlay_.toggle();
+      break;
     case GLFW_KEY_F12: pending_screenshots_.push_back("out/view-" + std::to_string(++saved_) + ".png"); break;
     case GLFW_KEY_V: saveViewTo("out/view-" + std::to_string(++saved_) + ".json"); break;
     case GLFW_KEY_ESCAPE: quit_ = true; break;

@@ -15,14 +15,13 @@
 namespace pvrr {
 
 struct EyeSample {
-  std::string eye;     // "left" | "right"
-  Vec3 world{0};       // the eye position
-  Vec3 unit{0};        // the sample's position on the unit sphere (the centre: 0)
+  std::string eye;  // "left" | "right"
+  Vec3 world{0};    // the eye position
+  Vec3 unit{0};     // the sample's position on the unit sphere (the centre: 0)
 };
 
 // The samples of both eyes' ellipsoids (EYE ELLIPSE), the left eye's first; `scale` multiplies the axes.
-std::vector<EyeSample> eyeEllipseSamples(const VehicleFrame& frame, const VehicleDesc::EyeEllipse& e,
-                                         double scale = 1);
+std::vector<EyeSample> eyeEllipseSamples(const VehicleFrame& frame, const VehicleDesc::EyeEllipse& e, double scale = 1);
 
 // The union of simple counter-clockwise polygons, merged one at a time (polygonUnion); loops below 1e-5 of a step's
 // largest are dropped (slivers where two footprints' horizon arcs nearly coincide, 1 km away); empty when a step

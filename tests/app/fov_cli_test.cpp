@@ -19,7 +19,6 @@ using pvrr::test::expectOneLineError;
 using pvrr::test::runPvrr;
 using pvrr::test::slurp;
 
-
 TEST(FovCli, CarMirrorAgainstR46ClassIII) {
   const fs::path dir = pvrr::test::freshTestDir("fov-ok");
   const CliResult r = runPvrr("fov models/car-mirror.json --samples 61 --out '" + (dir / "out").string() + "'");
@@ -115,19 +114,21 @@ TEST(FovCli, OneEyeAndAnExplicitRegulation) {
   fs::remove_all(dir);
 }
 
-
 // --eyes ellipse: an ellipse of size 0 gives the ocular points' zones exactly; a J941-like one covers at least as
 // much, and fov.json reports its samples and each eye's union.
 TEST(FovCli, EyeEllipse) {
   const fs::path dir = pvrr::test::freshTestDir("fov-ellipse");
-  const std::string common = "fov models/car-mirror.json --samples 41 --set 'elements[0].pose.normal=[0.47697, 0.1238, "
-                             "0.87021]' ";
+  const std::string common =
+      "fov models/car-mirror.json --samples 41 --set 'elements[0].pose.normal=[0.47697, 0.1238, "
+      "0.87021]' ";
   const CliResult p = runPvrr(common + "--out '" + (dir / "points").string() + "'");
   const CliResult z = runPvrr(common + "--eyes ellipse --set 'vehicle.eye_ellipse={\"axes\": [0, 0, 0]}' --out '" +
                               (dir / "zero").string() + "'");
   const CliResult e =
-      runPvrr(common + "--eyes ellipse --set 'vehicle.eye_ellipse={\"axes\": [0.2, 0.06, 0.09], \"tilt_deg\": 12}' "
-                       "--out '" + (dir / "ellipse").string() + "'");
+      runPvrr(common +
+              "--eyes ellipse --set 'vehicle.eye_ellipse={\"axes\": [0.2, 0.06, 0.09], \"tilt_deg\": 12}' "
+              "--out '" +
+              (dir / "ellipse").string() + "'");
   ASSERT_EQ(p.code, 0) << p.err;
   ASSERT_EQ(z.code, 0) << z.err;
   ASSERT_EQ(e.code, 0) << e.err;

@@ -39,9 +39,11 @@ TEST(ViewFovOverlay, OverlayCoversTheRoadTheFootprintPredicts) {
   const fs::path off = dir / "off.png", on = dir / "on.png";
   writeText(script, R"({"size": [320, 240], "events": [
       {"at_frame": 1, "do": "key", "key": "TAB"},
-      {"at_frame": 2, "do": "screenshot", "file": ")" + off.string() + R"(", "panel": true},
+      {"at_frame": 2, "do": "screenshot", "file": ")" +
+                        off.string() + R"(", "panel": true},
       {"at_frame": 3, "do": "key", "key": "O"},
-      {"at_frame": 4, "do": "screenshot", "file": ")" + on.string() + R"(", "panel": true},
+      {"at_frame": 4, "do": "screenshot", "file": ")" +
+                        on.string() + R"(", "panel": true},
       {"at_frame": 6, "do": "quit"}]})");
   CliResult r;
   RUN_VIEW_OR_SKIP("models/car-mirror.json " + std::string(kView) + " --script '" + script.string() + "' --stats '" +
