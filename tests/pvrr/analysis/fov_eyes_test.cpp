@@ -106,5 +106,20 @@ TEST(FovEyes, PlaneMirrorCoverageGrowsWithTheEllipse) {
   EXPECT_GT(prev[1], first[1] + 0.02);
 }
 
+TEST(FovEyes, UnionOfPolygonsIsOneLoopOrNothing) {
+  auto square = [](double x0, double y0, double w) {
+    return std::vector<Vec2>{Vec2(x0, y0), Vec2(x0 + w, y0), Vec2(x0 + w, y0 + w), Vec2(x0, y0 + w)};
+  };
+  // Three overlapping squares (no shared edge lines: polygonUnion does not take those): one loop, the area of their
+  // union, 3 x 100 less the overlaps 5 x 7 (first and second) and 4 x 7 (second and third).
+  const std::vector<Vec2> u = unionOfPolygons({square(0, 0, 10), square(5, 3, 10), square(11, 6, 10)});
+  ASSERT_FALSE(u.empty());
+  EXPECT_NEAR(signedArea(u), 300 - 35 - 28, 1e-9);
+  // A disjoint one: two loops, which the union does not represent.
+  EXPECT_TRUE(unionOfPolygons({square(0, 0, 10), square(20, 0, 10)}).empty());
+  // One polygon is its own union.
+  EXPECT_NEAR(signedArea(unionOfPolygons({square(0, 0, 3)})), 9, 1e-12);
+}
+
 }  // namespace
 }  // namespace pvrr
