@@ -68,7 +68,9 @@ struct EyeFootprint {
   std::vector<Vec2> road;  // vehicle-frame (x, y) of each sample (CONVENTIONS)
   std::vector<RayFate> fate;
   std::vector<Vec3> mirror_point;  // the exact surface point, world
-  // The image of the mirror's boundary, counter-clockwise in (x, y), one point per boundary sample.
+  // The image of the mirror's boundary, counter-clockwise in (x, y): one point per boundary sample, and between two
+  // whose road points lie more than 1 m and 5 % of their distance apart, points of the edge between them (halving
+  // it, at most 10 times), so that the outline follows the edge out to the horizon instead of a chord across it.
   std::vector<Vec2> outline;
   int count(RayFate f) const;
   // The farthest road reach behind the ocular points (m) of the Road rays, and whether any ray reaches the
