@@ -57,7 +57,8 @@ const std::map<std::string, Command>& commands() {
         "  (1 cm; Shift 10 cm); Home or H returns to the design eye point; 1-4 choose the mode; Tab hides the panel;\n"
         "  F12 writes out/view-N.png, V out/view-N.json (a scene that pvrr render reproduces); Esc quits.\n"
         "  T traces the Embree reference of the view in background threads (again: cancels), shown right of a\n"
-        "  split line that a drag moves; E overlays the angular error heat map (pvrr compare's figures in the panel).\n"
+        "  split line that a drag moves; E overlays the angular error heat map (pvrr compare's figures in the panel);\n"
+        "  O overlays the selected mirror's road footprint (pvrr fov's; scenes with a vehicle).\n"
         "  J/L and K/I turn the selected mirror or lens about its vertex in yaw and pitch (1 deg; Shift 10 deg).\n"
         "  Over a lens, the panel shows pvrr lensmap's readings at the lens point under the mouse.\n"
         "  --script {\"size\":[w,h],\"events\":[{\"at_frame\":N,\"do\":...}]}, do one of: \"set\" (\"path\", "
@@ -128,7 +129,7 @@ const std::map<std::string, Command>& commands() {
         "  PNG and SVG: power_error, cylinder, prism, lateral_colour, distortion. Conventions: docs/lensmap.md."}},
       {"fov",
        {cmdFov, "a mirror's field of view on the road, checked against regulation zones",
-        "pvrr fov SCENE [--element NAME] [--regulation ID]... [--eyes both|left|right] [--samples N]\n"
+        "pvrr fov SCENE [--element NAME] [--regulation ID]... [--eyes both|left|right|ellipse] [--samples N]\n"
         "         [--aim [--aim-range DEG]] [--set PATH=VALUE]... --out DIR\n"
         "  From each of the vehicle's ocular points (the scene's \"vehicle\" block), N x N rays (default 121) through\n"
         "  the mirror, reflected exactly and continued to the road; the footprint per eye and the share of each\n"
@@ -136,9 +137,10 @@ const std::map<std::string, Command>& commands() {
         "  Writes DIR/fov.json (element, eyes, footprint polygons in the vehicle frame, zones with\n"
         "  covered_fraction, obstructed_fraction, pass, verified; surface: mean and principal radii, magnification\n"
         "  range, R46 Annex 7's three-point mean radius), the plan view DIR/fov.png and .svg, and the magnification\n"
-        "  map DIR/magnification.png and .svg. --aim: the mirror's yaw and pitch about its vertex (within DEG, default\n"
-        "  10) that meets every zone with the largest margin, checked afresh: fov.json \"aim\", DIR/aimed.json (the\n"
-        "  scene with the new pose) and DIR/aimed/fov.png and .svg. Conventions: docs/fov.md."}},
+        "  map DIR/magnification.png and .svg. --eyes ellipse: over vehicle.eye_ellipse's samples, a zone point seen\n"
+        "  from any. --aim: the mirror's yaw and pitch about its pivot (element.pivot, default its vertex; within\n"
+        "  DEG, default 10) that meets every zone with the largest margin, checked afresh: fov.json \"aim\",\n"
+        "  DIR/aimed.json (the scene with the new pose) and DIR/aimed/fov.png and .svg. Conventions: docs/fov.md."}},
       {"caustic",
        {cmdCaustic, "the reference's caustic of mirrors and lenses on a receiving surface: irradiance map and figures",
         "pvrr caustic SCENE [--receiver NAME] [--window CU,CV,W,H] [--cells N] [--photons N] [--seed N]\n"

@@ -1,5 +1,6 @@
 // pvrr fov: a mirror's field of view on the road, checked against regulation zones (issue 21; the computation
 // and its conventions: pvrr/analysis/fov.h; the zones: models/regulations/*.json, docs/fov.md).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -15,6 +16,7 @@
 #include "app/view/save_view.h"
 #include "pvrr/analysis/fov.h"
 #include "pvrr/analysis/fov_aim.h"
+#include "pvrr/analysis/fov_eyes.h"
 #include "pvrr/analysis/fov_radius.h"
 #include "pvrr/base/atomic_file.h"
 #include "pvrr/base/error.h"
@@ -57,9 +59,72 @@ const char* eyesName(FovZone::Eyes e) {
   return "";
 }
 
+// The union of several footprints' outlines as "polygons" (one loop), or null and why.
+json unionJson(const std::vector<const EyeFootprint*>& feet) {
+  std::vector<std::vector<Vec2>> polys;
+  for (const EyeFootprint* f : feet) polys.push_back(f->outline);
+  const std::vector<Vec2> u = unionOfPolygons(polys);
+  if (u.empty())
+    return {{"polygons", nullptr},
+            {"note",
+             "the union is not one simple loop (footprint outlines fold where they reach the horizon, "
+             "or the union has a hole or parts): not represented; the zones' coverage uses every sample's "
+             "footprint (footprint.samples)"}};
+  return {{"polygons", json::array({polygonJson(u)})}};
+}
+
+// An eye ellipse's footprints (--eyes ellipse): per eye the union over its samples and the ray counts summed, each
+// sample's footprint, and the union over every sample.
+json ellipseFootprintJson(const std::vector<EyeFootprint>& feet, const VehicleFrame& frame) {
+  json fp = json::object();
+  json samples = json::array();
+  for (const char* eye : {"left", "right"}) {
+    std::vector<const EyeFootprint*> mine;
+    int road = 0, horizon = 0, obstructed = 0, back = 0;
+    double reach = 0;
+    bool sees_horizon = false;
+    for (const EyeFootprint& f : feet)
+      if (f.eye == eye) {
+        mine.push_back(&f);
+        road += f.count(RayFate::Road);
+        horizon += f.count(RayFate::Horizon);
+        obstructed += f.count(RayFate::Obstructed);
+        back += f.count(RayFate::Back);
+        reach = std::max(reach, f.reach_m);
+        sees_horizon = sees_horizon || f.sees_horizon;
+        samples.push_back({{"eye", f.eye},
+                           {"position", {f.eye_vehicle.x, f.eye_vehicle.y, f.eye_vehicle.z}},
+                           {"polygon", polygonJson(f.outline)}});
+      }
+    if (mine.empty()) continue;
+    json u = unionJson(mine);
+    fp[eye] = {{"polygon", u["polygons"].is_null() ? json(nullptr) : u["polygons"][0]},
+               {"samples", mine.size()},
+               {"road", road},
+               {"horizon", horizon},
+               {"obstructed", obstructed},
+               {"back", back},
+               {"road_reach_m", reach},
+               {"sees_horizon", sees_horizon}};
+  }
+  std::vector<const EyeFootprint*> all;
+  for (const EyeFootprint& f : feet) all.push_back(&f);
+  fp["union"] = unionJson(all);
+  fp["samples"] = samples;
+  const auto& e = *frame.desc().eye_ellipse;
+  fp["eye_ellipse"] = {{"axes_m", {e.axes_m.x, e.axes_m.y, e.axes_m.z}},
+                       {"tilt_deg", e.tilt_deg},
+                       {"definition",
+                        "one ellipsoid per eye centred on its ocular point, full axes along the vehicle's forward, "
+                        "left and up, sampled at its centre, its 6 axis ends and 8 octant points "
+                        "(pvrr/analysis/fov_eyes.h); each eye's polygon is the union over its samples"}};
+  return fp;
+}
+
 // Each eye's footprint (polygon and ray counts) and the union of the eyes' footprints: its outer loops (and any
 // holes, clockwise).
-json footprintJson(const std::vector<EyeFootprint>& feet) {
+json footprintJson(const std::vector<EyeFootprint>& feet, const VehicleFrame& frame, bool ellipse) {
+  if (ellipse) return ellipseFootprintJson(feet, frame);
   json fp = json::object();
   for (const EyeFootprint& f : feet)
     fp[f.eye] = {{"polygon", polygonJson(f.outline)},
@@ -93,8 +158,13 @@ FovRun runFov(const Scene& scene, int index, const VehicleFrame& frame, const st
   FovRun run;
   const RayScene rays(scene);
   const VehicleDesc& v = frame.desc();
-  if (eyes_opt != "right") run.feet.push_back(traceFootprint(rays, index, frame, v.eye_left, "left", options));
-  if (eyes_opt != "left") run.feet.push_back(traceFootprint(rays, index, frame, v.eye_right, "right", options));
+  if (eyes_opt == "ellipse") {
+    for (const EyeSample& e : eyeEllipseSamples(frame, *v.eye_ellipse))
+      run.feet.push_back(traceFootprint(rays, index, frame, e.world, e.eye, options));
+  } else {
+    if (eyes_opt != "right") run.feet.push_back(traceFootprint(rays, index, frame, v.eye_left, "left", options));
+    if (eyes_opt != "left") run.feet.push_back(traceFootprint(rays, index, frame, v.eye_right, "right", options));
+  }
   for (const EyeFootprint& f : run.feet) run.eyes.push_back(&f);
   for (const Regulation& r : regs)
     for (const FovZone& z : r.zones) {
@@ -138,9 +208,9 @@ json radiusJson(const Annex7Radius& a) {
           {"max_principal_deviation", a.max_principal_deviation},
           {"max_point_deviation", a.max_point_deviation},
           {"definition",
-           "R46 Annex 7 as recalled (unverified): r_i, r'_i the spherometer radii along and across the longer central "
-           "arc at 1/3, 1/2, 2/3 of it; r_p = (r_i + r'_i) / 2; r = (r_p1 + r_p2 + r_p3) / 3 "
-           "(pvrr/analysis/fov_radius.h)"}};
+           "R46 Annex 7: r_i, r'_i the spherometer radii along and across the longer central arc at 1/3, 1/2, 2/3 "
+           "of it; r_p = (r_i + r'_i) / 2; r = (r_p1 + r_p2 + r_p3) / 3 (the points, r_p and r as Directive "
+           "2003/97/EC's text has them; the spherometer's span recalled, unverified: pvrr/analysis/fov_radius.h)"}};
 }
 
 // The ocular points in the vehicle frame, and where they come from.
@@ -197,6 +267,15 @@ AimReport runAim(const std::string& scene_path, const std::vector<std::string>& 
   ao.range_deg = aim_range_deg;
   ao.left_eye = eyes_opt != "right";
   ao.right_eye = eyes_opt != "left";
+  const ElementDesc& ed = ls.desc.elements[size_t(index)];
+  if (ed.pivot) {
+    if (ed.attached_to_observer)
+      throw Error(scene_path + ": elements[" + std::to_string(index) +
+                  "].pivot: pvrr fov --aim turns a mirror fixed "
+                  "to the vehicle, not one attached to the observer");
+    ao.pivot = *ed.pivot;
+  }
+  const std::string pivot_name = ed.pivot ? "pivot" : "vertex";
   std::vector<FovZone> zones;
   for (const Regulation& r : regs) zones.insert(zones.end(), r.zones.begin(), r.zones.end());
   const AimResult ar = aimMirror(scene, index, frame, zones, ao);
@@ -222,6 +301,7 @@ AimReport runAim(const std::string& scene_path, const std::vector<std::string>& 
     worst = std::min(worst, after.results[k].covered_fraction +
                                 std::min(after.results[k].obstructed_fraction, zones[k].allowed_obstructed_fraction));
   res.aim = {{"pivot", {ar.pivot.x, ar.pivot.y, ar.pivot.z}},
+             {"pivot_from", ed.pivot ? "the element's pivot" : "the element's vertex (pose.position)"},
              {"yaw_axis", {ar.yaw_axis.x, ar.yaw_axis.y, ar.yaw_axis.z}},
              {"pitch_axis", {ar.pitch_axis.x, ar.pitch_axis.y, ar.pitch_axis.z}},
              {"yaw_deg", ar.angles.yaw_rad * 180 / kPi},
@@ -239,13 +319,14 @@ AimReport runAim(const std::string& scene_path, const std::vector<std::string>& 
              {"zones", zones_after},
              {"scene", (fs::path(out) / "aimed.json").string()},
              {"definitions",
-              "rotation about the pivot (the element's vertex): yaw about the vehicle's up axis after pitch about "
+              "rotation about the pivot (the element's pivot, default its vertex): yaw about the vehicle's up axis "
+              "after pitch about "
               "the horizontal axis in the mirror's plane; score: the smallest over the zones of the covered fraction "
               "plus the obstructed fraction up to its allowance (1: every zone passes); zones: the aimed scene "
               "checked afresh at the command's sampling (pvrr/analysis/fov_aim.h)"}};
   res.summary +=
       "aim: yaw " + fmt("%.2f", ar.angles.yaw_rad * 180 / kPi) + " deg, pitch " +
-      fmt("%.2f", ar.angles.pitch_rad * 180 / kPi) + " deg about " + name + "'s vertex: " +
+      fmt("%.2f", ar.angles.pitch_rad * 180 / kPi) + " deg about " + name + "'s " + pivot_name + ": " +
       (after.pass
            ? "every zone passes"
            : "no adjustment within " + fmt("%.0f", aim_range_deg) + " deg meets every zone; the best falls short by " +
@@ -269,12 +350,14 @@ int cmdFov(const std::vector<std::string>& argv) {
   const auto out = a.get("out");
   if (!out) usageError("fov", "--out DIR is required");
   const std::string eyes_opt = a.get("eyes", "both");
-  if (eyes_opt != "both" && eyes_opt != "left" && eyes_opt != "right")
-    usageError("fov", "--eyes: expected both, left or right, got \"" + eyes_opt + "\"");
+  if (eyes_opt != "both" && eyes_opt != "left" && eyes_opt != "right" && eyes_opt != "ellipse")
+    usageError("fov", "--eyes: expected both, left, right or ellipse, got \"" + eyes_opt + "\"");
   FovOptions options;
   options.samples = a.getInt("samples", options.samples, 2);
   if (options.samples > 1001) usageError("fov", "--samples: expected at most 1001");
   const bool aim = a.has("aim");
+  if (aim && eyes_opt == "ellipse")
+    usageError("fov", "--aim aims for the ocular points; it does not take --eyes ellipse (not yet)");
   const double aim_range_deg = a.getDouble("aim-range", 10);
   if (!(aim_range_deg >= 1 && aim_range_deg <= 45)) usageError("fov", "--aim-range: expected degrees in [1, 45]");
   const std::string scene_path = a.positional()[0];
@@ -283,6 +366,9 @@ int cmdFov(const std::vector<std::string>& argv) {
   if (!ls.desc.vehicle)
     throw Error(scene_path + ": vehicle: missing; pvrr fov needs the vehicle frame (docs/scene-format.md \"vehicle\")");
   const VehicleDesc& vehicle = *ls.desc.vehicle;
+  if (eyes_opt == "ellipse" && !vehicle.eye_ellipse)
+    throw Error(scene_path +
+                ": vehicle.eye_ellipse: missing; --eyes ellipse samples it (docs/scene-format.md \"vehicle\")");
   const Scene& scene = ls.scene;
   const int index = chooseElement(scene, a, scene_path, ElementType::Mirror, "no mirror", "mirrors");
   const Element& el = scene.elements[size_t(index)];
@@ -321,7 +407,9 @@ int cmdFov(const std::vector<std::string>& argv) {
   j["scene"] = scene_path;
   j["element"] = el.name;
   j["eyes"] = json::array();
-  for (const EyeFootprint& f : run.feet) j["eyes"].push_back(f.eye);
+  for (const EyeFootprint& f : run.feet)
+    if (std::find(j["eyes"].begin(), j["eyes"].end(), f.eye) == j["eyes"].end()) j["eyes"].push_back(f.eye);
+  if (eyes_opt == "ellipse") j["eye_samples"] = run.feet.size();
   j["ocular_points"] = ocularJson(frame);
   j["conventions"] = {
       {"frame",
@@ -337,7 +425,7 @@ int cmdFov(const std::vector<std::string>& argv) {
   j["horizon_m"] = options.horizon_m;
   j["zone_horizon_m"] = options.zone_horizon_m;
   j["samples"] = options.samples;
-  j["footprint"] = footprintJson(run.feet);
+  j["footprint"] = footprintJson(run.feet, frame, eyes_opt == "ellipse");
   j["zones"] = json::array();
   j["regulations"] = json::array();
   std::vector<FovPlotZone> plot_zones;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "app/sketch.h"
 #include "pvrr/base/format.h"
@@ -69,7 +70,10 @@ std::vector<std::string> writeFovPlot(const std::string& dir, const std::string&
                                       const std::vector<FovPlotZone>& zones, const FovOptions& options) {
   Sketch k;
   k.width = 940;
-  k.height = int(86 + 430 + 66 + 18 * (eyes.size() + 1) + 22 + 18 * zones.size() + 10);
+  size_t eye_lines = 0;  // one legend line per eye named (an eye ellipse's samples share their eye's)
+  for (const char* eye : {"left", "right"})
+    eye_lines += std::any_of(eyes.begin(), eyes.end(), [&](const EyeFootprint* f) { return f->eye == eye; }) ? 1 : 0;
+  k.height = int(86 + 430 + 66 + 18 * (eye_lines + 1) + 22 + 18 * zones.size() + 10);
   PlotArea a;
   a.u_max = fovDepthAxis(options.horizon_m);
   const bool left = (frame.desc().driver_side == VehicleDesc::Side::Left) == driver_side;
@@ -170,12 +174,25 @@ std::vector<std::string> writeFovPlot(const std::string& dir, const std::string&
 
   // Legend and the figures per zone.
   double ly = y1 + 66;
-  for (const EyeFootprint* f : eyes) {
-    const Rgb c = f->eye == "left" ? kLeftEye : kRightEye;
-    k.lines.push_back({{Vec2(a.left, ly - 4), Vec2(a.left + 30, ly - 4)}, c, 2, f->eye == "right"});
-    const std::string reach =
-        f->sees_horizon ? "reaches the horizon" : fmt("road reach %.0f m, no horizon", f->reach_m);
-    k.texts.push_back({a.left + 38, ly, f->eye + " eye footprint: " + reach, 12, 0, kBlack});
+  for (const char* eye : {"left", "right"}) {
+    // One line per eye; several footprints of one eye (an eye ellipse's samples) share it.
+    int count = 0;
+    bool horizon = false;
+    double reach = 0;
+    for (const EyeFootprint* f : eyes)
+      if (f->eye == eye) {
+        ++count;
+        horizon = horizon || f->sees_horizon;
+        reach = std::max(reach, f->reach_m);
+      }
+    if (count == 0) continue;
+    const bool right = std::string(eye) == "right";
+    k.lines.push_back({{Vec2(a.left, ly - 4), Vec2(a.left + 30, ly - 4)}, right ? kRightEye : kLeftEye, 2, right});
+    const std::string what = horizon ? "reaches the horizon" : fmt("road reach %.0f m, no horizon", reach);
+    const std::string whose =
+        count == 1 ? std::string(eye) + " eye footprint: "
+                   : std::string(eye) + " eye footprints (" + std::to_string(count) + " eye-ellipse samples): ";
+    k.texts.push_back({a.left + 38, ly, whose + what, 12, 0, kBlack});
     ly += 18;
   }
   k.polys.push_back({{Vec2(a.left, ly - 12), Vec2(a.left + 30, ly - 12), Vec2(a.left + 30, ly), Vec2(a.left, ly)},

@@ -49,7 +49,7 @@ const std::map<std::string, int>& keyCodes() {
       {"LEFT", GLFW_KEY_LEFT}, {"RIGHT", GLFW_KEY_RIGHT}, {"UP", GLFW_KEY_UP},   {"DOWN", GLFW_KEY_DOWN},
       {"HOME", GLFW_KEY_HOME}, {"TAB", GLFW_KEY_TAB},     {"F12", GLFW_KEY_F12}, {"ESCAPE", GLFW_KEY_ESCAPE},
       {"T", GLFW_KEY_T},       {"E", GLFW_KEY_E},         {"J", GLFW_KEY_J},     {"L", GLFW_KEY_L},
-      {"I", GLFW_KEY_I},       {"K", GLFW_KEY_K},
+      {"I", GLFW_KEY_I},       {"K", GLFW_KEY_K},         {"O", GLFW_KEY_O},
   };
   return table;
 }

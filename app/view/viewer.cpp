@@ -178,6 +178,7 @@ void Viewer::frame() {
     pending_screenshots_.clear();
   }
   window_.beginPanel();
+  fov_overlay_.draw(ls_.scene, ls_.desc, *rays_, selected_, scene_builds_, ob);  // under the panel, in panel shots
   const double shown_ms = recent_ms_.empty() ? f.frame_ms : recent_ms_.back();
   if (show_panel_) panel(f, shown_ms);
   window_.endPanel();
@@ -378,6 +379,9 @@ void Viewer::onKey(int key, int action, int mods) {
     case GLFW_KEY_E:
       overlay_ = !overlay_;
       break;
+    case GLFW_KEY_O:
+      fov_overlay_.toggle();
+      break;
     case GLFW_KEY_F12: pending_screenshots_.push_back("out/view-" + std::to_string(++saved_) + ".png"); break;
     case GLFW_KEY_V: saveViewTo("out/view-" + std::to_string(++saved_) + ".json"); break;
     case GLFW_KEY_ESCAPE: quit_ = true; break;
@@ -435,6 +439,7 @@ json Viewer::stats() const {
           {"frame_ms_median", med},
           {"frame_ms_max", t.empty() ? 0.0 : *std::max_element(t.begin(), t.end())},
           {"mode", nameOf(mode_)},
+          {"fov_overlay", fov_overlay_.stats()},
           // Medians of the frame's parts (ms): the renderer's frame (as pvrr render times it, plus the head's
           // update), presenting it, the panel (with any screenshot), and the swap with the input.
           {"parts_ms_median",

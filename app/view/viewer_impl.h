@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
+#include "app/view/fov_overlay.h"
 #include "app/view/head.h"
 #include "app/view/lens_probe.h"
 #include "app/view/reference_tiles.h"
@@ -177,6 +178,7 @@ class Viewer {
   bool heat_uploaded_ = false;
   double wipe_x_ = 0.5;  // the split line: 0 all reference, 1 all mode
   bool overlay_ = false;
+  FovOverlay fov_overlay_;  // the mirror's road footprint over the frame (O)
   std::string reference_note_;  // why there is no reference now (cancelled, discarded)
   int references_started_ = 0, frames_while_tracing_ = 0;
   double frame_ms_max_while_tracing_ = 0, reference_start_ms_ = 0;

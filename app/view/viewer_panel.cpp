@@ -191,6 +191,7 @@ void Viewer::panel(const gl::RasterFrame& f, double frame_ms) {
   referencePanel();
   lensPanel();
   elementsPanel();
+  fov_overlay_.panel();
   if (ImGui::CollapsingHeader("keys")) {
     ImGui::TextUnformatted(
         "drag (left button)  turn the head\n"
@@ -201,6 +202,7 @@ void Viewer::panel(const gl::RasterFrame& f, double frame_ms) {
         "J/L I/K             turn the selected element 1 deg in yaw / pitch (Shift: 10)\n"
         "T                   trace the reference of this view (again: cancel)\n"
         "E                   error overlay on or off\n"
+        "O                   field of view on the road (the mirror's footprint) on or off\n"
         "drag the split line wipe between the mode and the reference\n"
         "Tab                 hide or show this panel\n"
         "F12 / V             screenshot / save view (out/view-N.png, .json)\n"

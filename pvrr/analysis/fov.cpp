@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include "pvrr/base/error.h"
 #include "pvrr/optics/optics.h"
@@ -17,6 +18,10 @@ constexpr double kSamePoint_m = 1e-6;
 // At most this many non-obstructing objects (a following car, a building, the road's own ground quads) are
 // passed through on one ray before it reaches the road.
 constexpr int kMaxPassThrough = 64;
+// The footprint's outline is refined between boundary samples whose road points lie further apart than this (m),
+// or this share of their distance from the origin, halving the mirror's edge at most kOutlineDepth times.
+constexpr double kOutlineStep_m = 1.0, kOutlineRelStep = 0.05;
+constexpr int kOutlineDepth = 10;
 
 // Whether o + t d meets an obstruction (an element or a mesh of `obstructs`) first for t in (t_min, t_max).
 bool obstructed(const RayScene& rays, const std::vector<bool>& obstructs, const Vec3& o, const Vec3& d, double t_min,
@@ -93,52 +98,87 @@ EyeFootprint traceFootprint(const RayScene& rays, int element, const VehicleFram
   f.road.assign(size_t(n) * size_t(n), Vec2(0));
   f.fate.assign(f.road.size(), RayFate::Back);
   f.mirror_point.assign(f.road.size(), Vec3(0));
+  // One ray through square point s: its mirror point, road point and fate (CONVENTIONS); the obstruction tests
+  // only when `obstruction` (the outline's extra points need the road point alone).
+  struct Ray {
+    Vec3 p{0};
+    Vec2 road{0};
+    RayFate fate = RayFate::Back;
+  };
+  auto trace = [&](Vec2 s, bool obstruction) {
+    Ray out;
+    const Vec2 uv = mirrorParameters(el, s);
+    const cad::SurfacePoint sp = surface.sample(uv.x, uv.y, false);
+    Vec3 p = el.toWorldPoint(sp.p), nrm = glm::normalize(el.toWorldDir(sp.n));
+    out.p = p;
+    const double dist = glm::length(p - eye_world);
+    const Vec3 d = (p - eye_world) / dist;
+    if (glm::dot(d, nrm) >= 0) return out;  // the mirror's back faces the eye here
+    // The sight line: the exact hit where it meets the sampled point (the tracer's point and normal; a
+    // sample on the outline itself may be missed by rounding, and keeps the surface's own point and normal).
+    const RayHit h = rays.intersect(eye_world, d, 0, dist + 1e3 * kSamePoint_m);
+    if (h.kind == HitKind::Element && h.element == element && glm::length(h.point - p) < kSamePoint_m) {
+      p = h.point;
+      nrm = h.normal;
+    }
+    bool blocked = obstruction && obstructed(rays, obstructs, eye_world, d, 0, dist - kSamePoint_m);
+    const Vec3 r = reflect(d, nrm);
+    const Vec3 pv = frame.toVehicle(p), rv = frame.toVehicleDir(r);
+    const double hr = std::hypot(rv.x, rv.y);
+    const Vec2 dir_h = hr > 0 ? Vec2(rv.x, rv.y) / hr : Vec2(0);
+    double t_end;
+    if (rv.z < 0 && -pv.z / rv.z * hr <= options.horizon_m) {
+      t_end = -pv.z / rv.z;
+      out.road = Vec2(pv.x, pv.y) + t_end * Vec2(rv.x, rv.y);
+      out.fate = RayFate::Road;
+    } else {
+      t_end = hr > 0 ? options.horizon_m / hr : options.horizon_m;
+      out.road = Vec2(pv.x, pv.y) + options.horizon_m * dir_h;
+      out.fate = RayFate::Horizon;
+    }
+    if (obstruction && !blocked) blocked = obstructed(rays, obstructs, p, r, rays.epsilon(), t_end);
+    if (blocked) out.fate = RayFate::Obstructed;
+    return out;
+  };
+  auto square = [n](int i, int j) { return Vec2(-1 + 2.0 * i / (n - 1), -1 + 2.0 * j / (n - 1)); };
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) {
       const size_t k = size_t(j) * size_t(n) + size_t(i);
-      const Vec2 uv = sampleParameters(el, i, j, n);
-      const cad::SurfacePoint sp = surface.sample(uv.x, uv.y, false);
-      Vec3 p = el.toWorldPoint(sp.p), nrm = glm::normalize(el.toWorldDir(sp.n));
-      f.mirror_point[k] = p;
-      const double dist = glm::length(p - eye_world);
-      const Vec3 d = (p - eye_world) / dist;
-      if (glm::dot(d, nrm) >= 0) continue;  // the mirror's back faces the eye here
-      // The sight line: the exact hit where it meets the sampled point (the tracer's point and normal; a
-      // sample on the outline itself may be missed by rounding, and keeps the surface's own point and normal).
-      const RayHit h = rays.intersect(eye_world, d, 0, dist + 1e3 * kSamePoint_m);
-      if (h.kind == HitKind::Element && h.element == element && glm::length(h.point - p) < kSamePoint_m) {
-        p = h.point;
-        nrm = h.normal;
-      }
-      bool blocked = obstructed(rays, obstructs, eye_world, d, 0, dist - kSamePoint_m);
-      const Vec3 r = reflect(d, nrm);
-      const Vec3 pv = frame.toVehicle(p), rv = frame.toVehicleDir(r);
-      const double hr = std::hypot(rv.x, rv.y);
-      const Vec2 dir_h = hr > 0 ? Vec2(rv.x, rv.y) / hr : Vec2(0);
-      double t_end;
-      if (rv.z < 0 && -pv.z / rv.z * hr <= options.horizon_m) {
-        t_end = -pv.z / rv.z;
-        f.road[k] = Vec2(pv.x, pv.y) + t_end * Vec2(rv.x, rv.y);
-        f.fate[k] = RayFate::Road;
-      } else {
-        t_end = hr > 0 ? options.horizon_m / hr : options.horizon_m;
-        f.road[k] = Vec2(pv.x, pv.y) + options.horizon_m * dir_h;
-        f.fate[k] = RayFate::Horizon;
-      }
-      if (!blocked) blocked = obstructed(rays, obstructs, p, r, rays.epsilon(), t_end);
-      if (blocked) {
-        f.fate[k] = RayFate::Obstructed;
-        continue;
-      }
-      if (f.fate[k] == RayFate::Road) f.reach_m = std::max(f.reach_m, -f.road[k].x);
-      if (f.fate[k] == RayFate::Horizon) f.sees_horizon = true;
+      const Ray r = trace(square(i, j), true);
+      f.mirror_point[k] = r.p;
+      f.road[k] = r.road;
+      f.fate[k] = r.fate;
+      if (r.fate == RayFate::Road) f.reach_m = std::max(f.reach_m, -r.road.x);
+      if (r.fate == RayFate::Horizon) f.sees_horizon = true;
     }
-  // The boundary of the parameter square, once round.
-  auto at = [&](int i, int j) { return f.road[size_t(j) * size_t(n) + size_t(i)]; };
-  for (int i = 0; i < n - 1; ++i) f.outline.push_back(at(i, 0));
-  for (int j = 0; j < n - 1; ++j) f.outline.push_back(at(n - 1, j));
-  for (int i = n - 1; i > 0; --i) f.outline.push_back(at(i, n - 1));
-  for (int j = n - 1; j > 0; --j) f.outline.push_back(at(0, j));
+  // The boundary of the parameter square, once round; between two boundary samples whose road points lie far apart
+  // (where the mirror's edge runs out towards the horizon: a chord there would cut across the horizon's arc and the
+  // outline would cross itself), points of the edge between them, halving until they lie close.
+  std::vector<std::pair<int, int>> ring;
+  for (int i = 0; i < n - 1; ++i) ring.push_back({i, 0});
+  for (int j = 0; j < n - 1; ++j) ring.push_back({n - 1, j});
+  for (int i = n - 1; i > 0; --i) ring.push_back({i, n - 1});
+  for (int j = n - 1; j > 0; --j) ring.push_back({0, j});
+  auto far = [](Vec2 a, Vec2 b) {
+    return glm::length(a - b) > std::max(kOutlineStep_m, kOutlineRelStep * std::max(glm::length(a), glm::length(b)));
+  };
+  std::function<void(Vec2, Ray, Vec2, Ray, int)> refine = [&](Vec2 sa, Ray a, Vec2 sb, Ray b, int depth) {
+    if (depth >= kOutlineDepth || a.fate == RayFate::Back || b.fate == RayFate::Back || !far(a.road, b.road)) return;
+    const Vec2 sm = 0.5 * (sa + sb);
+    const Ray m = trace(sm, false);
+    refine(sa, a, sm, m, depth + 1);
+    if (m.fate != RayFate::Back) f.outline.push_back(m.road);
+    refine(sm, m, sb, b, depth + 1);
+  };
+  for (size_t q = 0; q < ring.size(); ++q) {
+    const auto [i0, j0] = ring[q];
+    const auto [i1, j1] = ring[(q + 1) % ring.size()];
+    const size_t k0 = size_t(j0) * size_t(n) + size_t(i0), k1 = size_t(j1) * size_t(n) + size_t(i1);
+    f.outline.push_back(f.road[k0]);
+    const Ray a{f.mirror_point[k0], f.road[k0], f.fate[k0] == RayFate::Back ? RayFate::Back : RayFate::Road};
+    const Ray b{f.mirror_point[k1], f.road[k1], f.fate[k1] == RayFate::Back ? RayFate::Back : RayFate::Road};
+    refine(square(i0, j0), a, square(i1, j1), b, 0);
+  }
   if (signedArea(f.outline) < 0) std::reverse(f.outline.begin(), f.outline.end());
   return f;
 }
@@ -274,10 +314,14 @@ ZoneResult evaluateZone(const FovZone& z, const VehicleFrame& frame, const std::
       }
     return state;
   };
-  const EyeFootprint *left = nullptr, *right = nullptr;
-  for (const EyeFootprint* e : eyes) (e->eye == "left" ? left : right) = e;
-  const std::vector<int> none(pts.size(), 0);
-  const std::vector<int> sl = left ? classify(*left) : none, sr = right ? classify(*right) : none;
+  // Several footprints of one eye (the samples of its eye ellipse): seen when any sample sees the point clear,
+  // else obstructed when any sees it through an obstructed cell.
+  std::vector<int> sl(pts.size(), 0), sr(pts.size(), 0);
+  for (const EyeFootprint* e : eyes) {
+    const std::vector<int> st = classify(*e);
+    std::vector<int>& dst = e->eye == "left" ? sl : sr;
+    for (size_t s = 0; s < pts.size(); ++s) dst[s] = (dst[s] == 1 || st[s] == 1) ? 1 : (dst[s] || st[s]) ? 2 : 0;
+  }
   int seen = 0, obs = 0;
   for (size_t s = 0; s < pts.size(); ++s) {
     int st = 0;

@@ -68,7 +68,9 @@ struct EyeFootprint {
   std::vector<Vec2> road;  // vehicle-frame (x, y) of each sample (CONVENTIONS)
   std::vector<RayFate> fate;
   std::vector<Vec3> mirror_point;  // the exact surface point, world
-  // The image of the mirror's boundary, counter-clockwise in (x, y), one point per boundary sample.
+  // The image of the mirror's boundary, counter-clockwise in (x, y): one point per boundary sample, and between two
+  // whose road points lie more than 1 m and 5 % of their distance apart, points of the edge between them (halving
+  // it, at most 10 times), so that the outline follows the edge out to the horizon instead of a chord across it.
   std::vector<Vec2> outline;
   int count(RayFate f) const;
   // The farthest road reach behind the ocular points (m) of the Road rays, and whether any ray reaches the
@@ -102,7 +104,8 @@ struct ZoneResult {
 std::vector<Vec2> zoneInVehicle(const FovZone& z, const VehicleFrame& frame, double zone_horizon_m);
 
 // Coverage of one zone by the footprints of the eyes given (left and/or right; an eye the zone needs but not
-// given counts as seeing nothing).
+// given counts as seeing nothing). Several footprints of one eye (an eye ellipse's samples, fov_eyes.h) act as
+// one: a point is seen by that eye when any of them sees it.
 ZoneResult evaluateZone(const FovZone& z, const VehicleFrame& frame, const std::vector<const EyeFootprint*>& eyes,
                         const FovOptions& options = {});
 

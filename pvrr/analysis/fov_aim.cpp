@@ -116,125 +116,121 @@ struct Searcher {
   }
 };
 
+}  // namespace
+
 // The smooth objective (METHOD 3): the zones' edge points located on the mirror's parameter square.
-class Margins {
- public:
-  Margins(const Scene& scene, int element, const VehicleFrame& frame, const std::vector<FovZone>& zones,
-          const AimOptions& options, const Mat4& base, const Vec3& pivot, const Vec3& yaw_axis, const Vec3& pitch_axis)
-      : el_(scene.elements[size_t(element)]),
-        frame_(frame),
-        options_(options),
-        base_(base),
-        pivot_(pivot),
-        yaw_axis_(yaw_axis),
-        pitch_axis_(pitch_axis) {
-    const double h = 0.5 * (frame.eye(true).z + frame.eye(false).z);
-    for (const FovZone& z : zones) {
-      const std::vector<Vec2> poly = zoneInVehicle(z, frame, options.fov.zone_horizon_m);
-      Vec2 lo(kInf), hi(-kInf);
-      for (const Vec2& p : poly) {
-        lo = glm::min(lo, p);
-        hi = glm::max(hi, p);
-      }
-      const double a0 = std::atan2(h, std::max(-hi.x, 1e-3)), a1 = std::atan2(h, -lo.x);
-      for (int k = 0; k < kEdgePoints; ++k) {
-        const double x = -h / std::tan(a0 + (a1 - a0) * k / (kEdgePoints - 1));
-        for (const double y : {lo.y, hi.y}) points_.push_back({frame.toWorld(Vec3(x, y, 0)), z.eyes, Vec2(0)});
-      }
+AimMargins::AimMargins(const Scene& scene, int element, const VehicleFrame& frame, const std::vector<FovZone>& zones,
+                       const AimOptions& options, const Mat4& base, const Vec3& pivot, const Vec3& yaw_axis,
+                       const Vec3& pitch_axis)
+    : el_(scene.elements[size_t(element)]),
+      frame_(frame),
+      left_eye_(options.left_eye),
+      right_eye_(options.right_eye),
+      base_(base),
+      pivot_(pivot),
+      yaw_axis_(yaw_axis),
+      pitch_axis_(pitch_axis) {
+  const double h = 0.5 * (frame.eye(true).z + frame.eye(false).z);
+  for (const FovZone& z : zones) {
+    const std::vector<Vec2> poly = zoneInVehicle(z, frame, options.fov.zone_horizon_m);
+    Vec2 lo(kInf), hi(-kInf);
+    for (const Vec2& p : poly) {
+      lo = glm::min(lo, p);
+      hi = glm::max(hi, p);
+    }
+    const double a0 = std::atan2(h, std::max(-hi.x, 1e-3)), a1 = std::atan2(h, -lo.x);
+    for (int k = 0; k < kEdgePoints; ++k) {
+      const double x = -h / std::tan(a0 + (a1 - a0) * k / (kEdgePoints - 1));
+      for (const double y : {lo.y, hi.y}) points_.push_back({frame.toWorld(Vec3(x, y, 0)), z.eyes, {}});
     }
   }
-  size_t size() const { return points_.size(); }
+}
 
-  // The margins at angles (degrees), each edge point's from the eye(s) its zone names.
-  std::vector<double> margins(const double* angles_deg) const {
-    const Mat4 pose = aimedPose(base_, pivot_, yaw_axis_, pitch_axis_, {angles_deg[0] * kDeg, angles_deg[1] * kDeg});
-    const VehicleDesc& v = frame_.desc();
-    std::vector<double> out;
-    for (Point& p : points_) {
-      const double ml = options_.left_eye ? margin(pose, v.eye_left, p) : -1;
-      const double mr = options_.right_eye ? margin(pose, v.eye_right, p) : -1;
-      switch (p.eyes) {
-        case FovZone::Eyes::Either:
-          out.push_back(std::max(ml, mr));
-          break;
-        case FovZone::Eyes::Both:
-          out.push_back(std::min(ml, mr));
-          break;
-        case FovZone::Eyes::Left:
-          out.push_back(ml);
-          break;
-        case FovZone::Eyes::Right:
-          out.push_back(mr);
-          break;
-      }
+void AimMargins::seedAt(const double* angles_deg) {
+  const Mat4 pose = aimedPose(base_, pivot_, yaw_axis_, pitch_axis_, {angles_deg[0] * kDeg, angles_deg[1] * kDeg});
+  const VehicleDesc& v = frame_.desc();
+  for (Point& p : points_) {
+    p.seed[0] = solve(pose, v.eye_left, p.q, p.seed[0]).s;
+    p.seed[1] = solve(pose, v.eye_right, p.q, p.seed[1]).s;
+  }
+}
+
+std::vector<double> AimMargins::margins(const double* angles_deg) const {
+  const Mat4 pose = aimedPose(base_, pivot_, yaw_axis_, pitch_axis_, {angles_deg[0] * kDeg, angles_deg[1] * kDeg});
+  const VehicleDesc& v = frame_.desc();
+  std::vector<double> out;
+  for (const Point& p : points_) {
+    const double ml = left_eye_ ? solve(pose, v.eye_left, p.q, p.seed[0]).margin : -1;
+    const double mr = right_eye_ ? solve(pose, v.eye_right, p.q, p.seed[1]).margin : -1;
+    switch (p.eyes) {
+      case FovZone::Eyes::Either:
+        out.push_back(std::max(ml, mr));
+        break;
+      case FovZone::Eyes::Both:
+        out.push_back(std::min(ml, mr));
+        break;
+      case FovZone::Eyes::Left:
+        out.push_back(ml);
+        break;
+      case FovZone::Eyes::Right:
+        out.push_back(mr);
+        break;
     }
-    return out;
   }
+  return out;
+}
 
- private:
-  struct Point {
-    Vec3 q;  // world, on the road
-    FovZone::Eyes eyes;
-    mutable Vec2 seed;
-  };
+// The residual angle vector between the reflected ray at square point s and the way to q.
+Vec2 AimMargins::residual(const Mat4& pose, const Vec3& eye, const Vec3& q, Vec2 s) const {
+  const Vec2 uv = mirrorParameters(el_, s);
+  const cad::SurfacePoint sp = el_.frontSurface().sample(uv.x, uv.y, false);
+  const Vec3 p = Vec3(pose * Vec4(sp.p, 1.0)), n = glm::normalize(Vec3(pose * Vec4(sp.n, 0.0)));
+  const Vec3 r = reflect(glm::normalize(p - eye), n), w = glm::normalize(q - p);
+  const Vec3 e1 = glm::normalize(glm::cross(r, std::abs(r.y) < 0.9 ? Vec3(0, 1, 0) : Vec3(1, 0, 0)));
+  const Vec3 e2 = glm::cross(r, e1);
+  return Vec2(glm::dot(w, e1), glm::dot(w, e2));
+}
 
-  // The residual angle vector between the reflected ray at square point s and the way to q.
-  Vec2 residual(const Mat4& pose, const Vec3& eye, const Vec3& q, Vec2 s) const {
-    const Vec2 uv = mirrorParameters(el_, s);
-    const cad::SurfacePoint sp = el_.frontSurface().sample(uv.x, uv.y, false);
-    const Vec3 p = Vec3(pose * Vec4(sp.p, 1.0)), n = glm::normalize(Vec3(pose * Vec4(sp.n, 0.0)));
-    const Vec3 r = reflect(glm::normalize(p - eye), n), w = glm::normalize(q - p);
-    const Vec3 e1 = glm::normalize(glm::cross(r, std::abs(r.y) < 0.9 ? Vec3(0, 1, 0) : Vec3(1, 0, 0)));
-    const Vec3 e2 = glm::cross(r, e1);
-    return Vec2(glm::dot(w, e1), glm::dot(w, e2));
-  }
-
-  // Newton on the square, clamped to it: inside, 1 - max(|s_x|, |s_y|); held at the edge, minus the remaining
-  // angle over the angle one square unit spans there (continuous through 0 at the edge).
-  double margin(const Mat4& pose, const Vec3& eye, Point& pt) const {
-    Vec2 s = pt.seed;
-    if (glm::length(residual(pose, eye, pt.q, s)) > 0.2) {  // a poor start: the best of a coarse grid
-      double best = kInf;
-      for (int j = 0; j < 5; ++j)
-        for (int i = 0; i < 5; ++i) {
-          const Vec2 c(-1 + 0.5 * i, -1 + 0.5 * j);
-          const double e = glm::length(residual(pose, eye, pt.q, c));
-          if (e < best) {
-            best = e;
-            s = c;
-          }
+// Newton on the square from `seed`, clamped to it: inside, 1 - max(|s_x|, |s_y|); held at the edge, minus the
+// remaining angle over the angle one square unit spans there (continuous through 0 at the edge). A function of its
+// arguments only (no state is kept between calls: Ceres' central differences see one function).
+AimMargins::Solve AimMargins::solve(const Mat4& pose, const Vec3& eye, const Vec3& q, Vec2 seed) const {
+  Vec2 s = seed;
+  if (glm::length(residual(pose, eye, q, s)) > 0.2) {  // a poor start: the best of a coarse grid
+    double best = kInf;
+    for (int j = 0; j < 5; ++j)
+      for (int i = 0; i < 5; ++i) {
+        const Vec2 c(-1 + 0.5 * i, -1 + 0.5 * j);
+        const double e = glm::length(residual(pose, eye, q, c));
+        if (e < best) {
+          best = e;
+          s = c;
         }
-    }
-    double scale = 1;
-    Vec2 f = residual(pose, eye, pt.q, s);
-    for (int it = 0; it < kInverseIterations && glm::length(f) > kInverseTol_rad; ++it) {
-      const Vec2 fu = (residual(pose, eye, pt.q, s + Vec2(kSquareStep, 0)) - f) / kSquareStep;
-      const Vec2 fv = (residual(pose, eye, pt.q, s + Vec2(0, kSquareStep)) - f) / kSquareStep;
-      const double det = fu.x * fv.y - fv.x * fu.y;
-      scale = std::sqrt(std::abs(det));
-      if (!(std::abs(det) > 1e-300)) break;
-      const Vec2 step(-(fv.y * f.x - fv.x * f.y) / det, -(-fu.y * f.x + fu.x * f.y) / det);
-      const Vec2 next = glm::clamp(s + step, Vec2(-1), Vec2(1));
-      if (next == s) break;  // held at the edge
-      s = next;
-      f = residual(pose, eye, pt.q, s);
-    }
-    pt.seed = s;
-    const double inside = 1 - std::max(std::abs(s.x), std::abs(s.y));
-    const double miss = glm::length(f);
-    return miss <= 1e-9 || scale <= 0 ? inside : inside - miss / scale;
+      }
   }
+  double scale = 1;
+  Vec2 f = residual(pose, eye, q, s);
+  for (int it = 0; it < kInverseIterations && glm::length(f) > kInverseTol_rad; ++it) {
+    const Vec2 fu = (residual(pose, eye, q, s + Vec2(kSquareStep, 0)) - f) / kSquareStep;
+    const Vec2 fv = (residual(pose, eye, q, s + Vec2(0, kSquareStep)) - f) / kSquareStep;
+    const double det = fu.x * fv.y - fv.x * fu.y;
+    scale = std::sqrt(std::abs(det));
+    if (!(std::abs(det) > 1e-300)) break;
+    const Vec2 step(-(fv.y * f.x - fv.x * f.y) / det, -(-fu.y * f.x + fu.x * f.y) / det);
+    const Vec2 next = glm::clamp(s + step, Vec2(-1), Vec2(1));
+    if (next == s) break;  // held at the edge
+    s = next;
+    f = residual(pose, eye, q, s);
+  }
+  const double inside = 1 - std::max(std::abs(s.x), std::abs(s.y));
+  const double miss = glm::length(f);
+  return {s, miss <= 1e-9 || scale <= 0 ? inside : inside - miss / scale};
+}
 
-  const Element& el_;
-  const VehicleFrame& frame_;
-  const AimOptions& options_;
-  Mat4 base_;
-  Vec3 pivot_, yaw_axis_, pitch_axis_;
-  mutable std::vector<Point> points_;
-};
+namespace {
 
 struct SoftMinResidual {
-  const Margins* m;
+  const AimMargins* m;
   bool operator()(const double* angles_deg, double* residuals) const {
     const std::vector<double> g = m->margins(angles_deg);
     for (size_t i = 0; i < g.size(); ++i) residuals[i] = std::exp(-g[i] / kSoftMinScale);
@@ -278,8 +274,9 @@ AimResult aimMirror(const Scene& scene, int element, const VehicleFrame& frame, 
   res.margin_deg = best.s.pass ? best.depth * options.fine_step_deg : 0;
 
   if (options.polish) {
-    const Margins m(scene, element, frame, zones, options, el.local_to_world, res.pivot, res.yaw_axis, res.pitch_axis);
+    AimMargins m(scene, element, frame, zones, options, el.local_to_world, res.pivot, res.yaw_axis, res.pitch_axis);
     double x[2] = {best.a.yaw_rad / kDeg, best.a.pitch_rad / kDeg};
+    m.seedAt(x);  // the seeds are fixed before Ceres starts: its objective is then a pure function of the angles
     ceres::NumericDiffOptions nd;
     nd.relative_step_size = 1e-4;  // degrees: x is O(1), the inverse's residual 1e-12 rad
     auto* cost = new ceres::NumericDiffCostFunction<SoftMinResidual, ceres::CENTRAL, ceres::DYNAMIC, 2>(

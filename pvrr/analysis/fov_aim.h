@@ -60,6 +60,40 @@ struct AimResult {
 Mat4 aimedPose(const Mat4& local_to_world, const Vec3& pivot, const Vec3& yaw_axis, const Vec3& pitch_axis,
                AimAngles a);
 
+// The polish's smooth objective (METHOD 3), exposed for its tests: each zone edge point's margin on the mirror's
+// parameter square at angles (yaw, pitch) in degrees. Newton starts from seeds fixed by seedAt (once, before the
+// solver runs), so margins() is a pure function of the angles: the same angles give the same bits whatever was
+// evaluated before (Ceres' central differences compare two evaluations of one function).
+class AimMargins {
+ public:
+  AimMargins(const Scene& scene, int element, const VehicleFrame& frame, const std::vector<FovZone>& zones,
+             const AimOptions& options, const Mat4& base, const Vec3& pivot, const Vec3& yaw_axis,
+             const Vec3& pitch_axis);
+  void seedAt(const double* angles_deg);
+  std::vector<double> margins(const double* angles_deg) const;
+  size_t size() const { return points_.size(); }
+
+ private:
+  struct Point {
+    Vec3 q;  // world, on the road
+    FovZone::Eyes eyes;
+    Vec2 seed[2];  // left, right eye
+  };
+  struct Solve {
+    Vec2 s;
+    double margin;
+  };
+  Vec2 residual(const Mat4& pose, const Vec3& eye, const Vec3& q, Vec2 s) const;
+  Solve solve(const Mat4& pose, const Vec3& eye, const Vec3& q, Vec2 seed) const;
+
+  const Element& el_;
+  const VehicleFrame& frame_;
+  bool left_eye_, right_eye_;
+  Mat4 base_;
+  Vec3 pivot_, yaw_axis_, pitch_axis_;
+  std::vector<Point> points_;
+};
+
 // Searches the adjustment of mirror `element` of `scene` for `zones` (none: an error of the caller's).
 AimResult aimMirror(const Scene& scene, int element, const VehicleFrame& frame, const std::vector<FovZone>& zones,
                     const AimOptions& options = {});

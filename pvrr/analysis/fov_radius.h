@@ -1,6 +1,8 @@
-// The mean radius of curvature of a mirror's reflecting surface as UN R46 defines it (its paragraph 2 definitions
-// and Annex 7, recalled, not confirmed in the primary text: docs/fov.md "The shipped regulations"), measured on
-// the exact surface (pvrr fov, issue 21):
+// The mean radius of curvature of a mirror's reflecting surface as UN R46 defines it (its definitions and Annex 7),
+// measured on the exact surface (pvrr fov, issue 21). The arc, the three points, r_p and r below are as the EU's
+// text of the same requirements has them (Directive 2003/97/EC, Annex I 1.1.1.4-1.1.1.6 and Annex II Appendix 1:
+// docs/fov.md "Verification"); R46's own Annex 7 was not read, and the spherometer's span (its Figure 3) is
+// recalled, not confirmed:
 //  - three measuring points, at 1/3, 1/2 and 2/3 of the arc of the reflecting surface through its centre
 //    (the longer of the two central arcs of the mirror's parameter square: the one parallel to segment b, or the
 //    perpendicular one where that is longer);

@@ -225,6 +225,9 @@ struct ElementDesc {
   // Mirror.
   SurfaceDesc surface;
   MirrorMaterialDesc mirror_material;
+  // The point the mirror turns about when it is adjusted (pvrr fov --aim), in the frame of `pose` (world unless
+  // attached to the observer); absent: pose.position (the vertex).
+  std::optional<Vec3> pivot;
 
   // Lens (cad/lens.h): front = eye side at z = 0, back = far side; each a sag surface (isSag()) or a CAD
   // face (Type::Cad, a NURBS graph over the lens's xy plane, cad::makeNurbsSag). Either the two surfaces
@@ -273,6 +276,15 @@ struct VehicleDesc {
     double eye_height_m = 0.635, eye_separation_m = 0.065;
   };
   std::optional<SeatReference> seat_reference;  // absent: the ocular points were given
+  // An eye ellipse (eyellipse, after SAE J941's description: one ellipsoid per eye, centred on that eye's ocular
+  // point, its axes along the vehicle's forward, left and up directions, the forward axis tilted in side view):
+  // `pvrr fov --eyes ellipse` samples it (pvrr/analysis/fov_eyes.h). Axis lengths are full lengths (J941 quotes
+  // them so); no default sizes are assumed.
+  struct EyeEllipse {
+    Vec3 axes_m{0};       // full lengths along forward, left, up
+    double tilt_deg = 0;  // the forward axis turned about the left axis, its forward end down (> 0)
+  };
+  std::optional<EyeEllipse> eye_ellipse;
   Side driver_side = Side::Left;
   // Names of environment objects that obstruct the driver's view (the vehicle's own door, housing): a ray
   // stopped first by one of them is obstructed. Rays stopped by the other environment objects (a following

@@ -511,7 +511,7 @@ ElementDesc readElement(const Ctx& c, const json* j, const std::string& path, si
   std::vector<std::string> keys = {"name",     "type",         "pose",    "attached_to_observer",
                                    "outline",  "tessellation", "patches", "max_patch_fov_deg",
                                    "material", "animation",    "dynamic"};
-  if (type == ElementDesc::Type::Mirror) keys.push_back("surface");
+  if (type == ElementDesc::Type::Mirror) keys.insert(keys.end(), {"surface", "pivot"});
   else keys.insert(keys.end(), {"front", "back", "centre_thickness", "min_edge_thickness", "prescription", "eye"});
   Obj o(c, j, path, what, keys);
   ElementDesc e;
@@ -537,6 +537,7 @@ ElementDesc readElement(const Ctx& c, const json* j, const std::string& path, si
     e.surface = readSurface(c, o.get("surface"), o.at("surface"), anySurface);
     analytic = e.surface.isSag();
     e.mirror_material = readMirrorMaterial(c, o.get("material"), o.at("material"));
+    if (o.has("pivot")) e.pivot = o.point("pivot");
   } else {
     if (o.has("prescription") && (o.has("front") || o.has("back")))
       o.expected("prescription", "either \"prescription\" or \"front\" and \"back\", not both");
@@ -633,9 +634,9 @@ RenderDesc readRender(const Ctx& c, const json* j, const std::string& source) {
 VehicleDesc readVehicle(const Ctx& c, const json* j, const std::vector<EnvObjectDesc>& environment) {
   Obj o(c, j, "vehicle",
         "an object {\"forward\", \"up\", \"road_height\", \"outermost\", \"ocular_points\" or \"seat_reference\", "
-        "\"driver_side\", \"obstructions\", \"regulations\"}",
-        {"forward", "up", "road_height", "outermost", "ocular_points", "seat_reference", "driver_side", "obstructions",
-         "regulations"});
+        "\"eye_ellipse\", \"driver_side\", \"obstructions\", \"regulations\"}",
+        {"forward", "up", "road_height", "outermost", "ocular_points", "seat_reference", "eye_ellipse", "driver_side",
+         "obstructions", "regulations"});
   VehicleDesc v;
   v.up = o.vec3("up", VecKind::Direction);
   v.forward = o.vec3("forward", VecKind::Direction);
@@ -673,6 +674,16 @@ VehicleDesc readVehicle(const Ctx& c, const json* j, const std::vector<EnvObject
     v.eye_left = mid + 0.5 * seat.eye_separation_m * left;
     v.eye_right = mid - 0.5 * seat.eye_separation_m * left;
     v.seat_reference = seat;
+  }
+  if (o.has("eye_ellipse")) {
+    Obj e(c, o.get("eye_ellipse"), o.at("eye_ellipse"), "an object {\"axes\": [forward, left, up], \"tilt_deg\"}",
+          {"axes", "tilt_deg"});
+    VehicleDesc::EyeEllipse ell;
+    ell.axes_m = e.point("axes");  // three finite lengths, in the file's unit
+    if (!(ell.axes_m.x >= 0 && ell.axes_m.y >= 0 && ell.axes_m.z >= 0))
+      e.expected("axes", "three lengths >= 0 (the ellipsoid's full axes along forward, left and up)");
+    ell.tilt_deg = e.number("tilt_deg", closed(-45, 45), 0.0, "an angle (degrees)");
+    v.eye_ellipse = ell;
   }
   v.driver_side = o.choice<VehicleDesc::Side>("driver_side");
   if (const json* obs =

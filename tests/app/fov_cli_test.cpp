@@ -2,6 +2,7 @@
 // mirror against R46 Class III, and one-line errors that leave no output.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -17,7 +18,6 @@ using pvrr::test::CliResult;
 using pvrr::test::expectOneLineError;
 using pvrr::test::runPvrr;
 using pvrr::test::slurp;
-
 
 TEST(FovCli, CarMirrorAgainstR46ClassIII) {
   const fs::path dir = pvrr::test::freshTestDir("fov-ok");
@@ -114,6 +114,70 @@ TEST(FovCli, OneEyeAndAnExplicitRegulation) {
   fs::remove_all(dir);
 }
 
+// --eyes ellipse: an ellipse of size 0 gives the ocular points' zones exactly; a J941-like one covers at least as
+// much, and fov.json reports its samples and each eye's union.
+TEST(FovCli, EyeEllipse) {
+  const fs::path dir = pvrr::test::freshTestDir("fov-ellipse");
+  const std::string common =
+      "fov models/car-mirror.json --samples 41 --set 'elements[0].pose.normal=[0.47697, 0.1238, "
+      "0.87021]' ";
+  const CliResult p = runPvrr(common + "--out '" + (dir / "points").string() + "'");
+  const CliResult z = runPvrr(common + "--eyes ellipse --set 'vehicle.eye_ellipse={\"axes\": [0, 0, 0]}' --out '" +
+                              (dir / "zero").string() + "'");
+  const CliResult e =
+      runPvrr(common +
+              "--eyes ellipse --set 'vehicle.eye_ellipse={\"axes\": [0.2, 0.06, 0.09], \"tilt_deg\": 12}' "
+              "--out '" +
+              (dir / "ellipse").string() + "'");
+  ASSERT_EQ(p.code, 0) << p.err;
+  ASSERT_EQ(z.code, 0) << z.err;
+  ASSERT_EQ(e.code, 0) << e.err;
+  const nlohmann::json jp = nlohmann::json::parse(slurp(dir / "points" / "fov.json"));
+  const nlohmann::json jz = nlohmann::json::parse(slurp(dir / "zero" / "fov.json"));
+  const nlohmann::json je = nlohmann::json::parse(slurp(dir / "ellipse" / "fov.json"));
+  EXPECT_EQ(jz["eye_samples"], 2);
+  EXPECT_EQ(je["eye_samples"], 30);
+  EXPECT_EQ(je["eyes"], (nlohmann::json{"left", "right"}));
+  EXPECT_EQ(je["footprint"]["samples"].size(), 30u);
+  EXPECT_EQ(je["footprint"]["left"]["samples"], 15);
+  ASSERT_EQ(jp["zones"].size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(jz["zones"][i]["covered_fraction"], jp["zones"][i]["covered_fraction"]);
+    EXPECT_EQ(jz["zones"][i]["obstructed_fraction"], jp["zones"][i]["obstructed_fraction"]);
+    EXPECT_GE(je["zones"][i]["covered_fraction"].get<double>(), jp["zones"][i]["covered_fraction"].get<double>());
+  }
+  // The mis-aimed mirror misses part of the near strip from the ocular points; moving the head recovers some.
+  EXPECT_LT(jp["zones"][1]["covered_fraction"].get<double>(), 1);
+  EXPECT_GT(je["zones"][1]["covered_fraction"].get<double>(), jp["zones"][1]["covered_fraction"].get<double>());
+  fs::remove_all(dir);
+}
+
+// --aim about a pivot behind the glass (the element's `pivot`): the pivot is reported and stays; the aimed mirror
+// passes.
+TEST(FovCli, AimAboutAPivot) {
+  const fs::path dir = pvrr::test::freshTestDir("fov-pivot");
+  const CliResult r = runPvrr(
+      "fov models/car-mirror.json --set 'elements[0].pose.normal=[0.47697, 0.1238, 0.87021]' "
+      "--set 'elements[0].pivot=[-0.52, 1.05, -0.40]' --aim --aim-range 8 --samples 41 --out '" +
+      (dir / "out").string() + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json aim = nlohmann::json::parse(slurp(dir / "out" / "fov.json"))["aim"];
+  EXPECT_EQ(aim["pivot_from"], "the element's pivot");
+  EXPECT_NEAR(aim["pivot"][0].get<double>(), -0.52, 1e-12);
+  EXPECT_NEAR(aim["pivot"][2].get<double>(), -0.40, 1e-12);
+  EXPECT_TRUE(aim["pass"].get<bool>()) << aim.dump(2);
+  EXPECT_NE(r.out.find("door-mirror's pivot: every zone passes"), std::string::npos) << r.out;
+  // The aimed scene keeps the pivot and moves the vertex about it: |vertex - pivot| is unchanged.
+  const nlohmann::json aimed = nlohmann::json::parse(slurp(dir / "out" / "aimed.json"));
+  std::vector<double> v;
+  for (const auto& c : aimed["elements"][0]["pose"]["position"]) v.push_back(c.get<double>());
+  EXPECT_EQ(aimed["elements"][0]["pivot"], (nlohmann::json{-0.52, 1.05, -0.40}));  // kept in the aimed scene
+  ASSERT_EQ(v.size(), 3u) << aimed.dump(2);
+  const double before = std::hypot(-0.5 + 0.52, 1.05 - 1.05, -0.35 + 0.40);
+  EXPECT_NEAR(std::hypot(v[0] + 0.52, v[1] - 1.05, v[2] + 0.40), before, 1e-9);
+  EXPECT_GT(std::hypot(v[0] + 0.5, v[1] - 1.05, v[2] + 0.35), 1e-3);  // the vertex moved
+  fs::remove_all(dir);
+}
 
 TEST(FovCli, ErrorsAreOneLineAndLeaveNothing) {
   const fs::path dir = pvrr::test::freshTestDir("fov-err");
@@ -132,6 +196,12 @@ TEST(FovCli, ErrorsAreOneLineAndLeaveNothing) {
                      "no element named \"mirror\"");
   expectOneLineError(runPvrr("fov models/car-mirror.json --aim --aim-range 90 --out '" + out + "'"),
                      "pvrr fov: --aim-range: expected degrees in [1, 45]");
+  expectOneLineError(runPvrr("fov models/car-mirror.json --eyes ellipse --out '" + out + "'"),
+                     "models/car-mirror.json: vehicle.eye_ellipse: missing");
+  expectOneLineError(
+      runPvrr("fov models/car-mirror.json --set 'vehicle.eye_ellipse={\"axes\": [0.2, -0.06, 0.09]}' --out '" + out +
+              "'"),
+      "vehicle.eye_ellipse.axes: expected three lengths >= 0");
   EXPECT_FALSE(fs::exists(out));
   fs::remove_all(dir);
 }

@@ -8,61 +8,15 @@
 #include <cstdio>
 #include <string>
 
-#include "pvrr/scene/scene_build.h"
-#include "pvrr/scene/scene_json.h"
+#include "tests/pvrr/analysis/fov_test_scenes.h"
 
 namespace pvrr {
 namespace {
 
-constexpr double kDeg = kPi / 180;
-
-// The door-mirror geometry of fov_test.cpp (x right, y up, the car faces -z; driver's side left), a plane mirror
-// of the given size whose normal is the bisector towards the eyes' midpoint and `out`, turned by (yaw, pitch).
-Scene planeMirror(double width, double height, double yaw_deg, double pitch_deg) {
-  const Vec3 mirror(-0.5, 1.05, -0.35);
-  const Vec3 n0 = glm::normalize(glm::normalize(Vec3(0, 1.2, 0) - mirror) + glm::normalize(Vec3(-0.12, -0.1, 1)));
-  // Turn the normal: yaw about up (+y), pitch about the horizontal axis in the mirror plane.
-  auto rot = [](const Vec3& v, const Vec3& k, double a) {
-    return v * std::cos(a) + glm::cross(k, v) * std::sin(a) + k * glm::dot(k, v) * (1 - std::cos(a));
-  };
-  const Vec3 h = glm::normalize(glm::cross(Vec3(0, 1, 0), n0));
-  const Vec3 n = rot(rot(n0, h, pitch_deg * kDeg), Vec3(0, 1, 0), yaw_deg * kDeg);
-  char buf[2048];
-  std::snprintf(buf, sizeof buf, R"({"version": 1,
-    "observer": {"eye": [0, 1.2, 0], "target": [-0.5, 1.05, -0.35]},
-    "elements": [{"name": "m", "type": "mirror",
-      "pose": {"position": [-0.5, 1.05, -0.35], "normal": [%.17g, %.17g, %.17g], "up": [0, 1, 0]},
-      "surface": {"type": "plane"}, "outline": {"shape": "rectangle", "width": %.17g, "height": %.17g}}],
-    "vehicle": {"forward": [0, 0, -1], "up": [0, 1, 0], "road_height": 0,
-      "outermost": {"left": [-0.45, 1, 0], "right": [1.35, 1, 0]},
-      "ocular_points": {"left": [-0.0325, 1.2, 0], "right": [0.0325, 1.2, 0]},
-      "driver_side": "left"}})",
-                n.x, n.y, n.z, width, height);
-  return buildScene(parseScene(buf, "test.json", "."));
-}
-
-VehicleFrame frameOf(const Scene&) {
-  VehicleDesc v;
-  v.forward = Vec3(0, 0, -1);
-  v.up = Vec3(0, 1, 0);
-  v.outermost_left = Vec3(-0.45, 1, 0);
-  v.outermost_right = Vec3(1.35, 1, 0);
-  v.eye_left = Vec3(-0.0325, 1.2, 0);
-  v.eye_right = Vec3(0.0325, 1.2, 0);
-  return VehicleFrame(v);
-}
-
-// R46 Class III's two driver-side strips as models/regulations/r46-class-iii.json has them (4 m wide from 20 m
-// behind, 1 m wide from 4 m behind, both to the horizon, 10 % obstruction allowed, either eye).
-std::vector<FovZone> classIII() {
-  std::vector<FovZone> z(2);
-  z[0].name = "4 m from 20 m";
-  z[0].polygon = {Vec2(-20, 0), Vec2(-20, 4), Vec2(-kInf, 4), Vec2(-kInf, 0)};
-  z[1].name = "1 m from 4 m";
-  z[1].polygon = {Vec2(-4, 0), Vec2(-4, 1), Vec2(-kInf, 1), Vec2(-kInf, 0)};
-  for (FovZone& f : z) f.allowed_obstructed_fraction = 0.1;
-  return z;
-}
+using test::classIII;
+using test::frameOf;
+using test::kDeg;
+using test::planeMirror;
 
 AimOptions fastOptions() {
   AimOptions o;
@@ -144,6 +98,68 @@ TEST(FovAim, PoseTurnsAboutThePivot) {
   EXPECT_NEAR(z.x, std::sin(0.3) * std::cos(0.2), kTol);
   EXPECT_NEAR(z.y, std::sin(0.2), kTol);
   EXPECT_NEAR(z.z, std::cos(0.3) * std::cos(0.2), kTol);
+}
+
+TEST(FovAim, PolishObjectiveIsAPureFunctionOfTheAngles) {
+  // Ceres' central differences compare f(x + h) and f(x - h): the objective must not depend on what was evaluated
+  // before. Evaluated at a, then far away at b (where Newton's answers differ), then at a again: the same bits; and
+  // the same bits as a fresh objective seeded the same way.
+  const Scene scene = planeMirror(0.3, 0.24, 4, -3);
+  const VehicleFrame frame = frameOf(scene);
+  const AimOptions o = fastOptions();
+  const Element& el = scene.elements[0];
+  const Vec3 pivot = el.toWorldPoint(Vec3(0)), yaw = Vec3(0, 1, 0);
+  const Vec3 pitch = glm::normalize(glm::cross(yaw, glm::normalize(el.toWorldDir(Vec3(0, 0, 1)))));
+  const double a[2] = {-4.5, 3.0}, b[2] = {3.0, -5.0};
+  AimMargins m(scene, 0, frame, classIII(), o, el.local_to_world, pivot, yaw, pitch);
+  m.seedAt(a);
+  const std::vector<double> first = m.margins(a);
+  const std::vector<double> far = m.margins(b);
+  const std::vector<double> again = m.margins(a);
+  ASSERT_EQ(first.size(), again.size());
+  ASSERT_EQ(first.size(), m.size());
+  for (size_t i = 0; i < first.size(); ++i) EXPECT_EQ(first[i], again[i]) << i;
+  bool moved = false;
+  for (size_t i = 0; i < first.size(); ++i) moved = moved || std::abs(first[i] - far[i]) > 1e-3;
+  EXPECT_TRUE(moved);  // b is a different adjustment: the check above is not trivially about a constant
+  AimMargins fresh(scene, 0, frame, classIII(), o, el.local_to_world, pivot, yaw, pitch);
+  fresh.seedAt(a);
+  const std::vector<double> f2 = fresh.margins(a);
+  for (size_t i = 0; i < first.size(); ++i) EXPECT_EQ(first[i], f2[i]) << i;
+}
+
+TEST(FovAim, TurnsAboutAPivotBehindTheVertex) {
+  // The mis-aimed mirror of MisAimedPlaneMirrorIsReAimed, its pivot (the `pivot` key of the element) 60 mm behind
+  // the glass and 30 mm towards the car: aimed about that point, the pivot stays where it is, the vertex moves on
+  // the sphere about it, and the answer passes at the default sampling.
+  const Vec3 vertex(-0.5, 1.05, -0.35);
+  const Scene probe = planeMirror(0.3, 0.24, 4, -3);
+  const Vec3 n = glm::normalize(probe.elements[0].toWorldDir(Vec3(0, 0, 1)));
+  const Vec3 pivot = vertex - 0.06 * n + Vec3(0.03, 0, 0);
+  char extra[256];
+  std::snprintf(extra, sizeof extra, R"(, "pivot": [%.17g, %.17g, %.17g])", pivot.x, pivot.y, pivot.z);
+  const std::string text = extra;
+  const SceneDesc desc = test::planeMirrorDesc(0.3, 0.24, 4, -3, text.c_str());
+  ASSERT_TRUE(desc.elements[0].pivot.has_value());
+  EXPECT_NEAR(glm::length(*desc.elements[0].pivot - pivot), 0, 1e-15);
+  const Scene scene = buildScene(desc);
+  const VehicleFrame frame = frameOf(scene);
+  AimOptions o = fastOptions();
+  o.pivot = desc.elements[0].pivot;
+  const AimResult r = aimMirror(scene, 0, frame, classIII(), o);
+  std::printf("pivot: yaw %.2f deg, pitch %.2f deg, margin %.1f deg; %s\n", r.angles.yaw_rad / kDeg,
+              r.angles.pitch_rad / kDeg, r.margin_deg, r.polish_report.c_str());
+  EXPECT_NEAR(glm::length(r.pivot - pivot), 0, 1e-15);
+  ASSERT_TRUE(r.after.pass);
+  // The pivot is a world point that stays: the aimed pose maps the old vertex about it.
+  const Vec3 v_after = Vec3(r.local_to_world * Vec4(0, 0, 0, 1));
+  EXPECT_NEAR(glm::length(v_after - pivot), glm::length(vertex - pivot), 1e-12);
+  const Mat4 rot_only = aimedPose(scene.elements[0].local_to_world, pivot, r.yaw_axis, r.pitch_axis, r.angles);
+  EXPECT_NEAR(glm::length(Vec3(rot_only * Vec4(0, 0, 0, 1)) - v_after), 0, 1e-15);
+  // Turned about the pivot, not the vertex: the vertex moved (by about the turn times its 67 mm lever).
+  EXPECT_GT(glm::length(v_after - vertex), 1e-3);
+  std::vector<double> covered;
+  EXPECT_TRUE(passesAt(scene, r.local_to_world, frame, &covered));
 }
 
 }  // namespace

@@ -48,6 +48,25 @@ TEST(VehicleBlock, ObstructionsDefaultToEverythingButGrounds) {
   EXPECT_EQ(d.vehicle->obstructions, (std::vector<std::string>{"own-door", "other-car"}));
 }
 
+TEST(VehicleBlock, EyeEllipse) {
+  // Full axes along forward, left, up, in the file's unit; no default size.
+  const SceneDesc d =
+      parseScene(scene(kGood + R"(, "eye_ellipse": {"axes": [0.2, 0.06, 0.09], "tilt_deg": 12}})"), "x.json", ".");
+  ASSERT_TRUE(d.vehicle->eye_ellipse.has_value());
+  EXPECT_EQ(d.vehicle->eye_ellipse->axes_m, Vec3(0.2, 0.06, 0.09));
+  EXPECT_EQ(d.vehicle->eye_ellipse->tilt_deg, 12);
+  EXPECT_FALSE(parseScene(scene(kGood + "}"), "x.json", ".").vehicle->eye_ellipse.has_value());
+  EXPECT_NE(errorOf(scene(kGood + R"(, "eye_ellipse": {"axes": [0.2, -0.06, 0.09]}})"))
+                .find("x.json: vehicle.eye_ellipse.axes: expected three lengths >= 0"),
+            std::string::npos);
+  EXPECT_NE(errorOf(scene(kGood + R"(, "eye_ellipse": {"axes": [0.2, 0.06, 0.09], "tilt_deg": 60}})"))
+                .find("vehicle.eye_ellipse.tilt_deg"),
+            std::string::npos);
+  EXPECT_NE(errorOf(scene(kGood + R"(, "eye_ellipse": {"axis": [0.2, 0.06, 0.09]}})"))
+                .find("vehicle.eye_ellipse.axis: unknown key"),
+            std::string::npos);
+}
+
 TEST(VehicleBlock, ErrorsNameTheJsonPath) {
   auto with = [](const std::string& from, const std::string& to) {
     std::string v = kGood;
