@@ -139,7 +139,8 @@ TEST_P(CausticTest, ConcaveMirrorFocusesAtHalfItsRadius) {
 TEST_P(CausticTest, OffUnlessALightTurnsItOn) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
-  const Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/burning-lens.json", {"observer.image_size=[80,60]"}));
+  const Scene s = buildScene(loadScene(PVRR_SOURCE_DIR "/models/burning-lens.json",
+                                       {"lights[0].caustics=false", "observer.image_size=[80,60]"}));
   EXPECT_TRUE(gl::causticDefines(s).empty());
   RayScene rays(s);
   gl::Renderer renderer(s, rays, gl::rendererOptionsFor(s));
