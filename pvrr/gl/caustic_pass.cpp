@@ -23,7 +23,8 @@ void makeTexture2D(unsigned& tex, int w, int h) {
 
 std::string planNote(const CausticPlan& plan, int map_size) {
   std::string note = std::to_string(plan.meshes.size()) + " photon mesh" + (plan.meshes.size() == 1 ? "" : "es") +
-                     " (" + std::to_string(plan.traced) + " exact photons), " + std::to_string(map_size) + "^2 " +
+                     " (" + std::to_string(plan.traced) + " exact photons traced in " +
+                     std::to_string(int(plan.elapsed_ms)) + " ms), " + std::to_string(map_size) + "^2 " +
                      "photons each, " + std::to_string(plan.receivers.size()) + " receiver" +
                      (plan.receivers.size() == 1 ? "" : "s");
   for (const std::string& n : plan.notes) note += "; " + n;
