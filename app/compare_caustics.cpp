@@ -57,8 +57,9 @@ nlohmann::json compareCaustics(LoadedScene& ls, const std::string& gl_name, cons
   session.seen_points = false;
   renderFrame(ls, RenderMode::Raster, gl_name, &session);
   const std::vector<gl::CausticMap> maps = session.renderer->causticMaps();
-  json out = {{"what", "raster caustic maps (the same in every raster mode) against the reference's light tracer "
-                       "on the same cells; the spot: the reference's cells at or above half its peak"},
+  json out = {{"what",
+               "raster caustic maps (the same in every raster mode) against the reference's light tracer "
+               "on the same cells; the spot: the reference's cells at or above half its peak"},
               {"reference_photons_per_side", kReferencePhotons},
               {"plan_notes", session.renderer->causticPlan().notes},
               {"receivers", json::array()}};
@@ -73,7 +74,8 @@ nlohmann::json compareCaustics(LoadedScene& ls, const std::string& gl_name, cons
     DepositOptions d;
     d.mesh = m.mesh;
     const IrradianceGrid ref = depositPhotons(bundle, m.grid.rect, d).grid;
-    json j = {{"receiver", name}, {"cells", {m.grid.rect.cells_u, m.grid.rect.cells_v}},
+    json j = {{"receiver", name},
+              {"cells", {m.grid.rect.cells_u, m.grid.rect.cells_v}},
               {"cell_mm", 1e3 * m.grid.rect.cellWidth()}};
     if (!spotMetrics(ref).found) {
       j["note"] = "no reference caustic light on these cells";
@@ -91,10 +93,11 @@ nlohmann::json compareCaustics(LoadedScene& ls, const std::string& gl_name, cons
     const std::string png = "caustic-" + name + ".png";
     writeCausticHeatMap(out_dir + "/" + png, m.grid, ref, c.reference.peak_irradiance);
     j["heat_map"] = png + ": reference | raster | |raster - reference| x 10, 0 to the reference's peak";
-    std::printf("caustic on %s: peak %.4g W/m^2 (reference %.4g), focus %.3f mm from the reference's, relative L1 "
-                "in the spot %.2f %% (%d cells), power ratio %.4f\n",
-                name.c_str(), c.test.peak_irradiance, c.reference.peak_irradiance, 1e3 * c.peak_distance_m,
-                100 * c.relative_l1_in_spot, c.reference.spot_cells, c.power_ratio);
+    std::printf(
+        "caustic on %s: peak %.4g W/m^2 (reference %.4g), focus %.3f mm from the reference's, relative L1 "
+        "in the spot %.2f %% (%d cells), power ratio %.4f\n",
+        name.c_str(), c.test.peak_irradiance, c.reference.peak_irradiance, 1e3 * c.peak_distance_m,
+        100 * c.relative_l1_in_spot, c.reference.spot_cells, c.power_ratio);
     out["receivers"].push_back(j);
   }
   return out;

@@ -147,10 +147,10 @@ void CausticPass::splat(const CausticMesh& m) {
   data.reserve(m.vertices.size() * 11);
   for (const CausticVertex& v : m.vertices) {
     const Vec3 o = v.origin - m.anchor;
-    data.insert(data.end(), {float(2 * (v.xy.x - ap.x0) / (ap.x1 - ap.x0) - 1),
-                             float(2 * (v.xy.y - ap.y0) / (ap.y1 - ap.y0) - 1), float(o.x), float(o.y), float(o.z),
-                             float(v.direction.x), float(v.direction.y), float(v.direction.z),
-                             float(v.power_density.x), float(v.power_density.y), float(v.power_density.z)});
+    data.insert(data.end(),
+                {float(2 * (v.xy.x - ap.x0) / (ap.x1 - ap.x0) - 1), float(2 * (v.xy.y - ap.y0) / (ap.y1 - ap.y0) - 1),
+                 float(o.x), float(o.y), float(o.z), float(v.direction.x), float(v.direction.y), float(v.direction.z),
+                 float(v.power_density.x), float(v.power_density.y), float(v.power_density.z)});
   }
   MeshBuffers mesh;
   uploadMesh(mesh, data, {2, 3, 3, 3}, m.triangles);

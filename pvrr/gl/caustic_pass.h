@@ -70,8 +70,8 @@ class CausticPass {
   const Programs& programs_;
   int unit_ = 0, map_size_ = 512;
   CausticPlan plan_;
-  int cells_side_ = 0;                 // the light maps' texture side (the largest window's cells)
-  unsigned maps_ = 0, fbo_ = 0;        // the receivers' light maps (array layers) and a framebuffer
+  int cells_side_ = 0;           // the light maps' texture side (the largest window's cells)
+  unsigned maps_ = 0, fbo_ = 0;  // the receivers' light maps (array layers) and a framebuffer
   unsigned photon_fbo_ = 0, photon_tex_[3] = {0, 0, 0}, empty_vao_ = 0;
   std::vector<Mat4> rendered_poses_;
   bool rendered_ = false;

@@ -176,8 +176,10 @@ void chooseWindow(CausticReceiver& r, const std::vector<std::pair<Vec3, double>>
     if (sum >= kWindowQuantile * total) break;
   }
   const double side = std::max(kMinWindow_m, 2 * kWindowScale * radius);
-  const double u0 = std::max(c.x - 0.5 * side, -0.5 * full.width_m), u1 = std::min(c.x + 0.5 * side, 0.5 * full.width_m);
-  const double v0 = std::max(c.y - 0.5 * side, -0.5 * full.height_m), v1 = std::min(c.y + 0.5 * side, 0.5 * full.height_m);
+  const double u0 = std::max(c.x - 0.5 * side, -0.5 * full.width_m),
+               u1 = std::min(c.x + 0.5 * side, 0.5 * full.width_m);
+  const double v0 = std::max(c.y - 0.5 * side, -0.5 * full.height_m),
+               v1 = std::min(c.y + 0.5 * side, 0.5 * full.height_m);
   r.window = full;
   r.window.centre = full.toWorld(Vec2(0.5 * (u0 + u1), 0.5 * (v0 + v1)));
   r.window.width_m = u1 - u0;

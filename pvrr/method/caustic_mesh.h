@@ -28,10 +28,10 @@ namespace pvrr {
 inline constexpr int kMaxCausticReceivers = 4;
 
 struct CausticPlanOptions {
-  int grid = 64;         // aperture cells per side traced at their corners
-  int refine = 8;        // sub-cells per side of a cell whose corners differ
-  int cells = 256;       // light-map cells along a window's longer side
-  int max_depth = 8;     // specular events before a photon is absorbed (the reference's default)
+  int grid = 64;      // aperture cells per side traced at their corners
+  int refine = 8;     // sub-cells per side of a cell whose corners differ
+  int cells = 256;    // light-map cells along a window's longer side
+  int max_depth = 8;  // specular events before a photon is absorbed (the reference's default)
   DispersionMode dispersion = DispersionMode::Off;
   int spectral_samples = 16;
 };
@@ -51,13 +51,13 @@ struct CausticMesh {
   std::vector<CausticVertex> vertices;
   std::vector<uint32_t> triangles;  // three indices each
   Vec3 anchor{0};                   // world point the GPU's positions are relative to: the element's origin
-  double lost_fraction = 0;  // aperture area of cells dropped for inconsistent corners, over the traced area
+  double lost_fraction = 0;         // aperture area of cells dropped for inconsistent corners, over the traced area
 };
 
 struct CausticReceiver {
-  int mesh = -1;        // Scene::meshes index
-  ReceiverRect full;    // the mesh's rectangle in its plane (cells unused)
-  ReceiverRect window;  // the light map: part of `full`, with its cells
+  int mesh = -1;            // Scene::meshes index
+  ReceiverRect full;        // the mesh's rectangle in its plane (cells unused)
+  ReceiverRect window;      // the light map: part of `full`, with its cells
   double landed_power = 0;  // scalar power of the vertex photons landing on it (the choice's measure)
 };
 

@@ -47,10 +47,11 @@ const gl::CausticMap* mapOf(const std::vector<gl::CausticMap>& maps, const Scene
 }
 
 void print(const char* what, const IrradianceComparison& c) {
-  std::printf("[ caustic ] %s: peak %.4g W/m^2 (reference %.4g), peaks %.4f mm apart, centroids %.4f mm, "
-              "relative L1 in the spot %.4f (%d cells), power ratio %.4f\n",
-              what, c.test.peak_irradiance, c.reference.peak_irradiance, 1e3 * c.peak_distance_m,
-              1e3 * c.centroid_distance_m, c.relative_l1_in_spot, c.reference.spot_cells, c.power_ratio);
+  std::printf(
+      "[ caustic ] %s: peak %.4g W/m^2 (reference %.4g), peaks %.4f mm apart, centroids %.4f mm, "
+      "relative L1 in the spot %.4f (%d cells), power ratio %.4f\n",
+      what, c.test.peak_irradiance, c.reference.peak_irradiance, 1e3 * c.peak_distance_m, 1e3 * c.centroid_distance_m,
+      c.relative_l1_in_spot, c.reference.spot_cells, c.power_ratio);
 }
 
 TEST_P(CausticTest, BurningLensSpotMatchesTheReference) {

@@ -79,10 +79,10 @@ TEST(CausticMesh, ThinLensMeshCarriesThePowerTheLensPasses) {
   const double r0 = std::pow((kN - 1) / (kN + 1), 2);
   const double expected = kPi * 0.25 * kD * kD * (1 - r0) * (1 - r0);
   constexpr double kPowerTol = 0.02;  // the bound for the reference's power conservation
-  std::printf("[ caustic mesh ] %zu vertices, %zu triangles, %lld exact photons: power %.6g W, expected %.6g W "
-              "(ratio %.5f), rim sliver dropped %.4f\n",
-              m.vertices.size(), m.triangles.size() / 3, plan.traced, power, expected, power / expected,
-              m.lost_fraction);
+  std::printf(
+      "[ caustic mesh ] %zu vertices, %zu triangles, %lld exact photons: power %.6g W, expected %.6g W "
+      "(ratio %.5f), rim sliver dropped %.4f\n",
+      m.vertices.size(), m.triangles.size() / 3, plan.traced, power, expected, power / expected, m.lost_fraction);
   EXPECT_NEAR(power / expected, 1.0, kPowerTol);
   // The window holds the focus: a paraxial focus 0.5 m below lies on the table's centre.
   EXPECT_LT(glm::length(plan.receivers[0].window.centre - Vec3(0, 0, -0.5)), 1e-3);
