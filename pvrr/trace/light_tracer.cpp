@@ -10,6 +10,7 @@
 #include "pvrr/base/error.h"
 #include "pvrr/optics/optics.h"
 #include "pvrr/optics/spectrum.h"
+#include "pvrr/trace/specular.h"
 
 namespace pvrr {
 
@@ -151,9 +152,7 @@ PhotonFate followPhoton(const RayScene& rays, int element, double wavelength_nm,
     if (inside < 0) {
       hit = rays.intersect(o, d, t_min);
     } else {
-      const RayHit back = rays.intersectElementSurface(inside, 1, o, d, t_min);
-      const RayHit front = rays.intersectElementSurface(inside, 0, o, d, t_min);
-      hit = back.t <= front.t ? back : front;
+      hit = hitInsideLens(rays, inside, o, d, t_min);
       if (!hit.hit()) return PhotonFate::Absorbed;  // out through the lens's edge band, not modelled as a surface
     }
     if (depth == 0 && (hit.kind != HitKind::Element || hit.element != element)) return PhotonFate::Missed;
@@ -166,38 +165,16 @@ PhotonFate followPhoton(const RayScene& rays, int element, double wavelength_nm,
     }
     if (depth >= max_depth) return PhotonFate::Absorbed;
     const Element& el = scene.elements[size_t(hit.element)];
-    const double cos_i = -glm::dot(d, hit.normal);
     ++p.bounces;
-    if (el.type == ElementType::Mirror) {
-      if (cos_i <= 0) return PhotonFate::Absorbed;  // the mirror's back
-      Vec3 refl = el.mirror.reflectance;
-      if (el.mirror.metal) {
-        if (spectral && el.mirror.metal_table) {
-          const ComplexIndex nk = el.mirror.metal_table->index(wavelength_nm > 0 ? wavelength_nm : kLineD_nm);
-          refl = Vec3(fresnelConductor(cos_i, 1.0, nk.n, nk.k));
-        } else {
-          for (int c = 0; c < 3; ++c) refl[c] = fresnelConductor(cos_i, 1.0, el.mirror.n[c], el.mirror.k[c]);
-        }
-      }
-      p.power *= refl;
-      o = hit.point;
-      d = reflect(d, hit.normal);
-      t_min = rays.epsilon();
-      continue;
-    }
-    const double n_glass = el.dispersion.index(wavelength_nm > 0 ? wavelength_nm : kLineD_nm);
-    const bool entering = inside < 0;
-    const double n1 = entering ? 1.0 : n_glass, n2 = entering ? n_glass : 1.0;
-    const Refraction rf = refract(d, hit.normal, n1, n2);
+    const double n_glass =
+        el.type == ElementType::Lens ? el.dispersion.index(wavelength_nm > 0 ? wavelength_nm : kLineD_nm) : 1.0;
+    const SpecularEvent e = specularEvent(el, hit, d, inside, n_glass, spectral, wavelength_nm);
+    if (e.kind == SpecularKind::MirrorBack) return PhotonFate::Absorbed;
+    if (e.kind != SpecularKind::TotalInternal) p.power *= e.factor;
     o = hit.point;
+    d = e.direction;
     t_min = rays.epsilon();
-    if (rf.tir) {
-      d = reflect(d, hit.normal);
-      continue;
-    }
-    p.power *= 1.0 - fresnelDielectric(std::abs(cos_i), n1, n2);
-    d = rf.direction;
-    inside = entering ? hit.element : -1;
+    inside = e.inside;
   }
 }
 
