@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "app/args.h"
+#include "app/compare_caustics.h"
 #include "app/progress.h"
 #include "app/report.h"
 #include "pvrr/base/error.h"
@@ -395,6 +396,8 @@ int cmdCompare(const std::vector<std::string>& argv) {
     progress.update(5.0 + double(++modes_done));
   }
   progress.finish();
+  // Light (issue 23 item 4): the caustics' irradiance error beside the angular error, where they are on.
+  if (json caustics = compareCaustics(ls, gl_name, *out_dir); !caustics.is_null()) metrics["caustics"] = caustics;
   metrics["gl"] = gl_used;
   metrics["modes"] = jm;
   metrics["time_s"] = time0_s;

@@ -4,6 +4,7 @@
 
 #include "pvrr/gl/gl.h"
 #include "pvrr/gl/impostor_maps.h"
+#include "pvrr/gl/caustic_pass.h"
 #include "pvrr/gl/shadow_pass.h"
 #include "pvrr/method/view_volume.h"
 
@@ -153,6 +154,7 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
     if (textured) p->set("u_texture", 0);
     setLights(*p, scene, origin);
     if (shadows_) shadows_->bind(*p, origin);
+    if (caustics_) caustics_->bind(*p, origin);
   }
   glActiveTexture(GL_TEXTURE0);
   // Back faces of closed convex meshes that near clipping cannot cut open (RendererOptions::cull_back_faces,

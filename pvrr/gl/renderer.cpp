@@ -6,6 +6,7 @@
 //   impostor_maps.h      impostor mode's height and surface maps, and its texture-unit plan
 //   environment_pass.h   sky and environment meshes, in every pass
 //   shadow_pass.h        the lights' shadow maps, read by the environment's shading in every pass
+//   caustic_pass.h       the lights' caustic light maps on planar receivers, read there too
 //   element_mesh.h, gl_objects.h, programs.h   element vertices, GL objects, programs built on first use
 //   stage_notes.h        the stage names and the texts of their notes
 #include "pvrr/gl/renderer.h"
@@ -13,6 +14,7 @@
 #include <algorithm>
 
 #include "pvrr/base/error.h"
+#include "pvrr/gl/caustic_pass.h"
 #include "pvrr/gl/cube_pass.h"
 #include "pvrr/gl/gl.h"
 #include "pvrr/gl/pvrr_pass.h"
@@ -67,6 +69,7 @@ struct Renderer::Impl {
   Programs programs;
   EnvironmentPass environment;
   std::unique_ptr<ShadowPass> shadows;  // made with the first context() (it needs the texture-unit count)
+  std::unique_ptr<CausticPass> caustics;  // likewise
   MeshPool meshes;
   ElementGridCache grid_cache;
   int max_texture_size = 0, max_texture_units = 0;
@@ -88,6 +91,8 @@ struct Renderer::Impl {
       limits = queryGlLimits();
       shadows = std::make_unique<ShadowPass>(scene, programs, environment, max_texture_units);
       environment.setShadows(shadows.get());
+      caustics = std::make_unique<CausticPass>(scene, rays, programs, max_texture_units, options.caustic_map_size);
+      environment.setCaustics(caustics.get());
     }
     return {scene, rays, options, programs, environment, meshes, grid_cache, max_texture_size, max_texture_units};
   }
@@ -128,6 +133,8 @@ RasterFrame Renderer::render(RenderMode mode, FrameCache* cache) {
   return impl_->render(mode, cache);
 }
 void Renderer::setReadBack(bool on) { impl_->options.read_back = on; }
+std::vector<CausticMap> Renderer::causticMaps() const { return impl_->caustics->readMaps(); }
+const CausticPlan& Renderer::causticPlan() const { return impl_->caustics->plan(); }
 unsigned Renderer::colorTexture() const { return impl_->frame_target ? impl_->frame_target->colorTexture(0) : 0u; }
 
 RasterFrame Renderer::Impl::render(RenderMode mode, FrameCache* cache) {
@@ -143,6 +150,7 @@ RasterFrame Renderer::Impl::render(RenderMode mode, FrameCache* cache) {
   meshes.rewind();
   ModePass& pass = passFor(mode);
   shadows->update(out.stages);  // before the first passes, whose environment reads the maps too
+  caustics->update(out.stages);
   // The CPU stages and the first passes (and the nested passes of elements seen in other elements' maps).
   pass.prepare(mode, out.stages, cache);
   const auto t0 = Clock::now();

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "pvrr/base/frame.h"
+#include "pvrr/gl/caustic_pass.h"
 #include "pvrr/method/pass_plan.h"
 #include "pvrr/trace/ray_scene.h"
 #include "pvrr/base/stats.h"
@@ -38,6 +39,9 @@ struct RendererOptions : PassPlanOptions {
   // side of a mirror's surface maps (pvrr/impostor/surface_map.h); each built once per renderer.
   int lens_height_map_size = 512;
   int surface_map_size = 512;
+  // Caustics (pvrr/gl/caustic_pass.h): the caustic map's side, photons per side of each light's aperture over
+  // an element, per wavelength sample.
+  int caustic_map_size = 512;
   // Viewpoint options and channels. Channels empty: each element gets dispersionChannels(scene, element)
   // (the scene's render.dispersion and spectral_samples); otherwise every element gets these channels.
   VertexStageOptions vertex;
@@ -103,6 +107,11 @@ class Renderer {
   // without a readback: GL_TEXTURE_2D of the frame's size, rows bottom-up as GL stores them, RGBA16 or RGBA32F
   // (RendererOptions::seen_points). Valid until the next render() in the renderer's context.
   unsigned colorTexture() const;
+  // The receivers' caustic light maps as the last frame drew them (pvrr/gl/caustic_pass.h); empty without
+  // caustics.
+  std::vector<CausticMap> causticMaps() const;
+  // The caustic plan behind them (its notes say what was left out).
+  const CausticPlan& causticPlan() const;
 
  private:
   struct Impl;

@@ -112,6 +112,7 @@ void ShadowPass::makeLayers() {
       layer.view = glm::lookAt(layer.origin, centre, up);
       layer.proj = glm::ortho(-radius, radius, -radius, radius, 0.5 * radius, 3.5 * radius);
       layer.texel_m = 2.0 * radius / kMapSize;
+      layer.caustics = l.caustics;
       layers_.push_back(layer);
       continue;
     }
@@ -133,6 +134,7 @@ void ShadowPass::makeLayers() {
       layer.perspective = true;
       layer.near_m = kPointNear_m;
       layer.far_m = far_m;
+      layer.caustics = l.caustics;
       layers_.push_back(layer);
     }
   }
@@ -235,7 +237,7 @@ void ShadowPass::render() {
       const Element& el = scene_.elements[e];
       if (el.type != ElementType::Lens) continue;
       lens.set("u_view_proj", toFloat(layer.proj * layer.view * el.local_to_world));
-      lens.set("u_transmittance", float(lensShadowTransmittance(el)));
+      lens.set("u_transmittance", layer.caustics ? 0.0f : float(lensShadowTransmittance(el)));
       draw(element_meshes_[e]);
     }
   }

@@ -11,7 +11,8 @@
 // gathers; measured in docs/accuracy.md "Shadows", its cost in docs/performance.md "Shadows").
 // Casters: the environment meshes and the mirrors (opaque); the lenses go into their own depth layers with
 // their transmittance (1 - R0)^2 beside (pvrr/trace/shadow_rays.h): a point behind the nearest lens from the
-// light gets that lens's transmittance, behind an opaque caster nothing. The maps are rendered when the
+// light gets that lens's transmittance, behind an opaque caster nothing; for a light whose caustics are on
+// (pvrr/gl/caustic_pass.h) nothing either, as the light through the lens arrives as the caustic. The maps are rendered when the
 // renderer's first frame needs them and again only when an element moved (spectacles with the head): the
 // environment and the lights stand still (Renderer).
 #pragma once
@@ -67,6 +68,7 @@ class ShadowPass {
     double texel_m = 0;  // a texel's size at unit distance (point) or everywhere (directional), metres
     bool perspective = false;
     double near_m = 0, far_m = 0;  // point: the depth range
+    bool caustics = false;         // the light's caustics are on: a lens passes none of its light straight
   };
   void makeLayers();
   void makeTextures();

@@ -53,6 +53,8 @@ struct Light {
   // Directional, point: occluders between a surface and the light shadow it (LightDesc::shadows). Off unless
   // set, so that a scene built in code keeps its unshadowed picture.
   bool shadows = false;
+  // Directional, point: the raster modes draw its caustics (LightDesc::caustics; pvrr/gl/caustic_pass.h).
+  bool caustics = false;
 };
 
 struct Observer {

@@ -404,6 +404,7 @@ Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
     Light light;
     light.radiance = l.color * l.intensity;
     light.shadows = l.shadows && l.type != LightDesc::Type::Ambient;
+    light.caustics = l.caustics && l.type != LightDesc::Type::Ambient;
     switch (l.type) {
       case LightDesc::Type::Ambient: light.type = Light::Type::Ambient; break;
       case LightDesc::Type::Directional:

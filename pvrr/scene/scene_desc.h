@@ -91,6 +91,9 @@ struct LightDesc {
   // Directional, point: whether what lies between a surface and the light shadows it ("shadows"; on unless
   // a scene says otherwise). Ambient light has no direction and casts none.
   bool shadows = true;
+  // Directional, point: whether the raster modes draw the caustics of this light's light through the mirrors
+  // and lenses ("caustics"; off unless a scene turns it on: pvrr/gl/caustic_pass.h).
+  bool caustics = false;
 };
 inline constexpr NameTable<LightDesc::Type, 3> kLightTypeNames = {{{LightDesc::Type::Directional, "directional"},
                                                                    {LightDesc::Type::Point, "point"},

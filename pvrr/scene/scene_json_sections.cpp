@@ -161,19 +161,21 @@ LightDesc readLight(const Ctx& c, const json* j, const std::string& path) {
   const LightDesc::Type type = peekChoice<LightDesc::Type>(c, j, path, what, "type");
   LightDesc l;
   if (type == LightDesc::Type::Directional) {
-    Obj o(c, j, path, what, {"type", "direction", "color", "intensity", "shadows"});
+    Obj o(c, j, path, what, {"type", "direction", "color", "intensity", "shadows", "caustics"});
     l.type = LightDesc::Type::Directional;
     l.direction = o.vec3("direction", VecKind::Direction);
     l.color = o.vec3("color", VecKind::ColourNonNegative, Vec3(1.0));
     l.intensity = o.number("intensity", kNonNegative, 1.0);
     l.shadows = o.boolean("shadows", true);
+    l.caustics = o.boolean("caustics", false);
   } else if (type == LightDesc::Type::Point) {
-    Obj o(c, j, path, what, {"type", "position", "color", "intensity", "shadows"});
+    Obj o(c, j, path, what, {"type", "position", "color", "intensity", "shadows", "caustics"});
     l.type = LightDesc::Type::Point;
     l.position = o.point("position");
     l.color = o.vec3("color", VecKind::ColourNonNegative, Vec3(1.0));
     l.intensity = o.number("intensity", kNonNegative, 1.0);
     l.shadows = o.boolean("shadows", true);
+    l.caustics = o.boolean("caustics", false);
   } else {
     Obj o(c, j, path, what, {"type", "color", "intensity"});
     l.type = LightDesc::Type::Ambient;

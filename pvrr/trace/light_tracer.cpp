@@ -10,6 +10,7 @@
 #include "pvrr/base/error.h"
 #include "pvrr/optics/optics.h"
 #include "pvrr/optics/spectrum.h"
+#include "pvrr/trace/specular.h"
 
 namespace pvrr {
 
@@ -55,16 +56,9 @@ std::vector<Vec3> elementPoints(const Element& el) {
   return pts;
 }
 
-// Where the photons of one (light, element) pair come from: origin + x a + y b (+ along the axis) over the
-// rectangle [x0, x1] x [y0, y1]. Directional: positions on a plane normal to the light; point: tangents about
-// the axis light -> element.
-struct Aperture {
-  bool point = false;
-  Vec3 origin{0}, axis{0}, a{0}, b{0};
-  double x0 = 0, x1 = 0, y0 = 0, y1 = 0;
-};
+}  // namespace
 
-bool apertureFor(const Scene& scene, const Light& light, const Element& el, Aperture& ap, std::string& why) {
+bool causticAperture(const Scene& scene, const Light& light, const Element& el, CausticAperture& ap, std::string& why) {
   const std::vector<Vec3> pts = elementPoints(el);
   if (pts.empty()) {
     why = "no finite point on its surfaces";
@@ -120,8 +114,7 @@ bool apertureFor(const Scene& scene, const Light& light, const Element& el, Aper
   return true;
 }
 
-// The wavelength samples to trace: one when nothing in the scene depends on the wavelength.
-std::vector<SpectralSample> samplesFor(const Scene& scene, const CausticOptions& o) {
+std::vector<SpectralSample> causticSamples(const Scene& scene, const CausticOptions& o) {
   bool depends = false;
   for (const Element& e : scene.elements) {
     if (e.type == ElementType::Lens && e.dispersion.abbe() < kInf) depends = true;
@@ -132,11 +125,23 @@ std::vector<SpectralSample> samplesFor(const Scene& scene, const CausticOptions&
   return o.dispersion == DispersionMode::Rgb ? rgbSamples() : spectralSamples(o.spectral_samples);
 }
 
-enum class Fate { Missed, Absorbed, Left };
+CausticPhoton photonAt(const CausticAperture& ap, const Light& light, const SpectralSample& sample, double x, double y,
+                       double measure) {
+  CausticPhoton p;
+  if (ap.point) {
+    p.origin = ap.origin;
+    p.direction = glm::normalize(ap.axis + x * ap.a + y * ap.b);
+    const double q = 1.0 + x * x + y * y;
+    p.power = light.radiance * sample.rgb_weight * (measure / (q * std::sqrt(q)));
+  } else {
+    p.origin = ap.origin + x * ap.a + y * ap.b;
+    p.direction = ap.axis;
+    p.power = light.radiance * sample.rgb_weight * measure;
+  }
+  return p;
+}
 
-// Follows one photon from its first element to the ray it leaves on. `p` holds origin, direction and power on
-// entry. Returns Missed when its first hit is not `element`.
-Fate tracePhoton(const RayScene& rays, int element, double wavelength_nm, bool spectral, int max_depth,
+PhotonFate followPhoton(const RayScene& rays, int element, double wavelength_nm, bool spectral, int max_depth,
                  CausticPhoton& p) {
   const Scene& scene = rays.scene();
   Vec3 o = p.origin, d = p.direction;
@@ -147,55 +152,33 @@ Fate tracePhoton(const RayScene& rays, int element, double wavelength_nm, bool s
     if (inside < 0) {
       hit = rays.intersect(o, d, t_min);
     } else {
-      const RayHit back = rays.intersectElementSurface(inside, 1, o, d, t_min);
-      const RayHit front = rays.intersectElementSurface(inside, 0, o, d, t_min);
-      hit = back.t <= front.t ? back : front;
-      if (!hit.hit()) return Fate::Absorbed;  // out through the lens's edge band, not modelled as a surface
+      hit = hitInsideLens(rays, inside, o, d, t_min);
+      if (!hit.hit()) return PhotonFate::Absorbed;  // out through the lens's edge band, not modelled as a surface
     }
-    if (depth == 0 && (hit.kind != HitKind::Element || hit.element != element)) return Fate::Missed;
+    if (depth == 0 && (hit.kind != HitKind::Element || hit.element != element)) return PhotonFate::Missed;
     if (hit.kind != HitKind::Element) {
       p.origin = o;
       p.direction = d;
       p.t_hit = hit.hit() ? hit.t : kInf;
       p.mesh = hit.hit() ? hit.mesh : -1;
-      return Fate::Left;
+      return PhotonFate::Left;
     }
-    if (depth >= max_depth) return Fate::Absorbed;
+    if (depth >= max_depth) return PhotonFate::Absorbed;
     const Element& el = scene.elements[size_t(hit.element)];
-    const double cos_i = -glm::dot(d, hit.normal);
     ++p.bounces;
-    if (el.type == ElementType::Mirror) {
-      if (cos_i <= 0) return Fate::Absorbed;  // the mirror's back
-      Vec3 refl = el.mirror.reflectance;
-      if (el.mirror.metal) {
-        if (spectral && el.mirror.metal_table) {
-          const ComplexIndex nk = el.mirror.metal_table->index(wavelength_nm > 0 ? wavelength_nm : kLineD_nm);
-          refl = Vec3(fresnelConductor(cos_i, 1.0, nk.n, nk.k));
-        } else {
-          for (int c = 0; c < 3; ++c) refl[c] = fresnelConductor(cos_i, 1.0, el.mirror.n[c], el.mirror.k[c]);
-        }
-      }
-      p.power *= refl;
-      o = hit.point;
-      d = reflect(d, hit.normal);
-      t_min = rays.epsilon();
-      continue;
-    }
-    const double n_glass = el.dispersion.index(wavelength_nm > 0 ? wavelength_nm : kLineD_nm);
-    const bool entering = inside < 0;
-    const double n1 = entering ? 1.0 : n_glass, n2 = entering ? n_glass : 1.0;
-    const Refraction rf = refract(d, hit.normal, n1, n2);
+    const double n_glass =
+        el.type == ElementType::Lens ? el.dispersion.index(wavelength_nm > 0 ? wavelength_nm : kLineD_nm) : 1.0;
+    const SpecularEvent e = specularEvent(el, hit, d, inside, n_glass, spectral, wavelength_nm);
+    if (e.kind == SpecularKind::MirrorBack) return PhotonFate::Absorbed;
+    if (e.kind != SpecularKind::TotalInternal) p.power *= e.factor;
     o = hit.point;
+    d = e.direction;
     t_min = rays.epsilon();
-    if (rf.tir) {
-      d = reflect(d, hit.normal);
-      continue;
-    }
-    p.power *= 1.0 - fresnelDielectric(std::abs(cos_i), n1, n2);
-    d = rf.direction;
-    inside = entering ? hit.element : -1;
+    inside = e.inside;
   }
 }
+
+namespace {
 
 // Counts and photons of one row of strata.
 struct RowOut {
@@ -204,7 +187,7 @@ struct RowOut {
   Vec3 entering_power{0}, leaving_power{0};
 };
 
-void shootRow(const RayScene& rays, const Light& light, const Aperture& ap, int light_index, int element,
+void shootRow(const RayScene& rays, const Light& light, const CausticAperture& ap, int light_index, int element,
               int sample_index, const SpectralSample& sample, bool spectral, const CausticOptions& o, int row,
               RowOut& out) {
   const int side = o.photons_per_side;
@@ -215,25 +198,15 @@ void shootRow(const RayScene& rays, const Light& light, const Aperture& ap, int 
       h = mix64(h ^ k);
     const double x = ap.x0 + (col + unitFromBits(h)) * dx;
     const double y = ap.y0 + (row + unitFromBits(mix64(h))) * dy;
-    CausticPhoton p;
+    CausticPhoton p = photonAt(ap, light, sample, x, y, dx * dy);
     p.light = light_index;
     p.element = element;
-    if (ap.point) {
-      p.origin = ap.origin;
-      p.direction = glm::normalize(ap.axis + x * ap.a + y * ap.b);
-      const double q = 1.0 + x * x + y * y;
-      p.power = light.radiance * sample.rgb_weight * (dx * dy / (q * std::sqrt(q)));
-    } else {
-      p.origin = ap.origin + x * ap.a + y * ap.b;
-      p.direction = ap.axis;
-      p.power = light.radiance * sample.rgb_weight * (dx * dy);
-    }
     const Vec3 entering = p.power;
-    const Fate fate = tracePhoton(rays, element, sample.wavelength_nm, spectral, o.max_depth, p);
-    if (fate == Fate::Missed) continue;
+    const PhotonFate fate = followPhoton(rays, element, sample.wavelength_nm, spectral, o.max_depth, p);
+    if (fate == PhotonFate::Missed) continue;
     ++out.entered;
     out.entering_power += entering;
-    if (fate == Fate::Absorbed) {
+    if (fate == PhotonFate::Absorbed) {
       ++out.absorbed;
       continue;
     }
@@ -251,7 +224,7 @@ PhotonBundle shootCausticPhotons(const RayScene& rays, const CausticOptions& o) 
     throw Error("caustics: photons per side must be in [1, 8192], got " + std::to_string(o.photons_per_side));
   if (o.element >= int(scene.elements.size()))
     throw Error("caustics: element " + std::to_string(o.element) + " out of range");
-  const std::vector<SpectralSample> samples = samplesFor(scene, o);
+  const std::vector<SpectralSample> samples = causticSamples(scene, o);
   const bool spectral = o.dispersion == DispersionMode::Spectral;
   PhotonBundle b;
   b.samples_per_photon = int(samples.size());
@@ -261,9 +234,9 @@ PhotonBundle shootCausticPhotons(const RayScene& rays, const CausticOptions& o) 
     if (light.type == Light::Type::Ambient) continue;  // no direction: it makes no caustic
     for (size_t ei = 0; ei < scene.elements.size(); ++ei) {
       if (o.element >= 0 && int(ei) != o.element) continue;
-      Aperture ap;
+      CausticAperture ap;
       std::string why;
-      if (!apertureFor(scene, light, scene.elements[ei], ap, why)) {
+      if (!causticAperture(scene, light, scene.elements[ei], ap, why)) {
         b.notes.push_back("light " + std::to_string(li) + ", element \"" + scene.elements[ei].name + "\": skipped, " +
                           why);
         continue;

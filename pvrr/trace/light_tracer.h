@@ -34,6 +34,7 @@
 #include <string>
 #include <vector>
 
+#include "pvrr/optics/spectrum.h"
 #include "pvrr/scene/render_desc.h"
 #include "pvrr/trace/irradiance_grid.h"
 #include "pvrr/trace/ray_scene.h"
@@ -98,5 +99,33 @@ CausticResult depositPhotons(const PhotonBundle& bundle, const ReceiverRect& rec
 
 // The padding of an aperture rectangle, relative to its size (covers the sampling of curved rims).
 constexpr double kAperturePad = 0.02;
+
+// The steps of shootCausticPhotons, shared with the raster caustics (pvrr/method/caustic_mesh.h), which trace
+// the same photons at the vertices of a grid over the same aperture.
+
+// Where the photons of one (light, element) pair come from: origin + x a + y b (+ along the axis) over the
+// rectangle [x0, x1] x [y0, y1]. Directional: positions on a plane normal to the light, the origin upstream of
+// the scene's bounds; point: tangents (x, y) of the angles about the unit axis light -> element.
+struct CausticAperture {
+  bool point = false;
+  Vec3 origin{0}, axis{0}, a{0}, b{0};
+  double x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+};
+// False, with the reason, when the pair has none (no finite surface point, a point light within the element).
+bool causticAperture(const Scene& scene, const Light& light, const Element& el, CausticAperture& ap,
+                     std::string& why);
+// The wavelength samples to trace: one (wavelength 0: the d line, weight 1) when nothing in the scene depends
+// on the wavelength or dispersion is off.
+std::vector<SpectralSample> causticSamples(const Scene& scene, const CausticOptions& o);
+// The photon at aperture coordinates (x, y) carrying the power of `measure` (an area in m^2, directional; a
+// tangent-plane area, point: the solid angle is measure / (1 + x^2 + y^2)^3/2) of the light at the sample.
+CausticPhoton photonAt(const CausticAperture& ap, const Light& light, const SpectralSample& sample, double x, double y,
+                       double measure);
+enum class PhotonFate { Missed, Absorbed, Left };
+// Follows one photon from its first element to the ray it leaves on: `p` holds origin, direction and power on
+// entry, and on Left the ray it leaves on, its power after the element's reflectance or Fresnel transmittances,
+// and where it meets the environment. Missed: its first hit is not `element`.
+PhotonFate followPhoton(const RayScene& rays, int element, double wavelength_nm, bool spectral, int max_depth,
+                        CausticPhoton& p);
 
 }  // namespace pvrr

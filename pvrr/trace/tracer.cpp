@@ -13,6 +13,7 @@
 #include "pvrr/base/error.h"
 #include "pvrr/optics/optics.h"
 #include "pvrr/trace/shading.h"
+#include "pvrr/trace/specular.h"
 #include "pvrr/optics/spectrum.h"
 
 namespace pvrr {
@@ -51,9 +52,7 @@ TraceResult Tracer::traceImpl(const Vec3& o_in, const Vec3& d_in, double wavelen
       hit = rays_.intersect(o, d, t_min);
     if (inside >= 0) {
       // Inside a lens: the next event is on one of its own surfaces.
-      RayHit back = rays_.intersectElementSurface(inside, 1, o, d, t_min);
-      RayHit front = rays_.intersectElementSurface(inside, 0, o, d, t_min);
-      hit = back.t <= front.t ? back : front;
+      hit = hitInsideLens(rays_, inside, o, d, t_min);
       if (!hit.hit()) {
         // Leaving through the lens's edge band, which is not modelled as a surface: absorbed.
         if (path) path->push_back({o, d, "absorb", inside, false, {}, {}, 1, 1});
@@ -102,9 +101,10 @@ TraceResult Tracer::traceImpl(const Vec3& o_in, const Vec3& d_in, double wavelen
       r.seen = hit.point;
       return r;
     }
-    const double cos_i = -glm::dot(d, hit.normal);
+    const double n_glass = el.type == ElementType::Lens ? lensIndex(el, wavelength_nm) : 1.0;
+    const SpecularEvent e = specularEvent(el, hit, d, inside, n_glass, metal_spectral, wavelength_nm);
     if (el.type == ElementType::Mirror) {
-      if (cos_i <= 0) {
+      if (e.kind == SpecularKind::MirrorBack) {
         // The mirror's back: dark diffuse.
         seg.event = "diffuse";
         if (path) path->push_back(seg);
@@ -113,48 +113,28 @@ TraceResult Tracer::traceImpl(const Vec3& o_in, const Vec3& d_in, double wavelen
         r.seen = hit.point;
         return r;
       }
-      Vec3 refl = el.mirror.reflectance;
-      if (el.mirror.metal) {
-        if (el.mirror.metal_table) r.hit_metal = true;
-        if (metal_spectral && el.mirror.metal_table) {
-          const ComplexIndex nk = el.mirror.metal_table->index(wavelength_nm > 0 ? wavelength_nm : kLineD_nm);
-          refl = Vec3(fresnelConductor(cos_i, 1.0, nk.n, nk.k));
-        } else {
-          for (int c = 0; c < 3; ++c) refl[c] = fresnelConductor(cos_i, 1.0, el.mirror.n[c], el.mirror.k[c]);
-        }
-      }
-      throughput *= refl;
+      if (el.mirror.metal && el.mirror.metal_table) r.hit_metal = true;
+      throughput *= e.factor;
       seg.event = "reflect";
       if (path) path->push_back(seg);
       o = hit.point;
-      d = reflect(d, hit.normal);
+      d = e.direction;
       t_min = eps;
       ++r.bounces;
       continue;
     }
     // Lens interface.
     r.hit_lens = true;
-    const double n_glass = lensIndex(el, wavelength_nm);
-    const bool entering = inside < 0;
-    const double n1 = entering ? 1.0 : n_glass;
-    const double n2 = entering ? n_glass : 1.0;
-    Refraction rf = refract(d, hit.normal, n1, n2);
-    seg.n1 = n1;
-    seg.n2 = n2;
+    seg.n1 = e.n1;
+    seg.n2 = e.n2;
     ++r.bounces;
     o = hit.point;
     t_min = eps;
-    if (rf.tir) {
-      seg.event = "tir";
-      if (path) path->push_back(seg);
-      d = reflect(d, hit.normal);
-      continue;
-    }
-    seg.event = "refract";
+    seg.event = e.kind == SpecularKind::TotalInternal ? "tir" : "refract";
     if (path) path->push_back(seg);
-    throughput *= 1.0 - fresnelDielectric(std::abs(cos_i), n1, n2);
-    d = rf.direction;
-    inside = entering ? hit.element : -1;
+    if (e.kind == SpecularKind::Refract) throughput *= e.factor;
+    d = e.direction;
+    inside = e.inside;
   }
 }
 

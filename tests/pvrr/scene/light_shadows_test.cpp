@@ -59,14 +59,35 @@ TEST(LightShadows, BadValuesAreRejectedInOneLine) {
 }
 
 // The shipped scenes keep their unshadowed pictures (and golden images): every light says so.
+// Shipped scenes turn shadows off (their pictures predate them), except the caustic scenes, whose sun has
+// caustics on and so needs the lens's shadow (docs/scene-format.md "caustics").
 TEST(LightShadows, ShippedScenesTurnThemOffExplicitly) {
-  int scenes = 0;
+  int scenes = 0, caustic = 0;
   for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::path(PVRR_SOURCE_DIR) / "models")) {
     if (entry.path().extension() != ".json") continue;
     ++scenes;
-    for (const LightDesc& l : loadScene(entry.path().string()).lights) EXPECT_FALSE(l.shadows) << entry.path();
+    for (const LightDesc& l : loadScene(entry.path().string()).lights) {
+      EXPECT_EQ(l.shadows, l.caustics) << entry.path();
+      caustic += l.caustics;
+    }
   }
   EXPECT_GE(scenes, 8);
+  EXPECT_EQ(caustic, 2);  // burning-lens and shaving-mirror-sun
+}
+
+// A light's "caustics" switch: off unless a scene turns it on; ambient light has none; bad values in one line.
+TEST(LightShadows, CausticsAreOffUnlessTurnedOn) {
+  const SceneDesc d = parseScene(sceneWithLights(R"({"type": "directional", "direction": [0, -1, 0]},
+      {"type": "point", "position": [0, 2, 0], "caustics": true})"),
+                                 kName, "");
+  EXPECT_FALSE(d.lights[0].caustics);
+  EXPECT_TRUE(d.lights[1].caustics);
+  EXPECT_TRUE(buildScene(d).lights[1].caustics);
+  EXPECT_FALSE(Light{}.caustics);
+  EXPECT_EQ(errorOf(sceneWithLights(R"({"type": "directional", "direction": [0, -1, 0], "caustics": 1})")),
+            kName + ": lights[0].caustics: expected true or false, got 1");
+  const std::string m = errorOf(sceneWithLights(R"({"type": "ambient", "caustics": true})"));
+  EXPECT_NE(m.find("lights[0].caustics: unknown key"), std::string::npos) << m;
 }
 
 }  // namespace

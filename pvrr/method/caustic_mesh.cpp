@@ -1,0 +1,301 @@
+#include "pvrr/method/caustic_mesh.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "pvrr/base/error.h"
+
+namespace pvrr {
+
+namespace {
+
+// The window about the landed power (as `pvrr caustic` chooses its own): the square about the power centroid
+// out to kWindowScale times the (Chebyshev) radius holding kWindowQuantile of the power, at least kMinWindow_m.
+constexpr double kWindowQuantile = 0.99, kWindowScale = 1.3, kMinWindow_m = 0.004;
+// Planarity of a receiver mesh: its normals within this of one another (1 - cos), its vertices within this
+// fraction of its extent of one plane (float vertices: a few ulps).
+constexpr double kNormalTol = 1e-9, kPlaneTol = 1e-6;
+
+struct Traced {
+  CausticPhoton p;
+  bool left = false;
+};
+
+bool consistent(const Traced* c[4]) {
+  for (int k = 0; k < 4; ++k)
+    if (!c[k]->left) return false;
+  for (int k = 1; k < 4; ++k)
+    if (c[k]->p.bounces != c[0]->p.bounces || c[k]->p.mesh != c[0]->p.mesh) return false;
+  return true;
+}
+
+// The traced photons of one (light, element, sample).
+struct PairTracer {
+  const RayScene& rays;
+  const Light& light;
+  const CausticAperture& ap;
+  const SpectralSample& sample;
+  int element;
+  bool spectral;
+  int max_depth;
+
+  Traced at(double x, double y) const {
+    Traced t;
+    t.p = photonAt(ap, light, sample, x, y, 1.0);
+    t.left = followPhoton(rays, element, sample.wavelength_nm, spectral, max_depth, t.p) == PhotonFate::Left;
+    return t;
+  }
+};
+
+// One cell's sub-grid: its traced corners and the consistent sub-cells' triangles (local indices).
+struct Refined {
+  std::vector<Traced> vertices;
+  std::vector<uint32_t> triangles;
+  double lost_area = 0;
+};
+
+void addQuad(std::vector<uint32_t>& tris, uint32_t a, uint32_t b, uint32_t c, uint32_t d) {
+  tris.insert(tris.end(), {a, b, c, a, c, d});  // corners a (x0, y0), b (x1, y0), c (x1, y1), d (x0, y1)
+}
+
+Refined refineCell(const PairTracer& tr, double x0, double y0, double dx, double dy, int s) {
+  Refined r;
+  r.vertices.resize(size_t(s + 1) * size_t(s + 1));
+  for (int j = 0; j <= s; ++j)
+    for (int i = 0; i <= s; ++i) r.vertices[size_t(j) * (s + 1) + i] = tr.at(x0 + dx * i / s, y0 + dy * j / s);
+  for (int j = 0; j < s; ++j)
+    for (int i = 0; i < s; ++i) {
+      const uint32_t a = uint32_t(j * (s + 1) + i), b = a + 1, c = a + uint32_t(s) + 2, d = a + uint32_t(s) + 1;
+      const Traced* corners[4] = {&r.vertices[a], &r.vertices[b], &r.vertices[c], &r.vertices[d]};
+      if (consistent(corners)) {
+        addQuad(r.triangles, a, b, c, d);
+      } else if (corners[0]->left || corners[1]->left || corners[2]->left || corners[3]->left) {
+        r.lost_area += dx * dy / (double(s) * s);
+      }
+    }
+  return r;
+}
+
+CausticVertex vertexOf(const Traced& t, double x, double y) {
+  CausticVertex v;
+  v.xy = Vec2(x, y);
+  v.origin = t.p.origin;
+  v.direction = t.p.direction;
+  v.power_density = t.p.power;
+  return v;
+}
+
+// Landed power per receiving mesh: (landing point, weight) of each vertex photon that meets a mesh.
+using Landings = std::vector<std::vector<std::pair<Vec3, double>>>;
+
+CausticMesh tracePair(const PairTracer& tr, const CausticPlanOptions& o, Landings& landed, long long& traced) {
+  const CausticAperture& ap = tr.ap;
+  const int g = o.grid, s = o.refine;
+  const double dx = (ap.x1 - ap.x0) / g, dy = (ap.y1 - ap.y0) / g;
+  std::vector<Traced> grid(size_t(g + 1) * size_t(g + 1));
+  tbb::parallel_for(0, g + 1, [&](int j) {
+    for (int i = 0; i <= g; ++i) grid[size_t(j) * (g + 1) + i] = tr.at(ap.x0 + i * dx, ap.y0 + j * dy);
+  });
+  traced += (long long)grid.size();
+  CausticMesh m;
+  m.aperture = ap;
+  auto land = [&](const Traced& t, double weight) {
+    if (!t.left || t.p.mesh < 0 || !std::isfinite(t.p.t_hit)) return;
+    const double w = weight * (t.p.power.x + t.p.power.y + t.p.power.z) / 3.0;
+    landed[size_t(t.p.mesh)].push_back({t.p.origin + t.p.t_hit * t.p.direction, w});
+  };
+  for (int j = 0; j <= g; ++j)
+    for (int i = 0; i <= g; ++i) {
+      const Traced& t = grid[size_t(j) * (g + 1) + i];
+      m.vertices.push_back(vertexOf(t, ap.x0 + i * dx, ap.y0 + j * dy));
+      land(t, dx * dy);
+    }
+  std::vector<std::pair<int, int>> to_refine;
+  double kept_area = 0;
+  for (int j = 0; j < g; ++j)
+    for (int i = 0; i < g; ++i) {
+      const uint32_t a = uint32_t(j * (g + 1) + i), b = a + 1, c = a + uint32_t(g) + 2, d = a + uint32_t(g) + 1;
+      const Traced* corners[4] = {&grid[a], &grid[b], &grid[c], &grid[d]};
+      if (consistent(corners)) {
+        addQuad(m.triangles, a, b, c, d);
+        kept_area += dx * dy;
+      } else if (s > 1 && (corners[0]->left || corners[1]->left || corners[2]->left || corners[3]->left)) {
+        to_refine.push_back({i, j});
+      }
+    }
+  std::vector<Refined> refined(to_refine.size());
+  tbb::parallel_for(size_t(0), to_refine.size(), [&](size_t k) {
+    refined[k] = refineCell(tr, ap.x0 + to_refine[k].first * dx, ap.y0 + to_refine[k].second * dy, dx, dy, s);
+  });
+  double lost = 0;
+  for (size_t k = 0; k < refined.size(); ++k) {
+    const Refined& r = refined[k];
+    const uint32_t base = uint32_t(m.vertices.size());
+    const double x0 = ap.x0 + to_refine[k].first * dx, y0 = ap.y0 + to_refine[k].second * dy;
+    for (int jj = 0; jj <= s; ++jj)
+      for (int ii = 0; ii <= s; ++ii) {
+        const Traced& t = r.vertices[size_t(jj) * (s + 1) + ii];
+        m.vertices.push_back(vertexOf(t, x0 + dx * ii / s, y0 + dy * jj / s));
+        land(t, dx * dy / (double(s) * s));
+      }
+    for (uint32_t idx : r.triangles) m.triangles.push_back(base + idx);
+    kept_area += dx * dy / (double(s) * s) * double(r.triangles.size() / 6);
+    lost += r.lost_area;
+    traced += (long long)r.vertices.size();
+  }
+  m.lost_fraction = kept_area + lost > 0 ? lost / (kept_area + lost) : 0;
+  return m;
+}
+
+// The window of receiver r about its landed power, with cells.
+void chooseWindow(CausticReceiver& r, const std::vector<std::pair<Vec3, double>>& landed, int cells) {
+  const ReceiverRect& full = r.full;
+  std::vector<std::pair<Vec2, double>> uv;
+  double total = 0;
+  Vec2 acc(0);
+  for (const auto& [x, w] : landed) {
+    const Vec2 q = full.toReceiver(x);
+    if (!full.contains(q) || !(w > 0)) continue;
+    uv.push_back({q, w});
+    total += w;
+    acc += w * q;
+  }
+  r.landed_power = total;
+  if (!(total > 0)) return;
+  const Vec2 c = acc / total;
+  std::vector<std::pair<double, double>> radii;
+  for (const auto& [q, w] : uv) radii.push_back({std::max(std::abs(q.x - c.x), std::abs(q.y - c.y)), w});
+  std::sort(radii.begin(), radii.end());
+  double sum = 0, radius = 0;
+  for (const auto& [d, w] : radii) {
+    sum += w;
+    radius = d;
+    if (sum >= kWindowQuantile * total) break;
+  }
+  const double side = std::max(kMinWindow_m, 2 * kWindowScale * radius);
+  const double u0 = std::max(c.x - 0.5 * side, -0.5 * full.width_m),
+               u1 = std::min(c.x + 0.5 * side, 0.5 * full.width_m);
+  const double v0 = std::max(c.y - 0.5 * side, -0.5 * full.height_m),
+               v1 = std::min(c.y + 0.5 * side, 0.5 * full.height_m);
+  r.window = full;
+  r.window.centre = full.toWorld(Vec2(0.5 * (u0 + u1), 0.5 * (v0 + v1)));
+  r.window.width_m = u1 - u0;
+  r.window.height_m = v1 - v0;
+  const double cell = std::max(r.window.width_m, r.window.height_m) / cells;
+  r.window.cells_u = std::max(1, int(std::lround(r.window.width_m / cell)));
+  r.window.cells_v = std::max(1, int(std::lround(r.window.height_m / cell)));
+}
+
+}  // namespace
+
+std::vector<int> causticLights(const Scene& scene) {
+  std::vector<int> out;
+  for (size_t i = 0; i < scene.lights.size(); ++i)
+    if (scene.lights[i].caustics && scene.lights[i].type != Light::Type::Ambient) out.push_back(int(i));
+  return out;
+}
+
+std::vector<CausticReceiver> planarReceivers(const Scene& scene) {
+  std::vector<CausticReceiver> out;
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    const EnvMesh& mesh = scene.meshes[m];
+    if (mesh.triangles.empty() || mesh.normals.size() != mesh.positions.size()) continue;
+    const Vec3 n = glm::normalize(Vec3(mesh.normals[0]));
+    const Vec3 p0 = Vec3(mesh.positions[0]);
+    double extent = 0;
+    for (const glm::vec3& p : mesh.positions) extent = std::max(extent, glm::length(Vec3(p) - p0));
+    bool planar = extent > 0;
+    for (size_t k = 0; k < mesh.positions.size() && planar; ++k)
+      planar = glm::dot(glm::normalize(Vec3(mesh.normals[k])), n) >= 1 - kNormalTol &&
+               std::abs(glm::dot(Vec3(mesh.positions[k]) - p0, n)) <= kPlaneTol * extent;
+    if (!planar) continue;
+    const glm::u32vec3 t = mesh.triangles[0];
+    Vec3 u = Vec3(mesh.positions[t.y]) - Vec3(mesh.positions[t.x]);
+    u = glm::normalize(u - glm::dot(u, n) * n);
+    const Vec3 v = glm::cross(n, u);  // so that u x v = n
+    double u0 = kInf, u1 = -kInf, v0 = kInf, v1 = -kInf;
+    for (const glm::vec3& p : mesh.positions) {
+      const Vec3 q = Vec3(p) - p0;
+      u0 = std::min(u0, glm::dot(q, u)), u1 = std::max(u1, glm::dot(q, u));
+      v0 = std::min(v0, glm::dot(q, v)), v1 = std::max(v1, glm::dot(q, v));
+    }
+    CausticReceiver r;
+    r.mesh = int(m);
+    r.full.u_axis = u;
+    r.full.v_axis = v;
+    r.full.centre = mesh.anchor + p0 + 0.5 * (u0 + u1) * u + 0.5 * (v0 + v1) * v;
+    r.full.width_m = u1 - u0;
+    r.full.height_m = v1 - v0;
+    out.push_back(r);
+  }
+  return out;
+}
+
+CausticPlan planCaustics(const RayScene& rays, const CausticPlanOptions& o) {
+  const auto start = std::chrono::steady_clock::now();
+  if (o.grid < 1 || o.grid > 1024 || o.refine < 1 || o.refine > 64 || o.cells < 4 || o.cells > 4096)
+    throw Error("caustics: photon grid, refinement or map cells out of range");
+  const Scene& scene = rays.scene();
+  CausticPlan plan;
+  CausticOptions co;
+  co.dispersion = o.dispersion;
+  co.spectral_samples = o.spectral_samples;
+  const std::vector<SpectralSample> samples = causticSamples(scene, co);
+  const bool spectral = o.dispersion == DispersionMode::Spectral;
+  Landings landed(scene.meshes.size());
+  for (const int li : causticLights(scene)) {
+    const Light& light = scene.lights[size_t(li)];
+    for (size_t ei = 0; ei < scene.elements.size(); ++ei) {
+      CausticAperture ap;
+      std::string why;
+      if (!causticAperture(scene, light, scene.elements[ei], ap, why)) {
+        plan.notes.push_back("light " + std::to_string(li) + ", element \"" + scene.elements[ei].name +
+                             "\": skipped, " + why);
+        continue;
+      }
+      for (size_t si = 0; si < samples.size(); ++si) {
+        const PairTracer tr{rays, light, ap, samples[si], int(ei), spectral, o.max_depth};
+        CausticMesh m = tracePair(tr, o, landed, plan.traced);
+        if (m.triangles.empty()) {
+          if (si == 0)
+            plan.notes.push_back("light " + std::to_string(li) + ", element \"" + scene.elements[ei].name +
+                                 "\": no light reaches it and leaves it");
+          continue;
+        }
+        m.light = li;
+        m.element = int(ei);
+        m.sample = int(si);
+        m.anchor = Vec3(scene.elements[ei].local_to_world[3]);
+        plan.meshes.push_back(std::move(m));
+      }
+    }
+  }
+  std::vector<CausticReceiver> planar = planarReceivers(scene);
+  std::vector<bool> is_planar(scene.meshes.size(), false);
+  for (CausticReceiver& r : planar) {
+    is_planar[size_t(r.mesh)] = true;
+    chooseWindow(r, landed[size_t(r.mesh)], o.cells);
+  }
+  for (size_t m = 0; m < landed.size(); ++m)
+    if (!is_planar[m] && !landed[m].empty())
+      plan.notes.push_back("mesh \"" + scene.meshes[m].name +
+                           "\" receives caustic light but is not planar: not drawn (planar receivers only)");
+  std::sort(planar.begin(), planar.end(),
+            [](const CausticReceiver& a, const CausticReceiver& b) { return a.landed_power > b.landed_power; });
+  for (const CausticReceiver& r : planar) {
+    if (!(r.landed_power > 0)) break;
+    if (int(plan.receivers.size()) == kMaxCausticReceivers) {
+      plan.notes.push_back("mesh \"" + scene.meshes[size_t(r.mesh)].name + "\": not drawn, more than " +
+                           std::to_string(kMaxCausticReceivers) + " receivers");
+      continue;
+    }
+    plan.receivers.push_back(r);
+  }
+  plan.elapsed_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return plan;
+}
+
+}  // namespace pvrr

@@ -1,0 +1,80 @@
+// The raster caustics' CPU side (issue 23 item 2; pvrr/gl/caustic_pass.h draws them; docs/caustics.md
+// "Raster caustics"). GL-free.
+//
+// Per light with caustics on (Light::caustics), per element and per wavelength sample, the reference's photons
+// (pvrr/trace/light_tracer.h: the same aperture, the same exact transport, followPhoton) are traced at the
+// vertices of a grid over the aperture instead of at jittered points: a "photon mesh". A cell whose four
+// corners took the same path (all left the element, after as many specular events, towards the same receiver)
+// is kept as two triangles; a cell whose corners differ (the element's rim, a shadow's edge, total internal
+// reflection setting in) is traced again on a finer sub-grid and its consistent sub-cells kept. The GPU
+// rasterizes the mesh into a caustic map over the aperture (one photon per texel, its exit ray and power
+// interpolated between exact vertices) and splats the photons into the receivers' light maps.
+//
+// Receivers: the environment meshes that are planar (quads, grounds, flat meshes: every triangle in one
+// plane), as the reference's receiver rectangles; each map covers a window about the caustic light landing on
+// it (the square about the landed power's centroid holding kWindowQuantile of it, enlarged kWindowScale
+// times), at most kMaxCausticReceivers receivers, by landed power. Curved receivers get no caustic light; the
+// notes say so when photons land on one.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "pvrr/scene/render_desc.h"
+#include "pvrr/trace/irradiance_grid.h"
+#include "pvrr/trace/light_tracer.h"
+
+namespace pvrr {
+
+inline constexpr int kMaxCausticReceivers = 4;
+
+struct CausticPlanOptions {
+  int grid = 64;      // aperture cells per side traced at their corners
+  int refine = 8;     // sub-cells per side of a cell whose corners differ
+  int cells = 256;    // light-map cells along a window's longer side
+  int max_depth = 8;  // specular events before a photon is absorbed (the reference's default)
+  DispersionMode dispersion = DispersionMode::Off;
+  int spectral_samples = 16;
+};
+
+// One exact photon at a mesh vertex: where it left its element and how much power per unit aperture measure
+// it carries (W/m^2 of aperture for a directional light, W per unit tangent-plane area for a point light,
+// after the element's reflectance or Fresnel transmittances and the sample's colour weight).
+struct CausticVertex {
+  Vec2 xy{0};  // aperture coordinates
+  Vec3 origin{0}, direction{0};
+  Vec3 power_density{0};
+};
+
+struct CausticMesh {
+  int light = -1, element = -1, sample = 0;
+  CausticAperture aperture;
+  std::vector<CausticVertex> vertices;
+  std::vector<uint32_t> triangles;  // three indices each
+  Vec3 anchor{0};                   // world point the GPU's positions are relative to: the element's origin
+  double lost_fraction = 0;         // aperture area of cells dropped for inconsistent corners, over the traced area
+};
+
+struct CausticReceiver {
+  int mesh = -1;            // Scene::meshes index
+  ReceiverRect full;        // the mesh's rectangle in its plane (cells unused)
+  ReceiverRect window;      // the light map: part of `full`, with its cells
+  double landed_power = 0;  // scalar power of the vertex photons landing on it (the choice's measure)
+};
+
+struct CausticPlan {
+  std::vector<CausticMesh> meshes;
+  std::vector<CausticReceiver> receivers;
+  std::vector<std::string> notes;  // pairs skipped, receivers not mapped, with the reason
+  long long traced = 0;            // exact photons traced at vertices
+  double elapsed_ms = 0;
+};
+
+// The lights whose caustics are on (directional and point lights with Light::caustics).
+std::vector<int> causticLights(const Scene& scene);
+// The scene's planar environment meshes, as receiver rectangles (their bounding rectangle in their plane).
+std::vector<CausticReceiver> planarReceivers(const Scene& scene);
+// Traces the photon meshes of every light with caustics on and chooses the receivers' windows.
+// Throws pvrr::Error for options out of range.
+CausticPlan planCaustics(const RayScene& rays, const CausticPlanOptions& options);
+
+}  // namespace pvrr
