@@ -12,6 +12,7 @@ uniform vec3 u_view_origin;    // the point rays come from (the camera, or the v
 #include "outputs.glsl"
 #include "shading.glsl"
 #include "shadow_lookup.glsl"
+#include "ambient_occlusion.glsl"
 #if defined(FACETED)
 flat in vec3 v_face_normal;
 flat in vec3 v_face_light;
@@ -34,6 +35,11 @@ void main() {
   vec3 n = normalize(v_normal);
   if (dot(n, v_pos - u_view_origin) > 0.0) n = -n;  // two-sided: face the viewer, as the tracer does
   o_color = vec4(shadeDiffuse(albedo, v_pos, n), 1.0);
+#endif
+#if defined(AMBIENT_OCCLUSION) && defined(FACETED)
+  o_color.rgb -= albedo * u_ambient * ambientOcclusion(v_pos, v_face_normal);  // the ambient term's occluded part
+#elif defined(AMBIENT_OCCLUSION)
+  o_color.rgb -= albedo * u_ambient * ambientOcclusion(v_pos, n);
 #endif
   o_seen = vec4(v_pos, 1.0);
   o_surface = vec4(0.0);

@@ -13,6 +13,7 @@
 namespace pvrr::gl {
 
 class ShadowPass;
+class AoFields;
 
 // The uniforms of shaders/shading.glsl, for a pass whose camera origin is `origin`.
 void setLights(const Program& p, const Scene& scene, const Vec3& origin);
@@ -43,6 +44,8 @@ class EnvironmentPass {
   void drawCasters(const Program& p, const Mat4& view_proj, const Vec3& origin) const;
   // The shadow maps the meshes' shading reads in every pass (null: none). Set by the renderer.
   void setShadows(const ShadowPass* shadows) { shadows_ = shadows; }
+  // The ambient occlusion fields the meshes' shading reads in every pass (null: none). Set by the renderer.
+  void setAoFields(const AoFields* ao) { ao_ = ao; }
 
  private:
   // The environment meshes' bounding boxes relative to `origin`.
@@ -60,6 +63,7 @@ class EnvironmentPass {
   std::vector<std::array<Vec3, 2>> env_bounds;  // per environment mesh: its bounding box, relative to its anchor
   std::vector<Texture> textures;  // environment textures, in Scene::textures order
   const ShadowPass* shadows_ = nullptr;
+  const AoFields* ao_ = nullptr;
 };
 
 }  // namespace pvrr::gl

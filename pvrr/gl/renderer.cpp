@@ -13,6 +13,7 @@
 #include <algorithm>
 
 #include "pvrr/base/error.h"
+#include "pvrr/gl/ao_fields.h"
 #include "pvrr/gl/cube_pass.h"
 #include "pvrr/gl/gl.h"
 #include "pvrr/gl/pvrr_pass.h"
@@ -67,6 +68,7 @@ struct Renderer::Impl {
   Programs programs;
   EnvironmentPass environment;
   std::unique_ptr<ShadowPass> shadows;  // made with the first context() (it needs the texture-unit count)
+  std::unique_ptr<AoFields> ao_fields;  // likewise
   MeshPool meshes;
   ElementGridCache grid_cache;
   int max_texture_size = 0, max_texture_units = 0;
@@ -88,6 +90,8 @@ struct Renderer::Impl {
       limits = queryGlLimits();
       shadows = std::make_unique<ShadowPass>(scene, programs, environment, max_texture_units);
       environment.setShadows(shadows.get());
+      ao_fields = std::make_unique<AoFields>(scene, max_texture_units);
+      environment.setAoFields(ao_fields.get());
     }
     return {scene, rays, options, programs, environment, meshes, grid_cache, max_texture_size, max_texture_units};
   }
@@ -143,6 +147,7 @@ RasterFrame Renderer::Impl::render(RenderMode mode, FrameCache* cache) {
   meshes.rewind();
   ModePass& pass = passFor(mode);
   shadows->update(out.stages);  // before the first passes, whose environment reads the maps too
+  ao_fields->note(out.stages);
   // The CPU stages and the first passes (and the nested passes of elements seen in other elements' maps).
   pass.prepare(mode, out.stages, cache);
   const auto t0 = Clock::now();
