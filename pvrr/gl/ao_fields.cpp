@@ -27,12 +27,8 @@ std::string ambientOcclusionSkipReason(const Scene& scene) {
 
 std::vector<std::string> aoDefines(const Scene& scene) {
   if (!ambientOcclusionSkipReason(scene).empty()) return {};
-  const AmbientOcclusionDesc& a = scene.render.ambient_occlusion;
-  int side = 1;
-  while (side * side < a.samples) ++side;
   return {"#define AMBIENT_OCCLUSION", "#define AO_FIELDS " + std::to_string(occluderCount(scene)),
-          "#define AO_POSITIONS " + std::to_string(a.positions),
-          "#define AO_DIRECTIONS " + std::to_string(a.directions), "#define AO_SIDE " + std::to_string(side)};
+          "#define AO_VOLUME " + std::to_string(kAoVolumeSize)};
 }
 
 AoFields::AoFields(const Scene& scene, int max_texture_units) : scene_(scene), unit_(max_texture_units - 4) {
@@ -41,18 +37,29 @@ AoFields::AoFields(const Scene& scene, int max_texture_units) : scene_(scene), u
   fields_ = buildAoFields(scene);
   build_ms_ = msSince(t0);
   if (fields_.empty()) return;
-  const int w = fields_[0].width();
+  // One RGBA8 3D texture: per field two blocks of n slices (O for +x, -x, +y, -y; then +z, -z), filtered
+  // linearly, clamped at the edges (the shader keeps z inside its block).
+  const size_t n = kAoVolumeSize, slice = n * n;
+  std::vector<uint8_t> texels(slice * n * 2 * fields_.size() * 4, 0);
+  for (size_t f = 0; f < fields_.size(); ++f)
+    for (size_t point = 0; point < slice * n && !fields_[f].volume.empty(); ++point)
+      for (size_t half = 0; half < 2; ++half)
+        for (size_t c = 0; c < 4; ++c)
+          texels[(((2 * f + half) * n * slice) + point) * 4 + c] = fields_[f].volume[point * 8 + half * 4 + c];
   glGenTextures(1, &texture_);
-  glBindTexture(GL_TEXTURE_2D_ARRAY, texture_);
+  glBindTexture(GL_TEXTURE_3D, texture_);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_R8, w, w, GLsizei(fields_.size()), 0, GL_RED, GL_UNSIGNED_BYTE, nullptr);
-  for (size_t i = 0; i < fields_.size(); ++i)
-    glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, GLint(i), w, w, 1, GL_RED, GL_UNSIGNED_BYTE, fields_[i].data.data());
+  glTexImage3D(GL_TEXTURE_3D, 0, GL_RGBA8, GLsizei(n), GLsizei(n), GLsizei(2 * n * fields_.size()), 0, GL_RGBA,
+               GL_UNSIGNED_BYTE, texels.data());
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAX_LEVEL, 0);
-  glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
+  glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAX_LEVEL, 0);
+  glBindTexture(GL_TEXTURE_3D, 0);
+  volume_bytes_ = texels.size();
   checkGlError("uploading the ambient occlusion fields");
 }
 
@@ -63,9 +70,9 @@ AoFields::~AoFields() {
 void AoFields::bind(const Program& p, const Vec3& origin) const {
   if (!active()) return;
   glActiveTexture(GLenum(GL_TEXTURE0 + unit_));
-  glBindTexture(GL_TEXTURE_2D_ARRAY, texture_);
+  glBindTexture(GL_TEXTURE_3D, texture_);
   glActiveTexture(GL_TEXTURE0);
-  p.set("u_ao_field", unit_);
+  p.set("u_ao_volume", unit_);
   for (size_t i = 0; i < fields_.size(); ++i) {
     const AoField& f = fields_[i];
     const Mat4 motion = occluderMotion(scene_, f.occluder);
@@ -93,9 +100,11 @@ void AoFields::note(FrameStages& stages) const {
   for (const AoField& f : fields_) bytes += f.bytes();
   const AmbientOcclusionDesc& a = scene_.render.ambient_occlusion;
   char text[256];
-  std::snprintf(text, sizeof text, "%s %zu field%s, %d^2 positions x %d^2 directions, %.1f MB (8 bit), built in %.0f ms",
+  std::snprintf(text, sizeof text,
+                "%s %zu field%s, %d^2 positions x %d^2 directions, %.1f MB (8 bit); occlusion volumes %d^3, %.1f MB; "
+                "built in %.0f ms",
                 noted_ ? "reused" : "built", fields_.size(), fields_.size() == 1 ? "" : "s", a.positions, a.directions,
-                double(bytes) / (1 << 20), build_ms_);
+                double(bytes) / (1 << 20), kAoVolumeSize, double(volume_bytes_) / (1 << 20), build_ms_);
   stages.ran(kAmbientOcclusionStage, noted_ ? 0 : build_ms_, int(fields_.size()), text);
   noted_ = true;
 }

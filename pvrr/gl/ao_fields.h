@@ -1,6 +1,7 @@
 // Ambient occlusion in every raster pass (render.ambient_occlusion; stage "ambient-occlusion"): the
-// displacement fields of the occluding objects (pvrr/method/ao_field.h), precomputed on the CPU when the
-// renderer is made and uploaded once as the layers of one GL_TEXTURE_2D_ARRAY of bytes; the environment's
+// displacement fields of the occluding objects (pvrr/method/ao_field.h) and the occlusion volumes evaluated
+// from them, precomputed on the CPU when the renderer is made; the volumes are uploaded once as one RGBA8
+// GL_TEXTURE_3D (two blocks of slices per occluder); the environment's
 // shading reads them in every pass (the second pass and the first passes: pvrr maps, envmap and impostor
 // cubes), so that a car's ground shadow seen in a mirror is the one seen directly
 // (shaders/ambient_occlusion.glsl). Each field follows its object's current rigid motion (EnvMesh::motion),
@@ -49,6 +50,7 @@ class AoFields {
   int unit_ = 0;
   unsigned texture_ = 0;
   double build_ms_ = 0;
+  size_t volume_bytes_ = 0;
   mutable bool noted_ = false;
 };
 

@@ -3,6 +3,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 
@@ -71,6 +72,9 @@ Vec3 directionOf(const Sample& p, int i, int j, int directions) {
 
 int texelOf(double u, int n) { return std::clamp(int(std::floor(u * n)), 0, n - 1); }
 
+// The occlusion volume of a field whose maps are built (below).
+void buildVolume(AoField& f);
+
 }  // namespace
 
 AoField buildAoField(const Scene& scene, int occluder, int positions, int directions) {
@@ -117,8 +121,118 @@ AoField buildAoField(const Scene& scene, int occluder, int positions, int direct
       }
     }
   });
+  buildVolume(f);
   f.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return f;
+}
+
+namespace {
+
+// The occlusion of the field at local offset p (from the centre) for the six axis normals.
+std::array<double, 6> axisOcclusion(const AoField& f, const Vec3& p) {
+  std::array<double, 6> o{};
+  const double dist = glm::length(p), radius = f.radius, c = dist * dist - radius * radius;
+  const int side = int(std::sqrt(double(kAoVolumeRays)));
+  auto add = [&](const Vec3& w, double weight) {
+    for (int a = 0; a < 3; ++a) o[size_t(2 * a + (w[a] < 0))] += weight * std::abs(w[a]);
+  };
+  if (dist > radius) {
+    const Vec3 axis = -p / dist;
+    const double sin_a = radius / dist, cos_a = std::sqrt(std::max(0.0, 1 - sin_a * sin_a));
+    Vec3 ta, tb;
+    basisAround(axis, ta, tb);
+    const double weight = 2 * (1 - cos_a) / (side * side);
+    for (int i = 0; i < side; ++i)
+      for (int j = 0; j < side; ++j) {
+        const Vec2 d = concentricDisk(Vec2((i + 0.5) / side * 2 - 1, (j + 0.5) / side * 2 - 1));
+        const double r2 = glm::dot(d, d), cos_t = 1 - r2 * (1 - cos_a), rd = std::sqrt(r2);
+        const double sin_t = std::sqrt(std::max(0.0, 1 - cos_t * cos_t));
+        const Vec2 around = rd > 0 ? d / rd : Vec2(0);
+        const Vec3 w = cos_t * axis + sin_t * (around.x * ta + around.y * tb);
+        const double b = glm::dot(p, w), disc = b * b - c;
+        if (disc < 0) continue;
+        const Vec3 e = p + (-b - std::sqrt(disc)) * w;
+        if (fieldDistance(f, e / glm::length(e), w) < kInf) add(w, weight);
+      }
+  } else {
+    // The whole sphere of directions, each cell of the octahedral map one (equal-area to a factor of about 2:
+    // weighted by its solid angle, the Jacobian of octDecode, here by the normalisation's 1 / |v|^3).
+    double total = 0;
+    std::vector<std::pair<Vec3, double>> dirs;
+    for (int i = 0; i < 2 * side; ++i)
+      for (int j = 0; j < 2 * side; ++j) {
+        const Vec2 uv((i + 0.5) / (2 * side), (j + 0.5) / (2 * side));
+        const Vec2 q = uv * 2.0 - Vec2(1.0);
+        const double zl = 1 - std::abs(q.x) - std::abs(q.y);
+        const Vec3 v(zl >= 0 ? q.x : (1 - std::abs(q.y)) * (q.x >= 0 ? 1 : -1),
+                     zl >= 0 ? q.y : (1 - std::abs(q.x)) * (q.y >= 0 ? 1 : -1), zl);
+        const double l = glm::length(v);
+        dirs.push_back({v / l, 1 / (l * l * l)});
+        total += 1 / (l * l * l);
+      }
+    for (const auto& [w, jac] : dirs) {
+      const double b = glm::dot(p, w);
+      const double t_exit = -b + std::sqrt(std::max(0.0, b * b - c));
+      const Vec3 e = p + t_exit * w;
+      if (fieldDistance(f, e / glm::length(e), -w) < t_exit) add(w, 4 * jac / total);  // 4 pi / pi
+    }
+  }
+  for (double& v : o) v = std::min(1.0, v);
+  return o;
+}
+
+void buildVolume(AoField& f) {
+  const int n = kAoVolumeSize;
+  f.volume.assign(size_t(n) * size_t(n) * size_t(n) * 8, 0);
+  tbb::parallel_for(0, n * n, [&](int jk) {
+    const int j = jk % n, k = jk / n;
+    for (int i = 0; i < n; ++i) {
+      const Vec3 t(2 * (i + 0.5) / n - 1, 2 * (j + 0.5) / n - 1, 2 * (k + 0.5) / n - 1);
+      const Vec3 p(aoUnwarp(t.x, f.radius), aoUnwarp(t.y, f.radius), aoUnwarp(t.z, f.radius));
+      const std::array<double, 6> o = axisOcclusion(f, p);
+      uint8_t* texel = &f.volume[(size_t(k) * size_t(n) * size_t(n) + size_t(j) * size_t(n) + size_t(i)) * 8];
+      for (int a = 0; a < 6; ++a) texel[a] = uint8_t(std::lround(o[size_t(a)] * 255));
+    }
+  });
+}
+
+}  // namespace
+
+double volumeOcclusion(const AoField& f, const Mat4& motion, const Vec3& x_world, const Vec3& n_world) {
+  if (f.volume.empty()) return 0;
+  const Mat3 r(motion);
+  const Vec3 p = glm::transpose(r) * (x_world - Vec3(motion[3])) - f.centre, n = glm::transpose(r) * n_world;
+  if (f.radius * f.radius < kAoMinCone * glm::dot(p, p)) return 0;
+  const int sz = kAoVolumeSize;
+  // Trilinear between grid points at texture coordinates (i + 0.5) / n, clamped at the outermost (GL's
+  // GL_LINEAR with GL_CLAMP_TO_EDGE).
+  double g[3];
+  int i0[3];
+  double fr[3];
+  for (int a = 0; a < 3; ++a) {
+    g[a] = std::clamp((aoWarp(p[a], f.radius) + 1) / 2 * sz - 0.5, 0.0, double(sz - 1));
+    i0[a] = std::min(int(std::floor(g[a])), sz - 2);
+    fr[a] = g[a] - i0[a];
+  }
+  double o[6] = {};
+  for (int c = 0; c < 8; ++c) {
+    const int dx = c & 1, dy = (c >> 1) & 1, dz = c >> 2;
+    const double w = (dx ? fr[0] : 1 - fr[0]) * (dy ? fr[1] : 1 - fr[1]) * (dz ? fr[2] : 1 - fr[2]);
+    const uint8_t* texel =
+        &f.volume[(size_t(i0[2] + dz) * size_t(sz) * size_t(sz) + size_t(i0[1] + dy) * size_t(sz) + size_t(i0[0] + dx)) * 8];
+    for (int a = 0; a < 6; ++a) o[a] += w * texel[a] / 255.0;
+  }
+  double sum = 0;
+  for (int a = 0; a < 3; ++a) sum += n[a] * n[a] * o[2 * a + (n[a] < 0)];
+  return sum;
+}
+
+double volumeVisibility(const std::vector<AoField>& fields, const Scene& scene, const Vec3& x, const Vec3& n,
+                        int receiver) {
+  double occluded = 0;
+  for (const AoField& f : fields)
+    if (f.occluder != receiver) occluded += volumeOcclusion(f, occluderMotion(scene, f.occluder), x, n);
+  return std::max(0.0, 1 - std::min(1.0, occluded));
 }
 
 std::vector<AoField> buildAoFields(const Scene& scene) {

@@ -600,7 +600,7 @@ ElementDesc readElement(const Ctx& c, const json* j, const std::string& path, si
   return e;
 }
 
-// render.ambient_occlusion: true, false, or {"positions", "directions", "samples", "reference_samples"} (on).
+// render.ambient_occlusion: true, false, or {"positions", "directions", "reference_samples"} (on).
 AmbientOcclusionDesc readAmbientOcclusion(const Ctx& c, const Obj& render) {
   AmbientOcclusionDesc a;
   const json* j = render.get("ambient_occlusion");
@@ -609,12 +609,11 @@ AmbientOcclusionDesc readAmbientOcclusion(const Ctx& c, const Obj& render) {
     return a;
   }
   Obj o(c, j, render.at("ambient_occlusion"),
-        "true, false or an object {\"positions\", \"directions\", \"samples\", \"reference_samples\"}",
-        {"positions", "directions", "samples", "reference_samples"});
+        "true, false or an object {\"positions\", \"directions\", \"reference_samples\"}",
+        {"positions", "directions", "reference_samples"});
   a.on = true;
   a.positions = o.integer("positions", 4, 128, a.positions);
   a.directions = o.integer("directions", 4, 64, a.directions);
-  a.samples = o.integer("samples", 1, 64, a.samples);
   a.reference_samples = o.integer("reference_samples", 1, 4096, a.reference_samples);
   return a;
 }
