@@ -159,9 +159,10 @@ std::array<double, 6> axisOcclusion(const AoField& f, const Vec3& p) {
     // weighted by its solid angle, the Jacobian of octDecode, here by the normalisation's 1 / |v|^3).
     double total = 0;
     std::vector<std::pair<Vec3, double>> dirs;
-    for (int i = 0; i < 2 * side; ++i)
-      for (int j = 0; j < 2 * side; ++j) {
-        const Vec2 uv((i + 0.5) / (2 * side), (j + 0.5) / (2 * side));
+    const int inside = kAoVolumeInsideSide;
+    for (int i = 0; i < inside; ++i)
+      for (int j = 0; j < inside; ++j) {
+        const Vec2 uv((i + 0.5) / inside, (j + 0.5) / inside);
         const Vec2 q = uv * 2.0 - Vec2(1.0);
         const double zl = 1 - std::abs(q.x) - std::abs(q.y);
         const Vec3 v(zl >= 0 ? q.x : (1 - std::abs(q.y)) * (q.x >= 0 ? 1 : -1),
@@ -202,7 +203,8 @@ double volumeOcclusion(const AoField& f, const Mat4& motion, const Vec3& x_world
   if (f.volume.empty()) return 0;
   const Mat3 r(motion);
   const Vec3 p = glm::transpose(r) * (x_world - Vec3(motion[3])) - f.centre, n = glm::transpose(r) * n_world;
-  if (f.radius * f.radius < kAoMinCone * glm::dot(p, p)) return 0;
+  const double fade = aoFade(f.radius * f.radius / std::max(glm::dot(p, p), 1e-300));
+  if (fade <= 0) return 0;
   const int sz = kAoVolumeSize;
   // Trilinear between grid points at texture coordinates (i + 0.5) / n, clamped at the outermost (GL's
   // GL_LINEAR with GL_CLAMP_TO_EDGE).
@@ -224,7 +226,7 @@ double volumeOcclusion(const AoField& f, const Mat4& motion, const Vec3& x_world
   }
   double sum = 0;
   for (int a = 0; a < 3; ++a) sum += n[a] * n[a] * o[2 * a + (n[a] < 0)];
-  return sum;
+  return fade * sum;
 }
 
 double volumeVisibility(const std::vector<AoField>& fields, const Scene& scene, const Vec3& x, const Vec3& n,

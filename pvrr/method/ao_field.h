@@ -29,6 +29,8 @@
 // reads sum n_i^2 O(sign(n_i) axis_i), exact for axis normals, such as a ground under a car that turns about
 // the vertical). A fragment reads it trilinearly: two texture lookups per occluder.
 #pragma once
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -38,9 +40,13 @@ namespace pvrr {
 
 inline constexpr double kAoRadiusMargin = 1e-3;  // relative widening of the bounding sphere
 inline constexpr uint8_t kAoMiss = 255;          // a field ray that meets nothing
-// A sphere seen within a cone narrower than this (sin^2 of its half angle: farther than about 22 radii) is left
-// out: it hides at most this cosine-weighted fraction (shaders/ambient_occlusion.glsl's AO_MIN_CONE).
-inline constexpr double kAoMinCone = 0.002;
+// A sphere seen within a cone narrower than this (sin^2 of its half angle: farther than 10 radii) is left out:
+// it hides at most this cosine-weighted fraction (less by how much of the sphere the occluder fills); a
+// volume's occlusion fades out linearly from twice this (7 radii) so that no edge shows
+// (shaders/ambient_occlusion.glsl's AO_MIN_CONE).
+inline constexpr double kAoMinCone = 0.01;
+// The fade: 1 at sin^2 >= 2 kAoMinCone, 0 at kAoMinCone.
+inline double aoFade(double sin2) { return std::clamp(sin2 / kAoMinCone - 1, 0.0, 1.0); }
 
 struct AoField {
   int occluder = -1;        // EnvMesh::occluder
@@ -58,8 +64,9 @@ struct AoField {
   size_t bytes() const { return data.size(); }
 };
 
-inline constexpr int kAoVolumeSize = 48;      // grid points per axis
-inline constexpr int kAoVolumeRays = 64;      // rays per grid point (cone or whole sphere)
+inline constexpr int kAoVolumeSize = 40;       // grid points per axis
+inline constexpr int kAoVolumeRays = 64;        // rays per grid point outside the sphere (its cone)
+inline constexpr int kAoVolumeInsideSide = 12;  // inside: the whole sphere, kAoVolumeInsideSide^2 rays
 
 // The warped coordinate t in (-1, 1) of offset x from the centre (radius r), and back.
 inline double aoWarp(double x, double r) { return x / (std::abs(x) + r); }

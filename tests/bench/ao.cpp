@@ -2,9 +2,12 @@
 // the field's precomputation time and size recorded"). Figures: docs/performance.md "Ambient occlusion".
 //
 // BM_AoFrame: the same frame with and without ambient occlusion, interleaved in one run (A B A B ...), so that
-// the machine's load affects both alike; counters: the median frame of each and their difference (ao_ms).
+// the machine's load affects both alike; counters: the median frame of each and their difference (ao_ms), in
+// wall-clock and in CPU time of the whole process (cpu_*: llvmpipe's threads included).
 // BM_AoFieldBuild: one occluder's field (the overtaking car's six boxes) at the default sampling.
 #include <benchmark/benchmark.h>
+
+#include <sys/resource.h>
 
 #include <algorithm>
 #include <vector>
@@ -27,6 +30,13 @@ Scene load(const std::string& name, std::vector<std::string> sets) {
   return s;
 }
 
+// The process's CPU time (user + system, every thread: llvmpipe's rasterizer threads included), ms.
+double cpuMs() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return (u.ru_utime.tv_sec + u.ru_stime.tv_sec) * 1e3 + (u.ru_utime.tv_usec + u.ru_stime.tv_usec) * 1e-3;
+}
+
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0 : v[v.size() / 2];
@@ -46,15 +56,23 @@ void BM_AoFrame(benchmark::State& state, const char* name, RenderMode mode, std:
   gl::Renderer r_off(off, rays_off, opt), r_on(on, rays_on, opt);
   r_off.render(mode);  // warm-up: shader compilation (and, with ambient occlusion, the fields)
   const gl::RasterFrame first = r_on.render(mode);
-  std::vector<double> with, without;
+  std::vector<double> with, without, cpu_with, cpu_without;
   for (auto _ : state) {
+    double c0 = cpuMs();
     without.push_back(r_off.render(mode).frame_ms);
+    double c1 = cpuMs();
     with.push_back(r_on.render(mode).frame_ms);
+    cpu_without.push_back(c1 - c0);
+    cpu_with.push_back(cpuMs() - c1);
   }
   const StageTiming* stage = first.stages.find("ambient-occlusion");
   state.counters["frame_ms"] = median(without);
   state.counters["frame_ao_ms"] = median(with);
   state.counters["ao_ms"] = median(with) - median(without);
+  // CPU time, which the machine's load inflates less than the wall clock.
+  state.counters["cpu_frame_ms"] = median(cpu_without);
+  state.counters["cpu_frame_ao_ms"] = median(cpu_with);
+  state.counters["cpu_ao_ms"] = median(cpu_with) - median(cpu_without);
   state.counters["fields"] = stage && stage->ran ? stage->count : 0;
   state.SetLabel(ctx->backendName() + " " + ctx->glRenderer() + (stage ? "; " + stage->note + stage->reason : ""));
 }
