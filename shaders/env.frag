@@ -13,6 +13,7 @@ uniform vec3 u_view_origin;    // the point rays come from (the camera, or the v
 #include "shading.glsl"
 #include "shadow_lookup.glsl"
 #include "caustic_lookup.glsl"
+#include "ambient_occlusion.glsl"
 #if defined(FACETED)
 flat in vec3 v_face_normal;
 flat in vec3 v_face_light;
@@ -38,6 +39,11 @@ void main() {
 #endif
 #if defined(CAUSTICS)
   o_color.rgb += albedo * causticIrradiance(v_pos);
+#endif
+#if defined(AMBIENT_OCCLUSION) && defined(FACETED)
+  o_color.rgb -= albedo * u_ambient * ambientOcclusion(v_pos, v_face_normal);  // the ambient term's occluded part
+#elif defined(AMBIENT_OCCLUSION)
+  o_color.rgb -= albedo * u_ambient * ambientOcclusion(v_pos, n);
 #endif
   o_seen = vec4(v_pos, 1.0);
   o_surface = vec4(0.0);

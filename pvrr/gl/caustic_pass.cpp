@@ -4,6 +4,7 @@
 
 #include "pvrr/base/error.h"
 #include "pvrr/gl/gl.h"
+#include "pvrr/gl/texture_units.h"
 #include "pvrr/gl/stage_notes.h"
 
 namespace pvrr::gl {
@@ -40,7 +41,7 @@ std::vector<std::string> causticDefines(const Scene& scene) {
 
 CausticPass::CausticPass(const Scene& scene, const RayScene& rays, const Programs& programs, int max_texture_units,
                          int map_size)
-    : scene_(scene), rays_(rays), programs_(programs), unit_(max_texture_units - 4), map_size_(map_size) {
+    : scene_(scene), rays_(rays), programs_(programs), unit_(units::causticMaps(max_texture_units)), map_size_(map_size) {
   if (map_size_ < 1) throw Error("caustics: the caustic map needs a positive size");
   if (!active()) return;
   programs_.built("caustic_map.vert", "caustic_map.frag", {});  // built now: a compile error comes with the renderer

@@ -42,8 +42,8 @@ struct CausticMap {
 
 class CausticPass {
  public:
-  // map_size: the caustic map's side (photons per side of each aperture). Its unit is the fourth from the
-  // last of `max_texture_units` (the shadow maps take the last three).
+  // map_size: the caustic map's side (photons per side of each aperture). Its unit is
+  // units::causticMaps (pvrr/gl/texture_units.h).
   CausticPass(const Scene& scene, const RayScene& rays, const Programs& programs, int max_texture_units,
               int map_size = 512);
   ~CausticPass();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "pvrr/gl/ao_fields.h"
 #include "pvrr/gl/gl.h"
 #include "pvrr/gl/impostor_maps.h"
 #include "pvrr/gl/caustic_pass.h"
@@ -155,6 +156,7 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
     setLights(*p, scene, origin);
     if (shadows_) shadows_->bind(*p, origin);
     if (caustics_) caustics_->bind(*p, origin);
+    if (ao_) ao_->bind(*p, origin);
   }
   glActiveTexture(GL_TEXTURE0);
   // Back faces of closed convex meshes that near clipping cannot cut open (RendererOptions::cull_back_faces,
@@ -185,6 +187,7 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
     p.use();
     p.set("u_offset", glm::vec3(mesh.anchor - origin));
     p.set("u_albedo", glm::vec3(mat.color));
+    if (ao_) ao_->setReceiver(p, mesh.occluder);
     if (env_textured[m]) glBindTexture(GL_TEXTURE_2D, textures[size_t(mat.texture)].name());
     gl::draw(env_meshes[m]);
   }

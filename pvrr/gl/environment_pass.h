@@ -14,6 +14,7 @@ namespace pvrr::gl {
 
 class ShadowPass;
 class CausticPass;
+class AoFields;
 
 // The uniforms of shaders/shading.glsl, for a pass whose camera origin is `origin`.
 void setLights(const Program& p, const Scene& scene, const Vec3& origin);
@@ -46,6 +47,8 @@ class EnvironmentPass {
   void setShadows(const ShadowPass* shadows) { shadows_ = shadows; }
   // The caustic light maps the meshes' shading adds (null: none). Set by the renderer.
   void setCaustics(const CausticPass* caustics) { caustics_ = caustics; }
+  // The ambient occlusion fields the meshes' shading reads in every pass (null: none). Set by the renderer.
+  void setAoFields(const AoFields* ao) { ao_ = ao; }
 
  private:
   // The environment meshes' bounding boxes relative to `origin`.
@@ -64,6 +67,7 @@ class EnvironmentPass {
   std::vector<Texture> textures;  // environment textures, in Scene::textures order
   const ShadowPass* shadows_ = nullptr;
   const CausticPass* caustics_ = nullptr;
+  const AoFields* ao_ = nullptr;
 };
 
 }  // namespace pvrr::gl

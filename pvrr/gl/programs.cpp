@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "pvrr/gl/caustic_pass.h"
+#include "pvrr/gl/ao_fields.h"
 #include "pvrr/gl/shadow_pass.h"
 
 namespace pvrr::gl {
@@ -43,6 +44,7 @@ const Program& Programs::env(bool faceted, bool textured, bool planes, bool with
   if (planes) d.push_back("#define PLANES");
   for (const std::string& s : shadowDefines(scene_)) d.push_back(s);
   for (const std::string& s : causticDefines(scene_)) d.push_back(s);
+  for (const std::string& s : aoDefines(scene_)) d.push_back(s);
   return built("env.vert", "env.frag", d);
 }
 

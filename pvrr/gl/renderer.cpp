@@ -15,6 +15,7 @@
 
 #include "pvrr/base/error.h"
 #include "pvrr/gl/caustic_pass.h"
+#include "pvrr/gl/ao_fields.h"
 #include "pvrr/gl/cube_pass.h"
 #include "pvrr/gl/gl.h"
 #include "pvrr/gl/pvrr_pass.h"
@@ -70,6 +71,7 @@ struct Renderer::Impl {
   EnvironmentPass environment;
   std::unique_ptr<ShadowPass> shadows;  // made with the first context() (it needs the texture-unit count)
   std::unique_ptr<CausticPass> caustics;  // likewise
+  std::unique_ptr<AoFields> ao_fields;  // likewise
   MeshPool meshes;
   ElementGridCache grid_cache;
   int max_texture_size = 0, max_texture_units = 0;
@@ -93,6 +95,8 @@ struct Renderer::Impl {
       environment.setShadows(shadows.get());
       caustics = std::make_unique<CausticPass>(scene, rays, programs, max_texture_units, options.caustic_map_size);
       environment.setCaustics(caustics.get());
+      ao_fields = std::make_unique<AoFields>(scene, max_texture_units);
+      environment.setAoFields(ao_fields.get());
     }
     return {scene, rays, options, programs, environment, meshes, grid_cache, max_texture_size, max_texture_units};
   }
@@ -151,6 +155,7 @@ RasterFrame Renderer::Impl::render(RenderMode mode, FrameCache* cache) {
   ModePass& pass = passFor(mode);
   shadows->update(out.stages);  // before the first passes, whose environment reads the maps too
   caustics->update(out.stages);
+  ao_fields->note(out.stages);
   // The CPU stages and the first passes (and the nested passes of elements seen in other elements' maps).
   pass.prepare(mode, out.stages, cache);
   const auto t0 = Clock::now();

@@ -8,6 +8,7 @@
 #include "cad/tessellate.h"
 #include "pvrr/gl/environment_pass.h"
 #include "pvrr/gl/gl.h"
+#include "pvrr/gl/texture_units.h"
 #include "pvrr/gl/stage_notes.h"
 #include "pvrr/trace/shadow_rays.h"
 
@@ -71,7 +72,7 @@ ShadowPass::ShadowPass(const Scene& scene, const Programs& programs, const Envir
       programs_(programs),
       environment_(environment),
       layout_(shadowLayout(scene)),
-      unit_(max_texture_units - 3) {
+      unit_(units::shadowMaps(max_texture_units)) {
   if (!active()) return;
   makeLayers();
   makeTextures();

@@ -46,7 +46,7 @@ class ShadowPass {
   // The map side (texels) of every layer.
   static constexpr int kMapSize = 1024;
 
-  // The maps' units are the last three of `max_texture_units` (GL_MAX_TEXTURE_IMAGE_UNITS), as
+  // The maps' units are units::shadowMaps and the two after it (pvrr/gl/texture_units.h), as
   // GL_TEXTURE_2D_ARRAY bindings, which no other program of the renderer samples there.
   ShadowPass(const Scene& scene, const Programs& programs, const EnvironmentPass& environment, int max_texture_units);
   ~ShadowPass();

@@ -52,6 +52,18 @@ inline constexpr int kMaxDepthLimit = 64;
 // The most secant steps render.refine accepts: the shader's search loop is unrolled by it.
 inline constexpr int kMaxRefineSteps = 16;
 
+// render.ambient_occlusion (pvrr/trace/ambient_occlusion.h): off by default. The raster path's displacement
+// fields (pvrr/method/ao_field.h) sample `positions`^2 points on each occluding object's bounding sphere
+// (octahedral map) and `directions`^2 rays from each (concentric map); each fragment casts `samples` rays per
+// occluder; the reference casts `reference_samples` rays per shaded point.
+struct AmbientOcclusionDesc {
+  bool on = false;
+  int positions = 64;
+  int directions = 16;
+  int samples = 16;
+  int reference_samples = 256;
+};
+
 // The settings of the "render" section with their defaults: the defaults of the scene format.
 struct RenderDesc {
   RenderMode mode = RenderMode::Pvrr;
@@ -71,6 +83,7 @@ struct RenderDesc {
   int spectral_samples = 16;
   Vec3 background{0.55, 0.7, 0.9};  // linear RGB of escaping rays (the sky)
   ViewpointSolver viewpoint_solver = ViewpointSolver::kAuto;
+  AmbientOcclusionDesc ambient_occlusion;
 };
 
 }  // namespace pvrr

@@ -43,6 +43,12 @@ struct EnvMesh {
   // makeSphereMesh): where near clipping cannot cut the solid open, its back faces are hidden by its front
   // faces, and the renderer culls them (RendererOptions::cull_back_faces).
   bool closed_convex = false;
+  // The ambient occluder it belongs to (EnvObjectDesc::occluder, numbered from 0 in the order of their first
+  // mesh; pvrr/trace/ambient_occlusion.h), or -1.
+  int occluder = -1;
+  // The rigid motion from its placed pose (Scene::placed_meshes) to now (applyAnimation); identity for a mesh
+  // that does not move. Its ambient occlusion field moves with it.
+  Mat4 motion{1.0};
 };
 
 struct Light {

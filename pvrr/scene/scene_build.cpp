@@ -182,6 +182,15 @@ void checkMeshParts(const MeshData& md, const std::string& where) {
 
 // One environment mesh per material part of a loaded mesh, each holding only the vertices its triangles use,
 // with the part's material (added to the scene).
+// The number of ambient occluder `name` (EnvObjectDesc::occluder): in the order first met; -1 for none.
+int occluderId(std::vector<std::string>& names, const std::string& name) {
+  if (name.empty()) return -1;
+  const auto it = std::find(names.begin(), names.end(), name);
+  if (it != names.end()) return int(it - names.begin());
+  names.push_back(name);
+  return int(names.size()) - 1;
+}
+
 void addMeshParts(Scene& scene, const EnvMesh& whole, const std::vector<MeshPart>& parts, const std::string& what,
                   size_t object, bool animated) {
   for (const MeshPart& p : parts) {
@@ -212,6 +221,7 @@ void addMeshParts(Scene& scene, const EnvMesh& whole, const std::vector<MeshPart
     }
     sub.material = int(scene.materials.size());
     scene.materials.push_back(mat);
+    sub.occluder = whole.occluder;
     scene.mesh_object.push_back(object);
     scene.placed_meshes.push_back(animated ? sub : EnvMesh{});
     scene.meshes.push_back(std::move(sub));
@@ -367,6 +377,7 @@ Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
   ob.width = desc.observer.image_width;
   ob.height = desc.observer.image_height;
 
+  std::vector<std::string> occluders;  // EnvObjectDesc::occluder names, numbered as met
   for (size_t i = 0; i < desc.environment.size(); ++i) {
     const EnvObjectDesc& o = desc.environment[i];
     const std::string what = file + ": environment[" + std::to_string(i) + "]" + (o.name.empty() ? "" : " (" + o.name + ")");
@@ -383,6 +394,7 @@ Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
       case EnvObjectDesc::Type::Mesh: mesh = loadedMesh(o, load_mesh, what, parts); break;
     }
     mesh.name = o.name.empty() ? std::string(nameOf(o.type)) + std::to_string(i) : o.name;
+    mesh.occluder = occluderId(occluders, o.occluder);
     if (!parts.empty()) {  // a file with its own materials (glTF): one mesh per part, the file's materials
       addMeshParts(scene, mesh, parts, what, i, o.animation.has_value());
       continue;
@@ -501,7 +513,8 @@ bool applyAnimation(Scene& scene, const SceneDesc& desc, double t_s) {
     EnvMesh& mesh = scene.meshes[m];
     const Vec3 anchor = mesh.anchor;
     const std::vector<glm::vec3> positions = mesh.positions;
-    moveMesh(scene.placed_meshes[m], motionAt(*o.animation, o.position, t_s), mesh);
+    mesh.motion = motionAt(*o.animation, o.position, t_s);
+    moveMesh(scene.placed_meshes[m], mesh.motion, mesh);
     moved = moved || anchor != mesh.anchor || positions != mesh.positions;
   }
   std::vector<Mat4> poses;

@@ -121,6 +121,10 @@ struct EnvObjectDesc {
   // Keyframed motion from the placed pose above, about `position` (pvrr/scene/animation.h); absent: it stays.
   std::optional<AnimationDesc> animation;
   bool dynamic = false;  // it may move (every animated object is dynamic)
+  // "ambient_occlusion": the occluder it belongs to when render.ambient_occlusion is on
+  // (pvrr/trace/ambient_occlusion.h): empty: none (the default); "object:<index>" (true): its own;
+  // "group:<name>" (a name): one occluder with the other objects of that name, which move together.
+  std::string occluder;
 };
 inline constexpr NameTable<EnvObjectDesc::Type, 5> kEnvObjectTypeNames = {{{EnvObjectDesc::Type::Mesh, "mesh"},
                                                                             {EnvObjectDesc::Type::Ground, "ground"},

@@ -240,7 +240,7 @@ EnvObjectDesc readEnvObject(const Ctx& c, const json* j, const std::string& path
   const std::string what = "an environment object {\"type\": " + alternatives<EnvObjectDesc::Type>() + ", ...}";
   using Type = EnvObjectDesc::Type;
   const Type type = peekChoice<Type>(c, j, path, what, "type");
-  std::vector<std::string> keys = {"type", "name", "material", "animation", "dynamic"};
+  std::vector<std::string> keys = {"type", "name", "material", "animation", "dynamic", "ambient_occlusion"};
   if (type == Type::Mesh) keys.insert(keys.end(), {"file", "transform"});
   if (type == Type::Ground) keys.insert(keys.end(), {"point", "normal", "size", "u_axis"});
   if (type == Type::Box) keys.insert(keys.end(), {"centre", "size", "rotation_deg", "axis_angle"});
@@ -252,6 +252,11 @@ EnvObjectDesc readEnvObject(const Ctx& c, const json* j, const std::string& path
   d.material = readMaterial(c, o.get("material"), o.at("material"));
   d.type = type;
   readMotion(c, o, d.animation, d.dynamic);
+  if (const json* a = o.get("ambient_occlusion")) {
+    if (a->is_boolean()) d.occluder = a->get<bool>() ? "object:" + std::to_string(index) : "";
+    else if (a->is_string() && !a->get<std::string>().empty()) d.occluder = "group:" + a->get<std::string>();
+    else o.expected("ambient_occlusion", "true, false or a group name (objects that move together)");
+  }
   if (type == Type::Mesh) {
     d.file = o.file("file", {".obj", ".ply", ".gltf", ".glb", ".stl"}, "OBJ, PLY, glTF or STL mesh");
     d.scale = Vec3(c.unit_m);
@@ -598,6 +603,24 @@ ElementDesc readElement(const Ctx& c, const json* j, const std::string& path, si
   return e;
 }
 
+// render.ambient_occlusion: true, false, or {"positions", "directions", "reference_samples"} (on).
+AmbientOcclusionDesc readAmbientOcclusion(const Ctx& c, const Obj& render) {
+  AmbientOcclusionDesc a;
+  const json* j = render.get("ambient_occlusion");
+  if (j->is_boolean()) {
+    a.on = j->get<bool>();
+    return a;
+  }
+  Obj o(c, j, render.at("ambient_occlusion"),
+        "true, false or an object {\"positions\", \"directions\", \"reference_samples\"}",
+        {"positions", "directions", "reference_samples"});
+  a.on = true;
+  a.positions = o.integer("positions", 4, 128, a.positions);
+  a.directions = o.integer("directions", 4, 64, a.directions);
+  a.reference_samples = o.integer("reference_samples", 1, 4096, a.reference_samples);
+  return a;
+}
+
 RenderDesc readRender(const Ctx& c, const json* j, const std::string& source) {
   RenderDesc r;  // its defaults are the format's
   r.output = (fs::path("out") / (fs::path(source).stem().string() + ".png")).string();
@@ -605,7 +628,7 @@ RenderDesc readRender(const Ctx& c, const json* j, const std::string& source) {
   Obj o(c, j, "render", "an object {\"mode\", \"map_size\", \"output\", ...}",
         {"mode", "map_size", "map_texels_per_pixel", "map_reuse_margin_deg", "impostor_iterations", "impostor_layers", "refine", "output",
          "max_depth", "dispersion", "spectral_samples",
-         "background", "viewpoint_solver"});
+         "background", "viewpoint_solver", "ambient_occlusion"});
   r.mode = o.choice<RenderMode>("mode", r.mode);
   r.map_size = o.integer("map_size", 16, kMaxImageSize, r.map_size);
   r.map_texels_per_pixel = o.number("map_texels_per_pixel", closed(0, 1e4), r.map_texels_per_pixel);
@@ -628,6 +651,7 @@ RenderDesc readRender(const Ctx& c, const json* j, const std::string& source) {
   r.spectral_samples = o.integer("spectral_samples", 3, 256, r.spectral_samples);
   r.background = o.vec3("background", VecKind::ColourNonNegative, r.background);
   r.viewpoint_solver = o.choice<ViewpointSolver>("viewpoint_solver", r.viewpoint_solver);
+  if (o.has("ambient_occlusion")) r.ambient_occlusion = readAmbientOcclusion(c, o);
   return r;
 }
 

@@ -33,14 +33,14 @@ Vec3 sampleTexture(const Texture& t, Vec2 uv) {
 }
 
 Vec3 shadeDiffuse(const Scene& scene, const DiffuseMaterial& m, const Vec3& p, const Vec3& n, Vec2 uv,
-                  const ShadowRays* shadows) {
+                  const ShadowRays* shadows, double ambient_visibility) {
   Vec3 albedo = m.color;
   if (m.texture >= 0) albedo *= sampleTexture(scene.textures[size_t(m.texture)], uv);
   Vec3 light(0.0);
   for (const Light& l : scene.lights) {
     switch (l.type) {
       case Light::Type::Ambient:
-        light += l.radiance;
+        light += ambient_visibility * l.radiance;
         break;
       case Light::Type::Directional: {
         const double cos_l = -glm::dot(n, l.direction);

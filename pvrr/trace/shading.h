@@ -19,7 +19,9 @@ namespace pvrr {
 inline constexpr double kMirrorBackAlbedo = 0.05;
 
 Vec3 sampleTexture(const Texture& t, Vec2 uv);
+// ambient_visibility: the ambient lights' term is multiplied by it (ambient occlusion,
+// pvrr/trace/ambient_occlusion.h; 1 without).
 Vec3 shadeDiffuse(const Scene& scene, const DiffuseMaterial& m, const Vec3& p, const Vec3& n_facing, Vec2 uv,
-                  const ShadowRays* shadows = nullptr);
+                  const ShadowRays* shadows = nullptr, double ambient_visibility = 1.0);
 
 }  // namespace pvrr

@@ -2,6 +2,8 @@
 // figure. Environment shading is pvrr/trace/shading.h, the same model the raster path uses, with shadow rays
 // (pvrr/trace/shadow_rays.h) for the lights whose shadows are on. A mirror's dark back is shaded unshadowed,
 // as the raster path shades it.
+// With render.ambient_occlusion on, the ambient lights' term of every environment hit is multiplied by its
+// visibility, estimated by hemisphere sampling (pvrr/trace/ambient_occlusion.h).
 //
 // Lens model (shared with the raster path): light passing a lens is weighted by the exact Fresnel
 // transmittance (1 - R) of each interface it crosses; the light a lens surface reflects is not added.

@@ -1,0 +1,104 @@
+// Presampled visibility around rigid objects, for ambient occlusion (pvrr/trace/ambient_occlusion.h defines
+// it): [Gaitatzes et al.]'s displacement fields. Per occluding object, at load time, with Embree:
+// - positional samples: `positions`^2 points on the object's bounding sphere (centre: its bounding box's
+//   centre in the placed pose; radius: the farthest vertex, widened by kAoRadiusMargin), one per texel of an
+//   octahedral map of the sphere (uniform enough, with a constant-time inverse);
+// - from each, `directions`^2 rays over the inward hemisphere, one per texel of a concentric map lifted by
+//   Malley's method (the paper's best sampling), in the frame basisAround(-s);
+// - per ray one byte: the distance to the object's first hit, in 254ths of the sphere's diameter, 255 when
+//   the ray misses (the paper's 8-bit maps). A field is (positions * directions)^2 bytes, one square atlas.
+// The field lives in the object's placed frame; the object's rigid motion (EnvMesh::motion) carries it.
+//
+// At run time (fieldVisibility here; shaders/ambient_occlusion.glsl the same in GLSL), per receiver point x
+// with normal n and per field:
+// - x outside the sphere: `samples` rays uniform over the cone of directions that meet the sphere, weighted by
+//   their solid angle and cosine; a ray that enters the sphere at e is occluded when the field's ray from the
+//   sample nearest e, in the same direction, hits (the paper's Algorithm 2, sampling only rays that meet the
+//   bounding sphere);
+// - x inside it (the ground under a car): `samples` cosine-distributed rays about n; the field's ray from
+//   the sample nearest the exit point e, back along the ray, hits at distance d; the object lies between x
+//   and e when d < |e - x|.
+// Occlusions of several fields add (a direction two of them hide is counted twice: an approximation); the
+// visibility is 1 minus their sum, at least 0.
+//
+// What a frame reads (the occlusion volume): casting the fragment's rays through the field costs llvmpipe
+// seconds a 1280 x 720 frame, so the field's occlusion is evaluated once, at load time, on a grid around the
+// occluder in its own frame (rigid: it moves with it), kAoVolumeSize^3 points at warped coordinates
+// t = x / (|x| + r) per axis (x from the sphere's centre: fine near the object, the whole space within
+// (-1, 1)), each holding the occlusion for the six axis normals +-x, +-y, +-z (an "ambient cube": a normal n
+// reads sum n_i^2 O(sign(n_i) axis_i), exact for axis normals, such as a ground under a car that turns about
+// the vertical). A fragment reads it trilinearly: two texture lookups per occluder.
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "pvrr/scene/scene.h"
+
+namespace pvrr {
+
+inline constexpr double kAoRadiusMargin = 1e-3;  // relative widening of the bounding sphere
+inline constexpr uint8_t kAoMiss = 255;          // a field ray that meets nothing
+// A sphere seen within a cone narrower than this (sin^2 of its half angle: farther than 10 radii) is left out:
+// it hides at most this cosine-weighted fraction (less by how much of the sphere the occluder fills); a
+// volume's occlusion fades out linearly from twice this (7 radii) so that no edge shows
+// (shaders/ambient_occlusion.glsl's AO_MIN_CONE).
+inline constexpr double kAoMinCone = 0.01;
+// The fade: 1 at sin^2 >= 2 kAoMinCone, 0 at kAoMinCone.
+inline double aoFade(double sin2) { return std::clamp(sin2 / kAoMinCone - 1, 0.0, 1.0); }
+
+struct AoField {
+  int occluder = -1;        // EnvMesh::occluder
+  Vec3 centre{0};           // bounding sphere in the placed pose (world)
+  double radius = 0;
+  int positions = 0;        // positional samples per side of the octahedral map
+  int directions = 0;       // direction samples per side of each concentric map
+  std::vector<uint8_t> data;  // width()^2 bytes, row v at v * width(): texel (p.x * directions + d.x,
+                              // p.y * directions + d.y) for positional texel p and direction texel d
+  // The occlusion volume: kAoVolumeSize^3 grid points (x fastest), per point 8 bytes: O for +x, -x, +y, -y,
+  // +z, -z in 255ths, then two zeros.
+  std::vector<uint8_t> volume;
+  double build_ms = 0;      // its precomputation (wall clock): field and volume
+  int width() const { return positions * directions; }
+  size_t bytes() const { return data.size(); }
+};
+
+inline constexpr int kAoVolumeSize = 40;       // grid points per axis
+inline constexpr int kAoVolumeRays = 64;        // rays per grid point outside the sphere (its cone)
+inline constexpr int kAoVolumeInsideSide = 12;  // inside: the whole sphere, kAoVolumeInsideSide^2 rays
+
+// The warped coordinate t in (-1, 1) of offset x from the centre (radius r), and back.
+inline double aoWarp(double x, double r) { return x / (std::abs(x) + r); }
+inline double aoUnwarp(double t, double r) { return r * t / (1 - std::abs(t)); }
+
+// Octahedral map of the unit sphere onto [0, 1]^2, and back.
+Vec2 octEncode(const Vec3& unit);
+Vec3 octDecode(Vec2 uv);
+
+// The field of occluder `occluder` (its meshes, in their placed pose; Scene::placed_meshes for an animated
+// one), with `positions`^2 positional and `directions`^2 directional samples.
+AoField buildAoField(const Scene& scene, int occluder, int positions, int directions);
+// A field per occluder (index = EnvMesh::occluder), with the scene's render.ambient_occlusion sampling.
+std::vector<AoField> buildAoFields(const Scene& scene);
+
+// The field's distance (metres) along the ray that enters the sphere at unit direction s from its centre in
+// direction w (both in the field's frame), or kInf when it misses.
+double fieldDistance(const AoField& f, const Vec3& s, const Vec3& w);
+// The cosine-weighted occlusion (0..1) one field casts at world point x with unit normal n, its object moved
+// by `motion` (rigid), with `samples` rays.
+double fieldOcclusion(const AoField& f, const Mat4& motion, const Vec3& x, const Vec3& n, int samples);
+// The visibility A(x, n) of the fields of every occluder but `receiver` (-1: none), each moved by its
+// meshes' current EnvMesh::motion.
+double fieldVisibility(const std::vector<AoField>& fields, const Scene& scene, const Vec3& x, const Vec3& n,
+                       int receiver, int samples);
+// The occlusion of the field's volume (trilinear, ambient cube) at world x with unit normal n: what a frame
+// shades (shaders/ambient_occlusion.glsl).
+double volumeOcclusion(const AoField& f, const Mat4& motion, const Vec3& x, const Vec3& n);
+// The visibility from the volumes of every occluder but `receiver`.
+double volumeVisibility(const std::vector<AoField>& fields, const Scene& scene, const Vec3& x, const Vec3& n,
+                        int receiver);
+// The current motion of occluder `occluder` (its first mesh's; a group's objects move together).
+Mat4 occluderMotion(const Scene& scene, int occluder);
+
+}  // namespace pvrr
