@@ -68,9 +68,11 @@ Mat4 cubeProjection(const Scene& scene, const Vec3& centre) {
 // can cover through view_proj, or nothing when no box reaches into the face's frustum. The part of a box
 // in front of the camera projects into the hull of its projected corners (perspective maps segments in
 // front of the camera to segments); a box reaching behind the camera's plane takes the whole face. Widened by
-// a texel against rounding.
+// a texel against rounding, and by `margin` texels more.
 std::optional<std::array<int, 4>> faceRect(const Mat4& view_proj, const std::vector<std::array<Vec3, 2>>& boxes,
-                                           int size) {
+                                           int size, int margin) {
+  // The frustum's sides widened by `margin` texels: a box just beside the face still takes its edge texels.
+  const double widen = 1.0 + 2.0 * margin / size;
   double x0 = kInf, y0 = kInf, x1 = -kInf, y1 = -kInf;
   bool any = false, whole = false;
   for (const auto& box : boxes) {
@@ -82,7 +84,7 @@ std::optional<std::array<int, 4>> faceRect(const Mat4& view_proj, const std::vec
     for (int axis = 0; axis < 3 && !outside; ++axis)
       for (double sign : {-1.0, 1.0}) {
         bool all = true;
-        for (int c = 0; c < 8 && all; ++c) all = sign * clip[c][axis] > clip[c].w;
+        for (int c = 0; c < 8 && all; ++c) all = sign * clip[c][axis] > clip[c].w * (axis < 2 ? widen : 1.0);
         outside = outside || all;
       }
     if (outside) continue;
@@ -98,9 +100,9 @@ std::optional<std::array<int, 4>> faceRect(const Mat4& view_proj, const std::vec
   }
   if (!any) return std::nullopt;
   if (whole) return std::array<int, 4>{0, 0, size, size};
-  auto window = [size](double ndc, bool up) {
+  auto window = [size, margin](double ndc, bool up) {
     const double p = (ndc + 1.0) * 0.5 * size;
-    return std::clamp(up ? int(std::ceil(p)) + 1 : int(std::floor(p)) - 1, 0, size);
+    return std::clamp(up ? int(std::ceil(p)) + 1 + margin : int(std::floor(p)) - 1 - margin, 0, size);
   };
   const int wx0 = window(x0, false), wx1 = window(x1, true), wy0 = window(y0, false), wy1 = window(y1, true);
   if (wx1 <= wx0 || wy1 <= wy0) return std::nullopt;
@@ -109,7 +111,7 @@ std::optional<std::array<int, 4>> faceRect(const Mat4& view_proj, const std::vec
 
 }  // namespace
 
-int CubePass::redrawWhereMoved(size_t e, const std::vector<size_t>& moved,
+int CubePass::redrawWhereMoved(size_t e, int layer, const std::vector<size_t>& moved,
                                const std::vector<std::array<Vec3, 2>>& before, CullCount& culled, size_t& texels) {
   const Vec3 centre = Vec3(ctx.scene.elements[e].local_to_world[3]);
   const Mat4 proj = cubeProjection(ctx.scene, centre);
@@ -120,11 +122,14 @@ int CubePass::redrawWhereMoved(size_t e, const std::vector<size_t>& moved,
   }
   int faces = 0, drawn = 0;
   for (int face = 0; face < 6; ++face) {
-    const auto rect = faceRect(proj * faceView(centre, face), boxes, cubes[e]->size);
+    // Layer 1 peels against layer 0 read with bilinear (and seamless) filtering: half a layer-1 texel of
+    // layer 0's change around, on this face or across an edge; two texels more cover it.
+    const int side = (layer ? cubes1 : cubes)[e]->size;
+    const auto rect = faceRect(proj * faceView(centre, face), boxes, side, layer ? 2 : 0);
     if (!rect) continue;
     glEnable(GL_SCISSOR_TEST);
     glScissor((*rect)[0], (*rect)[1], (*rect)[2], (*rect)[3]);
-    drawFace(e, 0, face, culled, drawn);  // selectFace's clear keeps to the scissor rectangle too
+    drawFace(e, layer, face, culled, drawn);  // selectFace's clear keeps to the scissor rectangle too
     glDisable(GL_SCISSOR_TEST);
     ++faces;
     texels += size_t((*rect)[2]) * size_t((*rect)[3]);
@@ -172,14 +177,14 @@ void CubePass::prepare(RenderMode frame_mode, FrameStages& stages, FrameCache* c
     ++reused_frames;
     if (partial) {
       boxes_before = drawn_key->mesh_boxes;
-      drawn_key = std::move(key);
-      layer1_drawn = false;  // the second layers peel what the first ones hold: drawn whole again if needed
+      drawn_key = std::move(key);  // the second layers keep layer1_key: updated in place where needed too
     }
   }
+  const bool layer1_stale = layers > 1 && layer1_drawn && !meshesMoved(scene, layer1_key.poses).empty();
   // The elements other cubes show: each mesh uploaded once (MeshPool slots).
   cube_mesh.assign(n_el, 0);
   // What draws into cubes this frame.
-  const bool cube_draws = !cubes_reused || partial || (layers > 1 && !layer1_drawn);
+  const bool cube_draws = !cubes_reused || partial || (layers > 1 && !layer1_drawn) || layer1_stale;
   for (size_t m = 0; m < n_el && cube_draws; ++m) {
     if (!inCubes(m)) continue;
     const ElementFrame f = prepareElement(scene, int(m), &ctx.grid_cache.get(scene, int(m)));
@@ -205,7 +210,7 @@ void CubePass::prepare(RenderMode frame_mode, FrameStages& stages, FrameCache* c
   int faces_redrawn = 0;
   size_t texels_redrawn = 0;
   for (size_t e = 0; e < n_el && partial; ++e)
-    faces_redrawn += redrawWhereMoved(e, stale.moved, boxes_before, s.culled, texels_redrawn);
+    faces_redrawn += redrawWhereMoved(e, 0, stale.moved, boxes_before, s.culled, texels_redrawn);
   second_layers = layers > 1;
   glFinish();
   s.ms = msSince(t0);
@@ -394,9 +399,17 @@ std::string CubePass::drawSecondLayers(const PassCamera& eye, const Framebuffer&
   }
   glActiveTexture(GL_TEXTURE0);
   CullCount layer_culled;
-  const bool layer1_reused = layer1_drawn;  // drawn with the first layers' key (prepare voids it with them)
+  // Drawn with the first layers' key (a full redraw of the first layers voids them), or with an earlier
+  // pose of the animated meshes: then updated where those are and were.
+  const bool layer1_reused = layer1_drawn;
+  const std::vector<size_t> moved = layer1_reused ? meshesMoved(ctx.scene, layer1_key.poses) : std::vector<size_t>{};
+  size_t texels = 0;
+  int faces = 0;
   for (size_t e = 0; e < n_el && !layer1_reused; ++e) layer_culled.add(drawCubes(e, 1).first);
+  for (size_t e = 0; e < n_el && !moved.empty(); ++e)
+    faces += redrawWhereMoved(e, 1, moved, layer1_key.mesh_boxes, layer_culled, texels);
   layer1_drawn = true;
+  layer1_key = *drawn_key;
   target.bind();
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
@@ -404,7 +417,10 @@ std::string CubePass::drawSecondLayers(const PassCamera& eye, const Framebuffer&
     if (left[e] > 0) drawElement(e, 1, eye);
   glFinish();
   return secondLayersNote(msSince(t_layers),
-                          layer1_reused ? std::string("reused, drawn in an earlier frame")
+                          layer1_reused && !moved.empty()
+                              ? "updated in place where the moving meshes are or were (" + std::to_string(faces) +
+                                    " faces, " + std::to_string(texels) + " texels), drawn in an earlier frame"
+                          : layer1_reused ? std::string("reused, drawn in an earlier frame")
                                         : cullNote(layer_culled, ctx.options.cull_back_faces),
                           total);
 }

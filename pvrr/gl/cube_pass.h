@@ -36,12 +36,12 @@ class CubePass : public ModePass {
   // One face of layer `layer` of element e's cubes (within the scissor rectangle, if one is set): the
   // elements other cubes show, then the environment; adds to the cull counts and the elements drawn.
   void drawFace(size_t e, int layer, int face, CullCount& culled, int& drawn);
-  // The static/dynamic split (issue 24): in layer 0 of element e's cubes, only the texels that the moved
+  // The static/dynamic split (issue 24): in layer `layer` of element e's cubes, only the texels that the moved
   // meshes cover now or covered when the cubes were drawn (`before`: their world boxes then) are drawn
   // again, each face within the scissor rectangle of those boxes, with the same draws as a whole face (so
   // they are the very texels a whole redraw makes; what the meshes do not cover shows nothing of them, the
   // environment's shading being local without shadows). Returns the faces drawn and adds their texels.
-  int redrawWhereMoved(size_t e, const std::vector<size_t>& moved,
+  int redrawWhereMoved(size_t e, int layer, const std::vector<size_t>& moved,
                        const std::vector<std::array<Vec3, 2>>& before, CullCount& culled, size_t& texels);
   // Element e in the second pass, from its mesh in element_slot[e]. Impostor with two layers (layer_draw): 0
   // the first draw, 2 the probe, 1 the second draw (drawElements).
@@ -76,7 +76,8 @@ class CubePass : public ModePass {
   RenderContext ctx;
   ImpostorMaps maps;
   std::optional<CubeKey> drawn_key;                 // the cubes' key; empty before the first draw
-  bool layer1_drawn = false;                        // the second layers' cubes were drawn with drawn_key too
+  bool layer1_drawn = false;  // the second layers' cubes were drawn with drawn_key's settings and elements,
+  CubeKey layer1_key;         // and with these mesh motions and boxes (updated in place when they moved)
   int reused_frames = 0;                            // frames drawn from the cubes since they were drawn
   bool cubes_reused = false;                        // this frame's cubes are the last frame's
   std::vector<std::unique_ptr<CubeTarget>> cubes;   // one per element
