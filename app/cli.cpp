@@ -44,8 +44,8 @@ const std::map<std::string, Command>& commands() {
         "  The stats' \"memory\" holds the resident memory after frame 100 (the first frame when N < 100), at\n"
         "  the end, their difference (rss_growth_mb), the peak, and 20 samples over the run.\n"
         "  --time T poses an animated scene (\"animation\" blocks) at T seconds (default 0); with --frames N, frame i\n"
-        "  is at T + i / F (--fps, default 30). A frame where something moved builds the renderer and the ray\n"
-        "  scene again (stats: time_s, fps, animated, frames_rebuilt)."}},
+        "  is at T + i / F (--fps, default 30). What moved is updated in place: the moved meshes' buffers, their\n"
+        "  own small ray scene, the cube maps only where they are (stats: time_s, fps, animated, frames_moved)."}},
       {"view",
        {cmdView, "open a design-review window: the scene live, head and eye moved by mouse and keys",
         "pvrr view [SCENE] [--mode pvrr|raster|envmap|impostor] [--gl auto|glx|egl] [--size WxH] [--set "

@@ -265,9 +265,10 @@ RenderedFrame renderFrame(LoadedScene& ls, RenderMode mode, const std::string& g
 
 bool poseSceneAt(LoadedScene& ls, double t_s, RenderSession* session) {
   if (!isAnimated(ls.desc) || !applyAnimation(ls.scene, ls.desc, t_s)) return false;
-  session->renderer.reset();  // before the ray scene it refers to
-  session->rays.reset();
-  session->cache = gl::FrameCache{};
+  if (session->rays) {  // in place: only what moved (the renderer finds its moved meshes itself)
+    session->rays->updateElementPoses();
+    session->rays->updateEnvironmentMeshes();
+  }
   return true;
 }
 
@@ -307,7 +308,7 @@ int cmdRender(const std::vector<std::string>& argv) {
   json rss_samples = json::array();  // [frame, MB] at about 20 points of the run, to tell growth from settling
   const int sample_every = std::max(1, frames / 20);
   const bool animated = isAnimated(ls.desc);
-  int rebuilt = 0;  // frames whose renderer and ray scene were built again because something moved
+  int moved_frames = 0;  // frames in which something moved (updated in place in the renderer and the ray scene)
   for (int i = 0; i < frames; ++i) {
     if (frames > 1 && orbit_deg != 0) {
       // Turn the head about the vertical axis through the eye.
@@ -323,7 +324,7 @@ int cmdRender(const std::vector<std::string>& argv) {
     }
     if (i > 0 && orbit_deg == 0) session.cache.environment_changed = false;
     // Time advances by 1 / fps a frame from --time (after the orbit: attached elements take both).
-    if (poseSceneAt(ls, time0_s + double(i) / fps, &session) && i > 0) ++rebuilt;
+    if (poseSceneAt(ls, time0_s + double(i) / fps, &session) && i > 0) ++moved_frames;
     session.read_back = i + 1 == frames;  // only the last frame is written out
     last = renderFrame(ls, mode, gl_name, &session);
     if (i + 1 == rss_frame) rss_baseline_mb = currentRssMb();
@@ -375,15 +376,15 @@ int cmdRender(const std::vector<std::string>& argv) {
   }
   if (animated && frames == 1) std::printf("animation: t = %.4g s\n", time0_s);
   if (animated && frames > 1)
-    std::printf("animation: t = %.4g s to %.4g s at %.4g fps; %d of %d frame(s) after the first built the renderer "
-                "and the ray scene again (something moved)\n",
-                time0_s, time0_s + double(frames - 1) / fps, fps, rebuilt, frames - 1);
+    std::printf("animation: t = %.4g s to %.4g s at %.4g fps; in %d of %d frame(s) after the first something moved "
+                "(updated in place: the moved meshes' buffers and their own ray scene, the cube maps where they are)\n",
+                time0_s, time0_s + double(frames - 1) / fps, fps, moved_frames, frames - 1);
   printQuality(last.elements, "");
   if (auto stats = a.get("stats")) {
     json j = {{"scene", scene_path}, {"mode", nameOf(mode)}, {"size", {last.width, last.height}}, {"gl", last.gl_backend},
               {"frame_ms", frame_ms}, {"frame_ms_mean", mean_ms}, {"frame_ms_max", max_ms}, {"frames", frames},
               {"frame_ms_first", first_ms}, {"time_s", time0_s}, {"fps", fps}, {"animated", animated},
-              {"frames_rebuilt", rebuilt},
+              {"frames_moved", moved_frames},
               {"stages", stagesJson(last.stages)},
               {"elements", last.elements}, {"peak_rss_mb", peakRssMb()}};
     // Resident memory (MB) after frame `after_frame` and after the last frame, before the PNG is written.

@@ -196,8 +196,8 @@ std::vector<Vec3> supersampledReference(const LoadedScene& ls, const std::string
 
 // Compare over time (--fps): the reference and every mode at each instant t_i = time0 + i / fps, i < frames;
 // per mode the angular error of each frame and the worst frame (largest p95). One renderer (one GL context)
-// draws every mode, each with its own frame cache (on, as pvrr render --frames runs), while nothing moves; a
-// frame where something moved builds the renderer and the ray scene again. Sets frames.csv's rows in `csv`.
+// draws every mode, each with its own frame cache (on, as pvrr render --frames runs); what moves is updated in
+// place (poseSceneAt, Renderer::render). Sets frames.csv's rows in `csv`.
 json compareOverTime(LoadedScene& ls, const std::vector<RenderMode>& modes, const std::string& gl_name, int frames,
                      double time0_s, double fps, std::string* csv) {
   RenderSession session;
@@ -208,10 +208,9 @@ json compareOverTime(LoadedScene& ls, const std::vector<RenderMode>& modes, cons
   for (int i = 0; i < frames; ++i) {
     const double t = time0_s + double(i) / fps;
     const bool moved = poseSceneAt(ls, t, &session);
-    for (gl::FrameCache& c : caches) {
-      if (moved) c = gl::FrameCache{};
-      else if (i > 0) c.environment_changed = false;
-    }
+    // The renderer follows the moved objects itself (Renderer::render, pvrr/gl/renderer.h).
+    for (gl::FrameCache& c : caches)
+      if (i > 0) c.environment_changed = false;
     RenderSession none;
     const RenderedFrame ref = renderFrame(ls, RenderMode::Raytrace, gl_name, &none);
     json jf = {{"frame", i}, {"time_s", t}, {"moved", moved}, {"modes", json::object()}};

@@ -71,8 +71,8 @@ void CausticPass::update(FrameStages& stages) {
     stages.skipped(kCausticMapsStage, "the scene has no mirror or lens");
     return;
   }
-  if (rendered_ && elementPoses() == rendered_poses_) {
-    stages.ran(kCausticMapsStage, 0, 0, "reused: the lights and the elements stood still");
+  if (rendered_ && elementPoses() == rendered_poses_ && scene_.mesh_motion == rendered_mesh_motion_) {
+    stages.ran(kCausticMapsStage, 0, 0, "reused: the lights, the elements and the animated meshes stood still");
     return;
   }
   const auto t0 = Clock::now();
@@ -81,6 +81,7 @@ void CausticPass::update(FrameStages& stages) {
   o.spectral_samples = scene_.render.spectral_samples;
   plan_ = planCaustics(rays_, o);
   rendered_poses_ = elementPoses();
+  rendered_mesh_motion_ = scene_.mesh_motion;
   rendered_ = true;
   if (plan_.receivers.empty()) {
     std::string why = "no caustic light lands on a planar receiver";

@@ -74,6 +74,7 @@ class CausticPass {
   unsigned maps_ = 0, fbo_ = 0;  // the receivers' light maps (array layers) and a framebuffer
   unsigned photon_fbo_ = 0, photon_tex_[3] = {0, 0, 0}, empty_vao_ = 0;
   std::vector<Mat4> rendered_poses_;
+  std::vector<Mat4> rendered_mesh_motion_;  // Scene::mesh_motion when the maps were made (a receiver may move)
   bool rendered_ = false;
 };
 

@@ -1,6 +1,8 @@
 #include "pvrr/gl/cube_pass.h"
 
 #include <algorithm>
+#include <cmath>
+#include <optional>
 
 #include "pvrr/base/format.h"
 #include "pvrr/gl/gl.h"
@@ -25,23 +27,116 @@ CubePass::CubeKey CubePass::keyNow(size_t formats) const {
   k.follow = follow;
   k.formats = formats;
   k.lens_in_cubes = lens_in_cubes;
-  for (const Element& el : ctx.scene.elements) k.poses.push_back(el.local_to_world);
+  k.poses = posesOf(ctx.scene);
+  for (size_t m = 0; m < ctx.scene.meshes.size(); ++m) k.mesh_boxes.push_back(ctx.environment.worldBox(m));
   return k;
 }
 
-std::string CubePass::staleReason(const FrameCache* cache, const CubeKey& k) const {
-  if (!cache) return "no frame cache (a single frame)";
-  if (cache->environment_changed) return "the environment changed (or a new frame cache)";
-  if (!drawn_key) return "first frame";
+CubePass::Staleness CubePass::staleness(const FrameCache* cache, const CubeKey& k) const {
+  if (!cache) return {"no frame cache (a single frame)", {}};
+  if (cache->environment_changed && !cache->only_meshes_moved)
+    return {"the environment changed (or a new frame cache)", {}};
+  if (!drawn_key) return {"first frame", {}};
   const CubeKey& d = *drawn_key;
   if (d.mode != k.mode || d.map_size != k.map_size || d.layers != k.layers || d.follow != k.follow ||
-      d.formats != k.formats || d.lens_in_cubes != k.lens_in_cubes || d.poses.size() != k.poses.size())
-    return "the mode or the map settings changed";
-  for (size_t e = 0; e < k.poses.size(); ++e)
-    if (d.poses[e] != k.poses[e])
-      return "element \"" + ctx.scene.elements[e].name + "\" moved" +
-             (ctx.scene.elements[e].attached_to_observer ? " (attached to the observer)" : "");
-  return "";
+      d.formats != k.formats || d.lens_in_cubes != k.lens_in_cubes)
+    return {"the mode or the map settings changed", {}};
+  const std::string element = elementMoved(ctx.scene, d.poses);
+  if (!element.empty()) return {element, {}};
+  std::vector<size_t> moved = meshesMoved(ctx.scene, d.poses);
+  if (moved.empty()) return {};
+  const std::string why = meshesMovedReason(ctx.scene, moved);
+  const bool all_animated =
+      d.mesh_boxes.size() == ctx.scene.meshes.size() &&
+      std::all_of(moved.begin(), moved.end(), [&](size_t m) { return ctx.scene.meshAnimated(m); });
+  if (!all_animated) return {why + " (not only animated meshes)", {}};
+  if (ctx.environment.shadowed())
+    return {why + ", and a light casts shadows: their shadows on the static surfaces moved too", {}};
+  if (ctx.environment.occludes(moved))
+    return {why + ", and an ambient occluder moved: its occlusion of the static surfaces moved too", {}};
+  return {"", std::move(moved)};
+}
+
+namespace {
+
+// A cube face's camera at `centre`: view (world) and projection.
+Mat4 faceView(const Vec3& centre, int face) { return glm::lookAt(centre, centre + kCubeDir[face], kCubeUp[face]); }
+Mat4 cubeProjection(const Scene& scene, const Vec3& centre) {
+  const double near_m = 1e-3, far_m = 2.0 * (scene.boundsRadius() + glm::length(centre - scene.bounds_min)) + 1.0;
+  return glm::perspective(kPi / 2, 1.0, near_m, far_m);
+}
+
+// The window rectangle {x, y, width, height} of a face of side `size` that holds every texel the boxes (world)
+// can cover through view_proj, or nothing when no box reaches into the face's frustum. The part of a box
+// in front of the camera projects into the hull of its projected corners (perspective maps segments in
+// front of the camera to segments); a box reaching behind the camera's plane takes the whole face. Widened by
+// a texel against rounding, and by `margin` texels more.
+std::optional<std::array<int, 4>> faceRect(const Mat4& view_proj, const std::vector<std::array<Vec3, 2>>& boxes,
+                                           int size, int margin) {
+  // The frustum's sides widened by `margin` texels: a box just beside the face still takes its edge texels.
+  const double widen = 1.0 + 2.0 * margin / size;
+  double x0 = kInf, y0 = kInf, x1 = -kInf, y1 = -kInf;
+  bool any = false, whole = false;
+  for (const auto& box : boxes) {
+    Vec4 clip[8];
+    for (int c = 0; c < 8; ++c)
+      clip[c] = view_proj *
+                Vec4((c & 1) ? box[1].x : box[0].x, (c & 2) ? box[1].y : box[0].y, (c & 4) ? box[1].z : box[0].z, 1.0);
+    bool outside = false;  // every corner beyond one plane of the frustum
+    for (int axis = 0; axis < 3 && !outside; ++axis)
+      for (double sign : {-1.0, 1.0}) {
+        bool all = true;
+        for (int c = 0; c < 8 && all; ++c) all = sign * clip[c][axis] > clip[c].w * (axis < 2 ? widen : 1.0);
+        outside = outside || all;
+      }
+    if (outside) continue;
+    any = true;
+    for (int c = 0; c < 8; ++c) {
+      if (!(clip[c].w > 1e-12)) {
+        whole = true;
+        break;
+      }
+      x0 = std::min(x0, clip[c].x / clip[c].w), x1 = std::max(x1, clip[c].x / clip[c].w);
+      y0 = std::min(y0, clip[c].y / clip[c].w), y1 = std::max(y1, clip[c].y / clip[c].w);
+    }
+  }
+  if (!any) return std::nullopt;
+  if (whole) return std::array<int, 4>{0, 0, size, size};
+  auto window = [size, margin](double ndc, bool up) {
+    const double p = (ndc + 1.0) * 0.5 * size;
+    return std::clamp(up ? int(std::ceil(p)) + 1 + margin : int(std::floor(p)) - 1 - margin, 0, size);
+  };
+  const int wx0 = window(x0, false), wx1 = window(x1, true), wy0 = window(y0, false), wy1 = window(y1, true);
+  if (wx1 <= wx0 || wy1 <= wy0) return std::nullopt;
+  return std::array<int, 4>{wx0, wy0, wx1 - wx0, wy1 - wy0};
+}
+
+}  // namespace
+
+int CubePass::redrawWhereMoved(size_t e, int layer, const std::vector<size_t>& moved,
+                               const std::vector<std::array<Vec3, 2>>& before, CullCount& culled, size_t& texels) {
+  const Vec3 centre = Vec3(ctx.scene.elements[e].local_to_world[3]);
+  const Mat4 proj = cubeProjection(ctx.scene, centre);
+  std::vector<std::array<Vec3, 2>> boxes;
+  for (const size_t m : moved) {
+    boxes.push_back(before[m]);
+    boxes.push_back(ctx.environment.worldBox(m));
+  }
+  int faces = 0, drawn = 0;
+  for (int face = 0; face < 6; ++face) {
+    // Layer 1 peels against layer 0 read with bilinear (and seamless) filtering: half a layer-1 texel of
+    // layer 0's change around, on this face or across an edge; two texels more cover it.
+    const int side = (layer ? cubes1 : cubes)[e]->size;
+    const auto rect = faceRect(proj * faceView(centre, face), boxes, side, layer ? 2 : 0);
+    if (!rect) continue;
+    glEnable(GL_SCISSOR_TEST);
+    glScissor((*rect)[0], (*rect)[1], (*rect)[2], (*rect)[3]);
+    drawFace(e, layer, face, culled, drawn);  // selectFace's clear keeps to the scissor rectangle too
+    glDisable(GL_SCISSOR_TEST);
+    ++faces;
+    texels += size_t((*rect)[2]) * size_t((*rect)[3]);
+  }
+  return faces;
 }
 
 void CubePass::prepare(RenderMode frame_mode, FrameStages& stages, FrameCache* cache) {
@@ -69,20 +164,29 @@ void CubePass::prepare(RenderMode frame_mode, FrameStages& stages, FrameCache* c
     if (scene.elements[e].type == ElementType::Lens) s.height_maps += maps.updateLensMaps(e);
     else s.surface_maps += maps.updateMirrorMaps(e);
   }
-  // Reuse: the cubes drawn last, if nothing they show has changed since (they do not depend on the eye).
+  // Reuse: the cubes drawn last, if nothing they show has changed since (they do not depend on the eye), or
+  // with only animated meshes moved, drawn again only where those are and were (the static/dynamic split).
   CubeKey key = keyNow(formats.size());
-  const std::string stale = staleReason(cache, key);
-  cubes_reused = stale.empty() && cubes.size() == n_el;
+  const Staleness stale = staleness(cache, key);
+  cubes_reused = stale.full.empty() && cubes.size() == n_el;
+  const bool partial = cubes_reused && !stale.moved.empty();
+  std::vector<std::array<Vec3, 2>> boxes_before;
   if (!cubes_reused) {
     drawn_key = std::move(key);
     layer1_drawn = false;
     reused_frames = 0;
   } else {
     ++reused_frames;
+    if (partial) {
+      boxes_before = drawn_key->mesh_boxes;
+      drawn_key = std::move(key);  // the second layers keep layer1_key: updated in place where needed too
+    }
   }
+  const bool layer1_stale = layers > 1 && layer1_drawn && !meshesMoved(scene, layer1_key.poses).empty();
   // The elements other cubes show: each mesh uploaded once (MeshPool slots).
   cube_mesh.assign(n_el, 0);
-  const bool cube_draws = !cubes_reused || (layers > 1 && !layer1_drawn);  // what draws into cubes this frame
+  // What draws into cubes this frame.
+  const bool cube_draws = !cubes_reused || partial || (layers > 1 && !layer1_drawn) || layer1_stale;
   for (size_t m = 0; m < n_el && cube_draws; ++m) {
     if (!inCubes(m)) continue;
     const ElementFrame f = prepareElement(scene, int(m), &ctx.grid_cache.get(scene, int(m)));
@@ -105,6 +209,10 @@ void CubePass::prepare(RenderMode frame_mode, FrameStages& stages, FrameCache* c
     s.culled.add(c);
     s.drawn_in_cubes += drawn;
   }
+  int faces_redrawn = 0;
+  size_t texels_redrawn = 0;
+  for (size_t e = 0; e < n_el && partial; ++e)
+    faces_redrawn += redrawWhereMoved(e, 0, stale.moved, boxes_before, s.culled, texels_redrawn);
   second_layers = layers > 1;
   glFinish();
   s.ms = msSince(t0);
@@ -114,7 +222,15 @@ void CubePass::prepare(RenderMode frame_mode, FrameStages& stages, FrameCache* c
   noteCubeFirstPass(stages, scene, mode, ctx.options.cull_back_faces, s);
   for (StageTiming& t : stages.stages) {
     if (t.name != stage::kFirstPass) continue;
-    if (cubes_reused) {  // the plan's note stays, as what the reused cubes hold
+    if (partial) {
+      const double share =
+          100.0 * double(texels_redrawn) / (6.0 * double(n_el) * ctx.options.map_size * ctx.options.map_size);
+      appendNote(t.note, "updated in place: " + meshesMovedReason(scene, stale.moved) +
+                             "; drawn again only where the moving meshes are or were (" +
+                             std::to_string(faces_redrawn) + " of " + std::to_string(6 * n_el) + " faces, " +
+                             fmt("%.1f", share) + " % of the texels), the rest kept from the cubes drawn " +
+                             std::to_string(reused_frames) + " frame(s) ago");
+    } else if (cubes_reused) {  // the plan's note stays, as what the reused cubes hold
       t.ran = false;
       t.reason = "cube maps reused: drawn " + std::to_string(reused_frames) +
                  " frame(s) ago, and nothing they show has changed since (the environment, every element's pose, "
@@ -123,7 +239,7 @@ void CubePass::prepare(RenderMode frame_mode, FrameStages& stages, FrameCache* c
       t.note.clear();
       t.ms = 0;
     } else {
-      appendNote(t.note, "drawn: " + stale);
+      appendNote(t.note, "drawn: " + stale.full);
     }
   }
 }
@@ -153,11 +269,17 @@ void CubePass::drawCubeElement(size_t m, const Mat4& view_proj, const Vec3& orig
 // beyond, the first layer's own texel (shaders/sky.frag, FIRST_LAYER). Layer 1 is drawn in the second pass,
 // and only if some pixel's search needs it (drawSecondLayers).
 std::pair<CullCount, int> CubePass::drawCubes(size_t e, int layer) {
+  CullCount culled;
+  int drawn = 0;
+  for (int face = 0; face < 6; ++face) drawFace(e, layer, face, culled, drawn);
+  return std::make_pair(culled, drawn);
+}
+
+void CubePass::drawFace(size_t e, int layer, int face, CullCount& culled, int& drawn) {
   const Scene& scene = ctx.scene;
   const size_t n_el = scene.elements.size();
   const Vec3 centre = Vec3(scene.elements[e].local_to_world[3]);
-  const double near_m = 1e-3, far_m = 2.0 * (scene.boundsRadius() + glm::length(centre - scene.bounds_min)) + 1.0;
-  const Mat4 proj = glm::perspective(kPi / 2, 1.0, near_m, far_m);
+  const Mat4 proj = cubeProjection(scene, centre);
   CubeTarget& c = layer ? *cubes1[e] : *cubes[e];
   if (layer) {  // the first layer's seen points, colour and normals (shaders/sky.frag, FIRST_LAYER)
     const std::vector<unsigned>& first = cubes[e]->colors;
@@ -169,18 +291,14 @@ std::pair<CullCount, int> CubePass::drawCubes(size_t e, int layer) {
     }
     glActiveTexture(GL_TEXTURE0);
   }
-  CullCount culled;
-  int drawn = 0;
-  for (int face = 0; face < 6; ++face) {
-    c.selectFace(face);
-    const Mat4 view = glm::lookAt(centre, centre + kCubeDir[face], kCubeUp[face]);
-    for (size_t m = 0; m < n_el; ++m)
-      if (m != e && inCubes(m)) {
-        drawCubeElement(m, relativeViewProj(proj, view, centre), centre, ctx.meshes.at(cube_mesh[m]), layer > 0);
-        drawn += face == 0;
-      }
-    culled.add(ctx.environment.draw(view, proj, centre, false, nullptr, false, with_seen, layer > 0));
-  }
+  c.selectFace(face);
+  const Mat4 view = faceView(centre, face);
+  for (size_t m = 0; m < n_el; ++m)
+    if (m != e && inCubes(m)) {
+      drawCubeElement(m, relativeViewProj(proj, view, centre), centre, ctx.meshes.at(cube_mesh[m]), layer > 0);
+      drawn += face == 0;
+    }
+  culled.add(ctx.environment.draw(view, proj, centre, false, nullptr, false, with_seen, layer > 0));
   if (layer) {
     for (int unit : {kPeelUnit, kFirstCubeUnit, kFirstCubeUnit + 1}) {
       glActiveTexture(GLenum(GL_TEXTURE0 + unit));
@@ -188,7 +306,6 @@ std::pair<CullCount, int> CubePass::drawCubes(size_t e, int layer) {
     }
     glActiveTexture(GL_TEXTURE0);
   }
-  return std::make_pair(culled, drawn);
 }
 
 // Impostor with two layers (layer_draw): 0 the first draw, which leaves the pixels whose search ends off a
@@ -284,9 +401,17 @@ std::string CubePass::drawSecondLayers(const PassCamera& eye, const Framebuffer&
   }
   glActiveTexture(GL_TEXTURE0);
   CullCount layer_culled;
-  const bool layer1_reused = layer1_drawn;  // drawn with the first layers' key (prepare voids it with them)
+  // Drawn with the first layers' key (a full redraw of the first layers voids them), or with an earlier
+  // pose of the animated meshes: then updated where those are and were.
+  const bool layer1_reused = layer1_drawn;
+  const std::vector<size_t> moved = layer1_reused ? meshesMoved(ctx.scene, layer1_key.poses) : std::vector<size_t>{};
+  size_t texels = 0;
+  int faces = 0;
   for (size_t e = 0; e < n_el && !layer1_reused; ++e) layer_culled.add(drawCubes(e, 1).first);
+  for (size_t e = 0; e < n_el && !moved.empty(); ++e)
+    faces += redrawWhereMoved(e, 1, moved, layer1_key.mesh_boxes, layer_culled, texels);
   layer1_drawn = true;
+  layer1_key = *drawn_key;
   target.bind();
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
@@ -294,7 +419,10 @@ std::string CubePass::drawSecondLayers(const PassCamera& eye, const Framebuffer&
     if (left[e] > 0) drawElement(e, 1, eye);
   glFinish();
   return secondLayersNote(msSince(t_layers),
-                          layer1_reused ? std::string("reused, drawn in an earlier frame")
+                          layer1_reused && !moved.empty()
+                              ? "updated in place where the moving meshes are or were (" + std::to_string(faces) +
+                                    " faces, " + std::to_string(texels) + " texels), drawn in an earlier frame"
+                          : layer1_reused ? std::string("reused, drawn in an earlier frame")
                                         : cullNote(layer_culled, ctx.options.cull_back_faces),
                           total);
 }

@@ -4,6 +4,7 @@
 // (depth-peeled cubes at half the size), drawn within the second pass only where some pixel's search needs
 // them; and each element's second-pass draw from its cubes.
 #pragma once
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -12,6 +13,7 @@
 #include "pvrr/gl/impostor_maps.h"
 #include "pvrr/gl/mode_pass.h"
 #include "pvrr/gl/stage_notes.h"
+#include "pvrr/scene/scene_poses.h"
 
 namespace pvrr::gl {
 
@@ -31,6 +33,16 @@ class CubePass : public ModePass {
   void drawCubeElement(size_t m, const Mat4& view_proj, const Vec3& origin, const MeshBuffers& mesh, bool peel);
   // Layer `layer` of element e's cubes; returns their cull counts and the elements drawn in them.
   std::pair<CullCount, int> drawCubes(size_t e, int layer);
+  // One face of layer `layer` of element e's cubes (within the scissor rectangle, if one is set): the
+  // elements other cubes show, then the environment; adds to the cull counts and the elements drawn.
+  void drawFace(size_t e, int layer, int face, CullCount& culled, int& drawn);
+  // The static/dynamic split (issue 24): in layer `layer` of element e's cubes, only the texels that the moved
+  // meshes cover now or covered when the cubes were drawn (`before`: their world boxes then) are drawn
+  // again, each face within the scissor rectangle of those boxes, with the same draws as a whole face (so
+  // they are the very texels a whole redraw makes; what the meshes do not cover shows nothing of them, the
+  // environment's shading being local without shadows). Returns the faces drawn and adds their texels.
+  int redrawWhereMoved(size_t e, int layer, const std::vector<size_t>& moved,
+                       const std::vector<std::array<Vec3, 2>>& before, CullCount& culled, size_t& texels);
   // Element e in the second pass, from its mesh in element_slot[e]. Impostor with two layers (layer_draw): 0
   // the first draw, 2 the probe, 1 the second draw (drawElements).
   void drawElement(size_t e, int layer_draw, const PassCamera& eye);
@@ -45,17 +57,27 @@ class CubePass : public ModePass {
     int map_size = 0, layers = 1, follow = 0;
     size_t formats = 0;
     bool lens_in_cubes = false;
-    std::vector<Mat4> poses;  // each element's local_to_world
+    ScenePoses poses;                              // the elements' poses and the meshes' motions
+    std::vector<std::array<Vec3, 2>> mesh_boxes;   // per environment mesh, its world box (EnvironmentPass)
   };
   CubeKey keyNow(size_t formats) const;
-  // Why the cubes drawn last cannot serve this frame (to be drawn again), or "" when they can. Reuse needs
-  // a frame cache whose environment has not changed (FrameCache::environment_changed).
-  std::string staleReason(const FrameCache* cache, const CubeKey& key) const;
+  // What to do with the cubes drawn last: `full` says why they are to be drawn whole again ("" when not);
+  // otherwise `moved` lists the animated meshes that moved since (drawn again where they are and were:
+  // redrawWhereMoved; none: the cubes are reused as they are). Reuse needs a frame cache whose environment
+  // has not changed (FrameCache::environment_changed) but by the animated meshes' motion
+  // (FrameCache::only_meshes_moved), every element where it was, and no light casting shadows when a mesh
+  // moved (its shadow on the static surfaces would move too).
+  struct Staleness {
+    std::string full;
+    std::vector<size_t> moved;
+  };
+  Staleness staleness(const FrameCache* cache, const CubeKey& key) const;
 
   RenderContext ctx;
   ImpostorMaps maps;
   std::optional<CubeKey> drawn_key;                 // the cubes' key; empty before the first draw
-  bool layer1_drawn = false;                        // the second layers' cubes were drawn with drawn_key too
+  bool layer1_drawn = false;  // the second layers' cubes were drawn with drawn_key's settings and elements,
+  CubeKey layer1_key;         // and with these mesh motions and boxes (updated in place when they moved)
   int reused_frames = 0;                            // frames drawn from the cubes since they were drawn
   bool cubes_reused = false;                        // this frame's cubes are the last frame's
   std::vector<std::unique_ptr<CubeTarget>> cubes;   // one per element

@@ -50,21 +50,14 @@ EnvironmentPass::EnvironmentPass(const Scene& s, const RendererOptions& o, const
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
   }
   env_meshes.resize(scene.meshes.size());
+  env_bounds.resize(scene.meshes.size());
+  env_motion.resize(scene.meshes.size());
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
     const EnvMesh& mesh = scene.meshes[m];
-    std::vector<float> data;
-    data.reserve(mesh.positions.size() * 8);
-    for (size_t i = 0; i < mesh.positions.size(); ++i) {
-      const glm::vec3 pos = mesh.positions[i], n = mesh.normals[i];
-      const glm::vec2 uv = mesh.uvs[i];
-      data.insert(data.end(), {pos.x, pos.y, pos.z, n.x, n.y, n.z, uv.x, uv.y});
-    }
-    std::vector<uint32_t> idx;
-    idx.reserve(mesh.triangles.size() * 3);
-    for (const auto& t : mesh.triangles) idx.insert(idx.end(), {t.x, t.y, t.z});
-    uploadMesh(env_meshes[m], data, {3, 3, 2}, idx);
+    upload(m);
     // Faceted: each triangle's three normals equal and perpendicular to it (a supplied normal tilted from
-    // its face would make the per-vertex two-sided flip differ from the per-fragment one).
+    // its face would make the per-vertex two-sided flip differ from the per-fragment one). Decided once: an
+    // animated mesh moves rigidly, which keeps a faceted mesh's normals equal (each is rotated alike).
     env_faceted.push_back(std::all_of(mesh.triangles.begin(), mesh.triangles.end(), [&](const auto& t) {
       const glm::vec3 n = mesh.normals[t.x];
       const Vec3 face = glm::cross(Vec3(mesh.positions[t.y] - mesh.positions[t.x]), Vec3(mesh.positions[t.z] - mesh.positions[t.x]));
@@ -72,18 +65,54 @@ EnvironmentPass::EnvironmentPass(const Scene& s, const RendererOptions& o, const
       const bool perpendicular = len == 0 || std::abs(glm::dot(face / len, Vec3(n))) >= 1 - 1e-6;
       return perpendicular && glm::length(mesh.normals[t.y] - n) <= 1e-6f && glm::length(mesh.normals[t.z] - n) <= 1e-6f;
     }));
-    Vec3 lo(mesh.positions.empty() ? glm::vec3(0) : mesh.positions[0]), hi(lo);
-    for (const glm::vec3& pos : mesh.positions) {
-      lo = glm::min(lo, Vec3(pos));
-      hi = glm::max(hi, Vec3(pos));
-    }
-    env_bounds.push_back({lo, hi});
     env_textured.push_back(scene.materials[size_t(mesh.material)].texture >= 0);
     // Its program, built now (not in the first frame's first pass) so that its compile time and any
     // compile error come with the renderer.
     programs.env(env_faceted.back(), env_textured.back(), false);
   }
   checkGlError("uploading the environment");
+}
+
+void EnvironmentPass::upload(size_t m) {
+  const EnvMesh& mesh = scene.meshes[m];
+  std::vector<float> data;
+  data.reserve(mesh.positions.size() * 8);
+  for (size_t i = 0; i < mesh.positions.size(); ++i) {
+    const glm::vec3 pos = mesh.positions[i], n = mesh.normals[i];
+    const glm::vec2 uv = mesh.uvs[i];
+    data.insert(data.end(), {pos.x, pos.y, pos.z, n.x, n.y, n.z, uv.x, uv.y});
+  }
+  std::vector<uint32_t> idx;
+  idx.reserve(mesh.triangles.size() * 3);
+  for (const auto& t : mesh.triangles) idx.insert(idx.end(), {t.x, t.y, t.z});
+  uploadMesh(env_meshes[m], data, {3, 3, 2}, idx);
+  Vec3 lo(mesh.positions.empty() ? glm::vec3(0) : mesh.positions[0]), hi(lo);
+  for (const glm::vec3& pos : mesh.positions) {
+    lo = glm::min(lo, Vec3(pos));
+    hi = glm::max(hi, Vec3(pos));
+  }
+  env_bounds[m] = {lo, hi};
+  env_motion[m] = scene.meshMotion(m);
+}
+
+std::vector<size_t> EnvironmentPass::update() {
+  std::vector<size_t> moved;
+  for (size_t m = 0; m < scene.meshes.size(); ++m)
+    if (scene.meshAnimated(m) && scene.meshMotion(m) != env_motion[m]) moved.push_back(m);
+  for (const size_t m : moved) upload(m);
+  if (!moved.empty()) checkGlError("updating the animated environment meshes");
+  return moved;
+}
+
+std::array<Vec3, 2> EnvironmentPass::worldBox(size_t m) const {
+  return {env_bounds[m][0] + scene.meshes[m].anchor, env_bounds[m][1] + scene.meshes[m].anchor};
+}
+
+bool EnvironmentPass::shadowed() const { return shadows_ && shadows_->active(); }
+
+bool EnvironmentPass::occludes(const std::vector<size_t>& moved) const {
+  if (!ao_ || !ao_->active()) return false;
+  return std::any_of(moved.begin(), moved.end(), [&](size_t m) { return scene.meshes[m].occluder >= 0; });
 }
 
 EnvironmentPass::~EnvironmentPass() {

@@ -49,12 +49,25 @@ class EnvironmentPass {
   void setCaustics(const CausticPass* caustics) { caustics_ = caustics; }
   // The ambient occlusion fields the meshes' shading reads in every pass (null: none). Set by the renderer.
   void setAoFields(const AoFields* ao) { ao_ = ao; }
+  // Whether some light casts shadows (the meshes' shading depends on where the others are).
+  bool shadowed() const;
+  // Whether one of meshes `moved` is an ambient occluder whose field is drawn (its occlusion reaches past
+  // its own box, onto the static surfaces around it).
+  bool occludes(const std::vector<size_t>& moved) const;
+
+  // The animated meshes that moved since they were uploaded (Scene::mesh_motion): their vertex buffers are
+  // written again in place (the scene holds their moved vertices) and their boxes recomputed. Returns them.
+  std::vector<size_t> update();
+  // Mesh m's bounding box in world coordinates, as uploaded.
+  std::array<Vec3, 2> worldBox(size_t m) const;
 
  private:
   // The environment meshes' bounding boxes relative to `origin`.
   std::vector<std::array<Vec3, 2>> boxes(const Vec3& origin) const;
   // The order to draw them in: the scene's, or sorted by their distance (RendererOptions::sort_environment).
   std::vector<size_t> drawOrder(const std::vector<std::array<Vec3, 2>>& boxes, bool reversed_depth) const;
+  // Uploads mesh m's vertices (relative to its anchor) and sets its box.
+  void upload(size_t m);
 
   const Scene& scene;
   const RendererOptions& options;
@@ -64,6 +77,7 @@ class EnvironmentPass {
   std::vector<bool> env_faceted;  // per environment mesh: every triangle has one normal at its three corners
   std::vector<bool> env_textured;  // per environment mesh: its material has a texture
   std::vector<std::array<Vec3, 2>> env_bounds;  // per environment mesh: its bounding box, relative to its anchor
+  std::vector<Mat4> env_motion;  // per environment mesh: the Scene::meshMotion its buffers hold
   std::vector<Texture> textures;  // environment textures, in Scene::textures order
   const ShadowPass* shadows_ = nullptr;
   const CausticPass* caustics_ = nullptr;

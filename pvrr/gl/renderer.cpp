@@ -153,7 +153,18 @@ RasterFrame Renderer::Impl::render(RenderMode mode, FrameCache* cache) {
                  limits);
   meshes.rewind();
   ModePass& pass = passFor(mode);
-  shadows->update(out.stages);  // before the first passes, whose environment reads the maps too
+  // Animated meshes that moved: their buffers rewritten in place (the ray scene is the caller's:
+  // RayScene::updateEnvironmentMeshes), and the frame cache started afresh but for the cube maps.
+  environment.update();
+  if (cache && cache->mesh_motion.empty()) {
+    cache->mesh_motion = scene.mesh_motion;  // its first frame
+  } else if (cache && cache->mesh_motion != scene.mesh_motion) {
+    const bool caller_changed = cache->environment_changed;
+    *cache = FrameCache{};
+    cache->mesh_motion = scene.mesh_motion;
+    cache->only_meshes_moved = !caller_changed;
+  }
+  shadows->update(out.stages, cache);  // before the first passes, whose environment reads the maps too
   caustics->update(out.stages);
   ao_fields->note(out.stages);
   // The CPU stages and the first passes (and the nested passes of elements seen in other elements' maps).
@@ -165,6 +176,7 @@ RasterFrame Renderer::Impl::render(RenderMode mode, FrameCache* cache) {
   out.elements = pass.takeElements();
   readBack(out);
   out.frame_ms = msSince(frame_start);
+  if (cache) cache->only_meshes_moved = false;
   return out;
 }
 

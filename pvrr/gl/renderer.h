@@ -97,9 +97,10 @@ class Renderer {
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
-  // Renders one frame of `scene` (which may have moved since construction only in its observer and in the
-  // poses of elements attached to the observer) as seen by the scene's observer. `mode`: a raster mode
-  // (isRenderMode); RenderMode::Raytrace is the tracer's (an internal error here).
+  // Renders one frame of `scene` as seen by the scene's observer. Since construction the scene may have
+  // changed only in its observer, its elements' poses and its animated meshes (applyAnimation), which are
+  // updated in place (the caller updates the RayScene: updateElementPoses, updateEnvironmentMeshes). `mode`: a raster
+  // mode (isRenderMode); RenderMode::Raytrace is the tracer's (an internal error here).
   RasterFrame render(RenderMode mode, FrameCache* cache = nullptr);
   // RendererOptions::read_back for the next frames (e.g. only the last of a run is written out).
   void setReadBack(bool on);

@@ -168,30 +168,34 @@ void ShadowPass::makeTextures() {
   glGenFramebuffers(1, &fbo_);
 }
 
-std::vector<Mat4> ShadowPass::elementPoses() const {
-  std::vector<Mat4> poses;
-  for (const Element& el : scene_.elements) poses.push_back(el.local_to_world);
-  return poses;
+std::string ShadowPass::staleReason(const FrameCache* cache) const {
+  if (!rendered_) return "first frame";
+  if (cache && cache->environment_changed)
+    return cache->only_meshes_moved ? meshesMovedReason(scene_, meshesMoved(scene_, rendered_poses_))
+                                    : "the environment changed (or a new frame cache)";
+  const std::string moved = elementMoved(scene_, rendered_poses_);
+  return moved.empty() ? meshesMovedReason(scene_, meshesMoved(scene_, rendered_poses_)) : moved;
 }
 
-void ShadowPass::update(FrameStages& stages) {
+void ShadowPass::update(FrameStages& stages, const FrameCache* cache) {
   if (!active()) {
     stages.skipped(kShadowMapsStage,
                    "no light casts shadows (every directional and point light has \"shadows\": false)");
     return;
   }
-  if (rendered_ && elementPoses() == rendered_poses_) {
-    stages.ran(kShadowMapsStage, 0, 0, "reused: the lights and the elements stood still");
+  const std::string why = staleReason(cache);
+  if (why.empty()) {
+    stages.ran(kShadowMapsStage, 0, 0, "reused: the lights, the environment and the elements stood still");
     return;
   }
   const auto t0 = Clock::now();
   render();
-  rendered_poses_ = elementPoses();
+  rendered_poses_ = posesOf(scene_);
   rendered_ = true;
   stages.ran(kShadowMapsStage, msSince(t0), layout_.layers,
              std::to_string(layout_.layers) + (layout_.layers == 1 ? " layer of " : " layers of ") +
                  std::to_string(kMapSize) + " x " + std::to_string(kMapSize) +
-                 (layout_.lenses ? ", lens layers beside" : ""));
+                 (layout_.lenses ? ", lens layers beside" : "") + "; drawn: " + why);
 }
 
 void ShadowPass::render() {

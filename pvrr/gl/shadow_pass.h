@@ -12,9 +12,13 @@
 // Casters: the environment meshes and the mirrors (opaque); the lenses go into their own depth layers with
 // their transmittance (1 - R0)^2 beside (pvrr/trace/shadow_rays.h): a point behind the nearest lens from the
 // light gets that lens's transmittance, behind an opaque caster nothing; for a light whose caustics are on
-// (pvrr/gl/caustic_pass.h) nothing either, as the light through the lens arrives as the caustic. The maps are rendered when the
-// renderer's first frame needs them and again only when an element moved (spectacles with the head): the
-// environment and the lights stand still (Renderer).
+// (pvrr/gl/caustic_pass.h) nothing either, as the light through the lens arrives as the caustic. The maps are
+// rendered when the
+// renderer's first frame needs them and again when something they show may have changed:
+// FrameCache::environment_changed (the caller's, or the renderer's when an animated mesh moved), as for the
+// cube maps (pvrr/gl/cube_pass.h), or an element or an animated mesh moved (pvrr/scene/scene_poses.h, the
+// one test of what moved that the cube maps use too). Without a frame cache only the poses decide (the
+// environment otherwise stands still); the lights stand still.
 #pragma once
 #include <string>
 #include <vector>
@@ -22,7 +26,9 @@
 #include "pvrr/base/stats.h"
 #include "pvrr/gl/gl_objects.h"
 #include "pvrr/gl/programs.h"
+#include "pvrr/method/pass_plan.h"
 #include "pvrr/scene/scene.h"
+#include "pvrr/scene/scene_poses.h"
 
 namespace pvrr::gl {
 
@@ -53,9 +59,9 @@ class ShadowPass {
   ShadowPass(const ShadowPass&) = delete;
   ShadowPass& operator=(const ShadowPass&) = delete;
 
-  // Renders the maps if they are missing or an element moved; notes the stage (ran, reused, or skipped with
-  // the reason).
-  void update(FrameStages& stages);
+  // Renders the maps if they are missing or may show something else (see above); notes the stage (ran with
+  // why, reused, or skipped with the reason).
+  void update(FrameStages& stages, const FrameCache* cache);
   bool active() const { return layout_.layers > 0; }
   // Binds the maps to their units and sets program p's shadow uniforms for a pass whose camera origin is
   // `origin`. Nothing when no light casts shadows.
@@ -73,7 +79,8 @@ class ShadowPass {
   void makeLayers();
   void makeTextures();
   void render();
-  std::vector<Mat4> elementPoses() const;
+  // Why the maps must be drawn this frame, or "" when the last ones serve.
+  std::string staleReason(const FrameCache* cache) const;
 
   const Scene& scene_;
   const Programs& programs_;
@@ -83,7 +90,7 @@ class ShadowPass {
   int unit_ = 0;  // the depth maps' unit; the lens depths and transmittances on the two after it
   unsigned depth_ = 0, lens_depth_ = 0, lens_t_ = 0, fbo_ = 0;
   std::vector<MeshBuffers> element_meshes_;  // per element: its front surface, element-local
-  std::vector<Mat4> rendered_poses_;         // the element poses the maps were rendered with
+  ScenePoses rendered_poses_;                // what the maps were rendered with
   bool rendered_ = false;
 };
 

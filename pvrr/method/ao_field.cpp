@@ -304,8 +304,8 @@ double fieldOcclusion(const AoField& f, const Mat4& motion, const Vec3& x_world,
 }
 
 Mat4 occluderMotion(const Scene& scene, int occluder) {
-  for (const EnvMesh& m : scene.meshes)
-    if (m.occluder == occluder) return m.motion;
+  for (size_t m = 0; m < scene.meshes.size(); ++m)
+    if (scene.meshes[m].occluder == occluder) return scene.meshMotion(m);
   return Mat4(1.0);
 }
 

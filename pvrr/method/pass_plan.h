@@ -46,6 +46,13 @@ struct FrameCache {
   // false also lets envmap and impostor modes reuse their cube maps, while no element moved
   // (pvrr/gl/cube_pass.h).
   bool environment_changed = true;
+  // The renderer's own record of the animated environment meshes (Scene::mesh_motion) of the last frame drawn
+  // with this cache. When they moved, the renderer starts the frame from a fresh cache (as if the caller had
+  // made a new one: everything that depends on the environment is recomputed), keeps this record, and sets
+  // only_meshes_moved for that frame, so that the passes that follow the meshes themselves (the cube maps,
+  // pvrr/gl/cube_pass.h) may update in place; it clears the flag again when the frame is done.
+  std::vector<Mat4> mesh_motion;
+  bool only_meshes_moved = false;
   // Map reuse (PassPlanOptions::map_reuse_margin_deg): the top-level maps the renderer last rendered, in map
   // slot order, with the (widened) volume and the longer side each was rendered with. Empty when that
   // first pass cannot be reused (it had nested passes or elements drawn dark, or was not widened).

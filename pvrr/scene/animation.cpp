@@ -1,6 +1,7 @@
 #include "pvrr/scene/animation.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -40,6 +41,30 @@ Mat4 motionAt(const AnimationDesc& a, const Vec3& pivot, double t_s) {
   Mat4 m(rotationFromDeg(s.rotation_deg));
   m[3] = Vec4(pivot + s.offset_m - Mat3(m) * pivot, 1.0);
   return m;
+}
+
+SweepSamples sweepSamples(const AnimationDesc& a) {
+  SweepSamples out;
+  const std::vector<Keyframe>& k = a.keys;
+  if (!k.empty()) out.times_s.push_back(k.front().time_s);
+  for (size_t i = 1; i < k.size(); ++i) {
+    const Vec3 turn = glm::abs(k[i].rotation_deg - k[i - 1].rotation_deg);
+    const double turn_deg = turn.x + turn.y + turn.z;
+    const int steps = std::clamp(int(std::ceil(turn_deg / kSweepStepDeg)), 1, kMaxSweepSteps);
+    // Equal steps of the interpolation weight (both weights are monotonic in time): the angles and the
+    // offset change by a fixed share of the interval's change per step.
+    for (int j = 1; j <= steps; ++j) {
+      const double w = double(j) / steps;
+      // The time whose weight is w: linear w; smooth inverts 3 s^2 - 2 s^3 by bisection.
+      double lo = 0, hi = 1;
+      for (int it = 0; it < 60 && a.interpolation == Interpolation::Smooth; ++it)
+        (interpolationWeight(a.interpolation, 0.5 * (lo + hi)) < w ? lo : hi) = 0.5 * (lo + hi);
+      const double s = a.interpolation == Interpolation::Smooth ? 0.5 * (lo + hi) : w;
+      out.times_s.push_back(j == steps ? k[i].time_s : k[i - 1].time_s + s * (k[i].time_s - k[i - 1].time_s));
+    }
+    out.max_step_rad = std::max(out.max_step_rad, radians(turn_deg) / steps);
+  }
+  return out;
 }
 
 }  // namespace pvrr

@@ -42,4 +42,20 @@ Mat3 rotationFromDeg(const Vec3& deg);
 // The rigid motion at time t of an object placed at `pivot`: x -> pivot + offset + R (x - pivot).
 Mat4 motionAt(const AnimationDesc& a, const Vec3& pivot, double t_s);
 
+// Instants that bound an animation's whole motion: every key, and between two keys enough instants that the
+// rotation angles change by at most kSweepStepDeg summed over the three axes from one to the next (at most
+// kMaxSweepSteps per interval, each step then larger). Between two neighbouring instants a point at distance
+// r from the pivot stays within r max_step_rad of the segment joining its two sampled positions: the
+// translation is linear in the interpolation weight, as the segment is, so only the turn strays from it; R =
+// Rz Ry Rx turns by at most the sum of its angles' changes, so the turning point moves at most r max_step_rad
+// and the segment's point at most as far, both starting and ending together. Padding the box of the
+// sampled poses by r max_step_rad therefore bounds the sweep.
+struct SweepSamples {
+  std::vector<double> times_s;
+  double max_step_rad = 0;  // the largest sum of the three angles' changes between neighbouring instants
+};
+inline constexpr double kSweepStepDeg = 1.0;
+inline constexpr int kMaxSweepSteps = 64;
+SweepSamples sweepSamples(const AnimationDesc& a);
+
 }  // namespace pvrr

@@ -46,9 +46,6 @@ struct EnvMesh {
   // The ambient occluder it belongs to (EnvObjectDesc::occluder, numbered from 0 in the order of their first
   // mesh; pvrr/trace/ambient_occlusion.h), or -1.
   int occluder = -1;
-  // The rigid motion from its placed pose (Scene::placed_meshes) to now (applyAnimation); identity for a mesh
-  // that does not move. Its ambient occlusion field moves with it.
-  Mat4 motion{1.0};
 };
 
 struct Light {
@@ -138,11 +135,18 @@ struct Scene {
   // elements are posed at; and per environment mesh (parallel to `meshes`; an object whose file has its own
   // materials became several meshes) the index of the scene file's environment object it was built from, and
   // its placed copy (before any motion) if that object is animated, else an empty mesh.
+  // mesh_motion: per environment mesh, the rigid motion (world) that took its placed copy to where it is now
+  // (identity for a mesh that is not animated): the renderer and the ray scene compare it with the motion
+  // they last drew or built with, to update only what moved (issue 24's static/dynamic split).
   double time_s = 0;
   std::vector<size_t> mesh_object;
   std::vector<EnvMesh> placed_meshes;
+  std::vector<Mat4> mesh_motion;
+  bool meshAnimated(size_t m) const { return m < placed_meshes.size() && !placed_meshes[m].positions.empty(); }
+  Mat4 meshMotion(size_t m) const { return m < mesh_motion.size() ? mesh_motion[m] : Mat4(1.0); }
   // Axis-aligned bounds of the environment (world), for far planes and escape distances. With animation:
-  // of every pose the animated meshes take at their keys, so that they do not change with time.
+  // of every pose the animated meshes take, at their keys and between them (animatedBounds in scene_build.cpp:
+  // a rotation sweeps outside its key poses), so that they do not change with time.
   Vec3 bounds_min{0}, bounds_max{0};
   void updateBounds();
   double boundsRadius() const { return 0.5 * glm::length(bounds_max - bounds_min); }

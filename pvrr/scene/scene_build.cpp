@@ -224,6 +224,7 @@ void addMeshParts(Scene& scene, const EnvMesh& whole, const std::vector<MeshPart
     sub.occluder = whole.occluder;
     scene.mesh_object.push_back(object);
     scene.placed_meshes.push_back(animated ? sub : EnvMesh{});
+    scene.mesh_motion.push_back(Mat4(1.0));
     scene.meshes.push_back(std::move(sub));
   }
 }
@@ -409,6 +410,7 @@ Scene buildScene(const SceneDesc& desc, const MeshLoader& load_mesh) {
     scene.materials.push_back(mat);
     scene.mesh_object.push_back(i);
     scene.placed_meshes.push_back(o.animation ? mesh : EnvMesh{});
+    scene.mesh_motion.push_back(Mat4(1.0));
     scene.meshes.push_back(std::move(mesh));
   }
 
@@ -511,11 +513,11 @@ bool applyAnimation(Scene& scene, const SceneDesc& desc, double t_s) {
     const EnvObjectDesc& o = desc.environment[scene.mesh_object[m]];
     if (!o.animation) continue;
     EnvMesh& mesh = scene.meshes[m];
-    const Vec3 anchor = mesh.anchor;
-    const std::vector<glm::vec3> positions = mesh.positions;
-    mesh.motion = motionAt(*o.animation, o.position, t_s);
-    moveMesh(scene.placed_meshes[m], mesh.motion, mesh);
-    moved = moved || anchor != mesh.anchor || positions != mesh.positions;
+    const Mat4 motion = motionAt(*o.animation, o.position, t_s);
+    if (motion == scene.mesh_motion[m]) continue;  // the same motion poses the same mesh
+    moveMesh(scene.placed_meshes[m], motion, mesh);
+    scene.mesh_motion[m] = motion;
+    moved = true;
   }
   std::vector<Mat4> poses;
   for (const Element& el : scene.elements) poses.push_back(el.local_to_world);
@@ -524,19 +526,28 @@ bool applyAnimation(Scene& scene, const SceneDesc& desc, double t_s) {
   return moved;
 }
 
-// The bounds of the scene as built, widened by every pose its animated meshes take at their keys (the
-// elements' positions change the bounds little; the scene at t = 0 holds them).
+// The bounds of the scene as built, widened by every pose its animated meshes take: posed at the instants of
+// sweepSamples (the keys, and between them at most kSweepStepDeg of turn apart), padded by how far a vertex
+// can stray from the segment between its sampled positions in between (none for a motion without a turn),
+// so that a rotation sweeping outside the key poses stays inside (the elements' positions change the bounds little; the
+// scene at t = 0 holds them).
 void animatedBounds(Scene& scene, const SceneDesc& desc) {
   scene.updateBounds();
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
     const EnvObjectDesc& o = desc.environment[scene.mesh_object[m]];
     if (!o.animation) continue;
-    EnvMesh moved = scene.placed_meshes[m];
-    for (const Keyframe& k : o.animation->keys) {
-      moveMesh(scene.placed_meshes[m], motionAt(*o.animation, o.position, k.time_s), moved);
+    const EnvMesh& placed = scene.placed_meshes[m];
+    double radius_m = 0;  // the farthest vertex from the pivot
+    for (const glm::vec3& p : placed.positions)
+      radius_m = std::max(radius_m, glm::length(placed.anchor + Vec3(p) - o.position));
+    const SweepSamples sweep = sweepSamples(*o.animation);
+    const Vec3 pad(radius_m * sweep.max_step_rad);
+    EnvMesh moved = placed;
+    for (const double t_s : sweep.times_s) {
+      moveMesh(placed, motionAt(*o.animation, o.position, t_s), moved);
       for (const glm::vec3& p : moved.positions) {
-        scene.bounds_min = glm::min(scene.bounds_min, moved.anchor + Vec3(p));
-        scene.bounds_max = glm::max(scene.bounds_max, moved.anchor + Vec3(p));
+        scene.bounds_min = glm::min(scene.bounds_min, moved.anchor + Vec3(p) - pad);
+        scene.bounds_max = glm::max(scene.bounds_max, moved.anchor + Vec3(p) + pad);
       }
     }
   }

@@ -90,7 +90,14 @@ bool refineRaySurface(const cad::Surface& s, const Vec3& o, const Vec3& d, Vec2&
 
 struct RayScene::Impl {
   RTCDevice device = nullptr;
-  RTCScene scene = nullptr;
+  RTCScene scene = nullptr;  // the static meshes and the elements
+  // With animated meshes: `dynamic` holds them, and `top` instances `scene` and `dynamic` (the IDs of its two
+  // instances after every geometry's); the queries traverse `top`. Without: top == scene, dynamic null.
+  RTCScene top = nullptr, dynamic = nullptr;
+  unsigned static_instance = RTC_INVALID_GEOMETRY_ID, dynamic_instance = RTC_INVALID_GEOMETRY_ID;
+  std::vector<int> mesh_geom;      // per environment mesh: its geometry ID, or -1 (no triangles)
+  std::vector<Mat4> mesh_motion;   // per environment mesh: the Scene::mesh_motion its triangles were placed with
+  std::vector<Mat4> element_pose;  // per element: the local_to_world its tessellations were placed with
   Vec3 anchor{0};  // world position subtracted before converting to float
   std::vector<GeomInfo> geoms;
   // Element surface -> geometry ID in `scene`.
@@ -109,13 +116,19 @@ struct RayScene::Impl {
     std::mutex mutex;  // guards points, normals and answer, and the installing and committing of `beside`
     std::vector<Vec3> points, normals;
     std::shared_ptr<const RayScene::TangentClearance> answer;
-    std::atomic<RTCScene> beside{nullptr};
+    std::atomic<RTCScene> beside{nullptr};  // the scene queried (with animated meshes: an instance of
+                                            // beside_static and one of `dynamic`)
+    RTCScene beside_static = nullptr;       // with animated meshes: everything static but the element
   };
   std::vector<std::unique_ptr<Clearance>> clearance;
   bool moving = false;  // RaySceneOptions::moving_elements took effect: dynamic scenes
   ~Impl() {
-    for (const auto& c : clearance)
+    for (const auto& c : clearance) {
       if (c && c->beside.load()) rtcReleaseScene(c->beside.load());
+      if (c && c->beside_static) rtcReleaseScene(c->beside_static);
+    }
+    if (top && top != scene) rtcReleaseScene(top);
+    if (dynamic) rtcReleaseScene(dynamic);
     for (auto& pair : element_scenes)
       for (RTCScene s : pair)
         if (s) rtcReleaseScene(s);
@@ -126,8 +139,10 @@ struct RayScene::Impl {
 
 namespace {
 
-unsigned addTriangles(RTCDevice dev, RTCScene scn, const std::vector<glm::vec3>& verts,
-                      const std::vector<glm::u32vec3>& tris) {
+// Attaches a triangle geometry to `scn` under ID `id` (the IDs are unique across the static and the dynamic
+// scene: a hit's geomID names its GeomInfo in either).
+void addTriangles(RTCDevice dev, RTCScene scn, unsigned id, const std::vector<glm::vec3>& verts,
+                  const std::vector<glm::u32vec3>& tris) {
   RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
   auto* v = static_cast<float*>(
       rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), verts.size()));
@@ -144,9 +159,56 @@ unsigned addTriangles(RTCDevice dev, RTCScene scn, const std::vector<glm::vec3>&
     idx[3 * i + 2] = tris[i].z;
   }
   rtcCommitGeometry(g);
-  unsigned id = rtcAttachGeometry(scn, g);
+  rtcAttachGeometryByID(scn, g, id);
   rtcReleaseGeometry(g);
-  return id;
+}
+
+// An instance of `child` with the identity transform, attached to `parent` under ID `id`: Embree transforms
+// the ray by the identity (multiplications by 1 and additions of 0), so the child sees the very float ray.
+void addInstance(RTCDevice dev, RTCScene parent, RTCScene child, unsigned id) {
+  RTCGeometry inst = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_INSTANCE);
+  rtcSetGeometryInstancedScene(inst, child);
+  const float identity[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+  rtcSetGeometryTransform(inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, identity);
+  rtcCommitGeometry(inst);
+  rtcAttachGeometryByID(parent, inst, id);
+  rtcReleaseGeometry(inst);
+}
+
+// A scene over `inner` (static) and `dynamic`, for the queries: instances under IDs after every geometry's.
+RTCScene twoLevel(RTCDevice dev, RTCScene inner, RTCScene dynamic, unsigned first_id) {
+  RTCScene t = rtcNewScene(dev);
+  addInstance(dev, t, inner, first_id);
+  addInstance(dev, t, dynamic, first_id + 1);
+  rtcCommitScene(t);
+  return t;
+}
+
+// Recommits `top`'s instances (their child scenes were committed) and `top`.
+void recommitTop(RTCScene top, unsigned first_id) {
+  for (unsigned id : {first_id, first_id + 1}) rtcCommitGeometry(rtcGetGeometry(top, id));
+  rtcCommitScene(top);
+}
+
+// An environment mesh's vertices relative to the scene's anchor, in float.
+std::vector<glm::vec3> meshVertices(const EnvMesh& mesh, const Vec3& anchor) {
+  std::vector<glm::vec3> verts(mesh.positions.size());
+  const Vec3 shift = mesh.anchor - anchor;
+  for (size_t i = 0; i < verts.size(); ++i) verts[i] = glm::vec3(Vec3(mesh.positions[i]) + shift);
+  return verts;
+}
+
+// An environment mesh's triangles in double (EnvTriangle).
+std::vector<EnvTriangle> meshTriangles(const EnvMesh& mesh) {
+  std::vector<EnvTriangle> tris(mesh.triangles.size());
+  for (size_t t = 0; t < tris.size(); ++t) {
+    const glm::u32vec3 tri = mesh.triangles[t];
+    const Vec3 a = mesh.anchor + Vec3(mesh.positions[tri.x]);
+    const Vec3 b = mesh.anchor + Vec3(mesh.positions[tri.y]);
+    const Vec3 c = mesh.anchor + Vec3(mesh.positions[tri.z]);
+    tris[t] = EnvTriangle{a, b - a, c - a, glm::normalize(glm::cross(b - a, c - a))};
+  }
+  return tris;
 }
 
 }  // namespace
@@ -173,26 +235,31 @@ RayScene::RayScene(const Scene& scene, RaySceneOptions options) : scene_(scene),
   im.anchor = scene.observer.eye;
   epsilon_ = 1e-9 * std::max(1.0, scene.boundsRadius()) + 1e-12 * glm::length(im.anchor);
 
+  // The animated meshes' own scene: rebuilt whole when they move (it is small), its BVH of low quality.
+  bool any_dynamic = false;
+  for (size_t m = 0; m < scene.meshes.size(); ++m)
+    any_dynamic = any_dynamic || (scene.meshAnimated(m) && !scene.meshes[m].triangles.empty());
+  if (any_dynamic) {
+    im.dynamic = rtcNewScene(im.device);
+    rtcSetSceneFlags(im.dynamic, RTC_SCENE_FLAG_DYNAMIC);
+    rtcSetSceneBuildQuality(im.dynamic, RTC_BUILD_QUALITY_LOW);
+  }
+  unsigned next_id = 0;
+  im.mesh_geom.assign(scene.meshes.size(), -1);
+  im.mesh_motion.assign(scene.meshes.size(), Mat4(1.0));
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
     const EnvMesh& mesh = scene.meshes[m];
     if (mesh.triangles.empty()) continue;
-    std::vector<glm::vec3> verts(mesh.positions.size());
-    const Vec3 shift = mesh.anchor - im.anchor;
-    for (size_t i = 0; i < verts.size(); ++i) verts[i] = glm::vec3(Vec3(mesh.positions[i]) + shift);
-    unsigned id = addTriangles(im.device, im.scene, verts, mesh.triangles);
+    const unsigned id = next_id++;
+    addTriangles(im.device, scene.meshAnimated(m) ? im.dynamic : im.scene, id, meshVertices(mesh, im.anchor),
+                 mesh.triangles);
     if (im.geoms.size() <= id) im.geoms.resize(id + 1);
-    im.geoms[id] = GeomInfo{HitKind::Environment, int(m), 0, {}, {}, {}};
-    std::vector<EnvTriangle>& tris = im.geoms[id].tris;
-    tris.resize(mesh.triangles.size());
-    for (size_t t = 0; t < tris.size(); ++t) {
-      const glm::u32vec3 tri = mesh.triangles[t];
-      const Vec3 a = mesh.anchor + Vec3(mesh.positions[tri.x]);
-      const Vec3 b = mesh.anchor + Vec3(mesh.positions[tri.y]);
-      const Vec3 c = mesh.anchor + Vec3(mesh.positions[tri.z]);
-      tris[t] = EnvTriangle{a, b - a, c - a, glm::normalize(glm::cross(b - a, c - a))};
-    }
+    im.geoms[id] = GeomInfo{HitKind::Environment, int(m), 0, {}, {}, meshTriangles(mesh)};
+    im.mesh_geom[m] = int(id);
+    im.mesh_motion[m] = scene.meshMotion(m);
   }
   im.element_geoms.assign(scene.elements.size(), {-1, -1});
+  for (const Element& el : scene.elements) im.element_pose.push_back(el.local_to_world);
   im.element_scenes.assign(scene.elements.size(), {nullptr, nullptr});
   for (size_t e = 0; e < scene.elements.size(); ++e) {
     const Element& el = scene.elements[e];
@@ -204,7 +271,8 @@ RayScene::RayScene(const Scene& scene, RaySceneOptions options) : scene_(scene),
                                                    options.element_tessellation, outline);
       std::vector<glm::vec3> verts(tess.positions.size());
       for (size_t i = 0; i < verts.size(); ++i) verts[i] = glm::vec3(el.toWorldPoint(tess.positions[i]) - im.anchor);
-      unsigned id = addTriangles(im.device, im.scene, verts, tess.triangles);
+      const unsigned id = next_id++;
+      addTriangles(im.device, im.scene, id, verts, tess.triangles);
       if (moving) {
         // Moved rigidly by updateElementPoses: the topology stays, so the BVH is refitted, not rebuilt.
         RTCGeometry g = rtcGetGeometry(im.scene, id);
@@ -223,6 +291,12 @@ RayScene::RayScene(const Scene& scene, RaySceneOptions options) : scene_(scene),
     }
   }
   rtcCommitScene(im.scene);
+  im.top = im.scene;
+  if (im.dynamic) {
+    rtcCommitScene(im.dynamic);
+    im.static_instance = next_id;
+    im.top = twoLevel(im.device, im.scene, im.dynamic, im.static_instance);
+  }
   im.moving = moving;
   im.clearance.resize(scene.elements.size());
   for (size_t e = 0; e < scene.elements.size(); ++e) {
@@ -251,9 +325,18 @@ RayScene::~RayScene() = default;
 
 void RayScene::updateElementPoses() {
   Impl& im = *impl_;
+  // Only the elements that moved since their tessellations were placed: a commit without them costs nothing.
+  std::vector<bool> moved(scene_.elements.size());
+  bool any = false;
+  for (size_t e = 0; e < moved.size(); ++e) {
+    moved[e] = scene_.elements[e].local_to_world != im.element_pose[e];
+    any = any || moved[e];
+    im.element_pose[e] = scene_.elements[e].local_to_world;
+  }
+  if (!any) return;
   for (size_t id = 0; id < im.geoms.size(); ++id) {
     const GeomInfo& g = im.geoms[id];
-    if (g.kind != HitKind::Element) continue;
+    if (g.kind != HitKind::Element || !moved[size_t(g.index)]) continue;
     const Element& el = scene_.elements[size_t(g.index)];
     RTCGeometry geom = rtcGetGeometry(im.scene, unsigned(id));
     auto* v = static_cast<float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
@@ -267,14 +350,57 @@ void RayScene::updateElementPoses() {
     rtcCommitGeometry(geom);
   }
   rtcCommitScene(im.scene);
+  if (im.dynamic) recommitTop(im.top, im.static_instance);
   for (const auto& c : im.clearance) {
     if (!c) continue;
     std::lock_guard<std::mutex> lock(c->mutex);
-    if (c->beside.load()) rtcCommitScene(c->beside.load());
+    if (c->beside_static) {
+      rtcCommitScene(c->beside_static);
+      recommitTop(c->beside.load(), im.static_instance);
+    } else if (c->beside.load()) {
+      rtcCommitScene(c->beside.load());
+    }
   }
   for (auto& pair : im.element_scenes)
     for (RTCScene s : pair)
       if (s) rtcCommitScene(s);
+}
+
+bool RayScene::hasDynamicMeshes() const { return impl_->dynamic != nullptr; }
+
+int RayScene::updateEnvironmentMeshes() {
+  Impl& im = *impl_;
+  int moved = 0;
+  for (size_t m = 0; m < im.mesh_geom.size() && im.dynamic; ++m) {
+    if (im.mesh_geom[m] < 0 || !scene_.meshAnimated(m) || scene_.meshMotion(m) == im.mesh_motion[m]) continue;
+    const EnvMesh& mesh = scene_.meshes[m];
+    const unsigned id = unsigned(im.mesh_geom[m]);
+    RTCGeometry geom = rtcGetGeometry(im.dynamic, id);
+    auto* v = static_cast<float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
+    const std::vector<glm::vec3> verts = meshVertices(mesh, im.anchor);
+    for (size_t i = 0; i < verts.size(); ++i) {
+      v[3 * i] = verts[i].x;
+      v[3 * i + 1] = verts[i].y;
+      v[3 * i + 2] = verts[i].z;
+    }
+    rtcUpdateGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0);
+    rtcCommitGeometry(geom);
+    im.geoms[id].tris = meshTriangles(mesh);
+    im.mesh_motion[m] = scene_.meshMotion(m);
+    ++moved;
+  }
+  if (moved == 0) return 0;
+  rtcCommitScene(im.dynamic);
+  recommitTop(im.top, im.static_instance);
+  for (const auto& c : im.clearance) {
+    if (!c) continue;
+    std::lock_guard<std::mutex> lock(c->mutex);
+    if (c->beside_static) recommitTop(c->beside.load(), im.static_instance);
+  }
+  const RTCError err = rtcGetDeviceError(im.device);
+  if (err != RTC_ERROR_NONE)
+    throw Error("Embree: updating the animated meshes failed (error " + std::to_string(int(err)) + ")");
+  return moved;
 }
 
 namespace {
@@ -376,7 +502,7 @@ RayHit RayScene::intersectIn(int beside_element, const Vec3& o, const Vec3& d, d
   if (!std::isfinite(o.x + o.y + o.z + d.x + d.y + d.z)) return RayHit{};
   const Impl& im = *impl_;
   RTCScene scene =
-      beside_element < 0 ? im.scene : im.clearance[size_t(beside_element)]->beside.load(std::memory_order_acquire);
+      beside_element < 0 ? im.top : im.clearance[size_t(beside_element)]->beside.load(std::memory_order_acquire);
   // After a rejected candidate the next query starts strictly beyond it (the float slack must not bring the
   // same triangle back).
   float past = 0.0f;
@@ -429,7 +555,7 @@ void RayScene::intersectPacket(const Vec3* o, const Vec3* d, int count, RayHit* 
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   ctx.flags = coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-  rtcIntersect16(valid, im.scene, &ctx, &rh);
+  rtcIntersect16(valid, im.top, &ctx, &rh);
   for (int i = 0; i < count; ++i) {
     if (rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) {
       out[i] = RayHit{};
@@ -502,28 +628,40 @@ std::shared_ptr<const RayScene::TangentClearance> RayScene::tangentClearance(int
   for (size_t i = 0; i < points.size() && !any_clear; ++i)
     any_clear = out->ahead[i] <= out->tolerance || out->behind[i] >= -out->tolerance;
   // The scene beside the element, once: built outside the lock (Embree's build runs tasks), installed under it.
-  RTCScene built = nullptr;
+  RTCScene built = nullptr, built_static = nullptr;
   if (any_clear && !c.beside.load(std::memory_order_acquire)) {
     built = rtcNewScene(im.device);
     if (!built) throw Error("Embree: could not create the scene beside element " + std::to_string(element));
     rtcSetSceneBuildQuality(built, im.moving ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_HIGH);
     if (im.moving) rtcSetSceneFlags(built, RTC_SCENE_FLAG_DYNAMIC);
-    for (size_t id = 0; id < im.geoms.size(); ++id)
-      if (im.geoms[id].kind != HitKind::None &&
-          !(im.geoms[id].kind == HitKind::Element && im.geoms[id].index == element))
+    for (size_t id = 0; id < im.geoms.size(); ++id) {
+      const GeomInfo& g = im.geoms[id];
+      const bool in_dynamic = g.kind == HitKind::Environment && scene_.meshAnimated(size_t(g.index));
+      if (g.kind != HitKind::None && !in_dynamic && !(g.kind == HitKind::Element && g.index == element))
         rtcAttachGeometryByID(built, rtcGetGeometry(im.scene, unsigned(id)), unsigned(id));
+    }
     rtcCommitScene(built);
+    if (im.dynamic) {  // the queried scene instances it and the animated meshes' scene
+      built_static = built;
+      built = twoLevel(im.device, built_static, im.dynamic, im.static_instance);
+    }
     const RTCError err = rtcGetDeviceError(im.device);
     if (err != RTC_ERROR_NONE) {
       rtcReleaseScene(built);
+      if (built_static) rtcReleaseScene(built_static);
       throw Error("Embree: building the scene beside element " + std::to_string(element) + " failed (error " +
                   std::to_string(int(err)) + ")");
     }
   }
   std::lock_guard<std::mutex> lock(c.mutex);
   if (built) {
-    if (c.beside.load()) rtcReleaseScene(built);  // another thread was first
-    else c.beside.store(built, std::memory_order_release);
+    if (c.beside.load()) {  // another thread was first
+      rtcReleaseScene(built);
+      if (built_static) rtcReleaseScene(built_static);
+    } else {
+      c.beside_static = built_static;
+      c.beside.store(built, std::memory_order_release);
+    }
   }
   c.points = points;
   c.normals = normals;

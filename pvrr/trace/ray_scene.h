@@ -2,7 +2,11 @@
 // - environment triangles are found by Embree (float, relative to one scene anchor near the observer) and
 //   the hit is recomputed in double on the hit triangle;
 // - optical elements are found on a fine tessellation and the hit is then refined by Newton iterations on
-//   the element's exact surface, so results do not depend on that tessellation.
+//   the element's exact surface, so results do not depend on that tessellation;
+// - animated environment meshes (Scene::meshAnimated) live in a small scene of their own beside the static
+//   one, both instanced (with the identity: the float rays are unchanged) in the scene the queries traverse,
+//   so that moving them (updateEnvironmentMeshes) rebuilds only their own small BVH (issue 24's
+//   static/dynamic split). A scene without animated meshes is one Embree scene, as before.
 // No Embree type appears here.
 #pragma once
 #include <memory>
@@ -92,9 +96,17 @@ class RayScene {
   RayHit intersectBeside(int element, const Vec3& o, const Vec3& d, double t_min = 0, double t_max = kInf) const;
 
   // After elements moved (Element::local_to_world changed, e.g. spectacles turning with the head): moves
-  // their candidate tessellations in Embree and recommits (the scenes beside mirrors too). The environment is
-  // untouched. As Embree requires, no query (intersect*, tangentClearance) may run meanwhile.
+  // the candidate tessellations of those that moved in Embree and recommits (the scenes beside mirrors too);
+  // nothing when none moved. The environment is untouched. As Embree requires, no query (intersect*, tangentClearance)
+  // may run meanwhile.
   void updateElementPoses();
+  // After animated environment meshes moved (Scene::mesh_motion changed, pvrr/scene/scene_build.h
+  // applyAnimation): moves those meshes' triangles in Embree and recommits only the small scene that holds
+  // the animated meshes (and the instances above it); the static meshes' BVH stays. Returns how many meshes
+  // moved. The same rule as updateElementPoses: no query meanwhile.
+  int updateEnvironmentMeshes();
+  // Whether the scene holds animated environment meshes, in a scene of their own (Scene::meshAnimated).
+  bool hasDynamicMeshes() const;
 
   const Scene& scene() const { return scene_; }
   // Offset that moves a secondary ray's origin off a surface, relative to the scene scale.

@@ -41,7 +41,7 @@ TEST(MotionCli, RenderAtATimeIsTheFrameOfAClipAtThatTime) {
   EXPECT_NE(test::slurp(dir / "start.png"), test::slurp(dir / "clip.png")) << "the car did not move";
   const json stats = json::parse(test::slurp(dir / "clip.json"));
   EXPECT_TRUE(stats["animated"].get<bool>());
-  EXPECT_EQ(stats["frames_rebuilt"].get<int>(), 2);
+  EXPECT_EQ(stats["frames_moved"].get<int>(), 2);
   EXPECT_NE(clip.out.find("animation: t = 0 s to 0.8 s at 2.5 fps"), std::string::npos) << clip.out;
 }
 

@@ -38,6 +38,7 @@ void addObject(Scene& s, EnvMesh mesh, size_t object, int occluder) {
   s.meshes.push_back(mesh);
   s.mesh_object.push_back(object);
   s.placed_meshes.push_back(EnvMesh{});
+  s.mesh_motion.push_back(Mat4(1.0));
 }
 
 Scene baseScene() {
@@ -123,9 +124,9 @@ Scene carScene(const Mat4& motion) {
     m.anchor = Vec3(motion * Vec4(placed.anchor, 1.0));
     for (size_t i = 0; i < m.positions.size(); ++i) m.positions[i] = glm::vec3(r * Vec3(placed.positions[i]));
     for (size_t i = 0; i < m.normals.size(); ++i) m.normals[i] = glm::vec3(r * Vec3(placed.normals[i]));
-    m.motion = motion;
     addObject(s, m, 1, 0);
     s.placed_meshes.back() = placed;
+    s.mesh_motion.back() = motion;
   }
   s.updateBounds();
   return s;

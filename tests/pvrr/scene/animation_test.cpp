@@ -1,6 +1,7 @@
 // Keyframed motion (pvrr/scene/animation.h): interpolation against its closed forms, the rigid motion about
 // the placed position, the scene format's "animation" and "dynamic" (one-line errors naming the JSON path), and
-// the built scene posed at a time (applyAnimation).
+// the built scene posed at a time (applyAnimation), its bounds over a turn between keys, and the ray scene
+// moved in place (RayScene::updateEnvironmentMeshes).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,6 +11,7 @@
 #include "pvrr/scene/animation.h"
 #include "pvrr/scene/scene_build.h"
 #include "pvrr/scene/scene_json.h"
+#include "pvrr/trace/ray_scene.h"
 
 namespace pvrr {
 namespace {
@@ -168,6 +170,69 @@ TEST(Animation, TheBuiltSceneIsPosedAtTheTimeGiven) {
   EXPECT_FALSE(applyAnimation(s, d, 0.5)) << "nothing moves from where it is";
   EXPECT_TRUE(applyAnimation(s, d, 0.6));
   EXPECT_EQ(s.time_s, 0.6);
+}
+
+// A long bar turning from -45 to +45 degrees about its centre between two keys: at 0 degrees (mid-way) its
+// ends reach 4 m from the centre along x, beyond both key poses' boxes (4 cos 45 = 2.83 m, plus the bar's
+// half width). The bounds hold every instant's pose (checked finely here), not only the keys'.
+TEST(Animation, BoundsHoldARotationBetweenKeys) {
+  const std::string scene = R"({
+    "version": 1,
+    "observer": {"eye": [0, 1.2, 0], "target": [0, 1.2, -1]},
+    "environment": [
+      {"type": "box", "name": "bar", "centre": [0, 0.5, -10], "size": [8, 0.2, 0.2],
+       "animation": {"keys": [{"time_s": 0, "rotation_deg": [0, -45, 0]}, {"time_s": 1, "rotation_deg": [0, 45, 0]}]}}
+    ]
+  })";
+  const SceneDesc d = parseScene(scene, "t.json", "");
+  Scene s = buildScene(d);
+  const Vec3 lo = s.bounds_min, hi = s.bounds_max;
+  EXPECT_GE(hi.x, 4.0) << "the mid-way pose is outside the keys' boxes";
+  for (int i = 0; i <= 200; ++i) {
+    applyAnimation(s, d, i / 200.0);
+    const EnvMesh& m = s.meshes[0];
+    for (const glm::vec3& p : m.positions) {
+      const Vec3 w = m.anchor + Vec3(p);
+      EXPECT_TRUE(glm::all(glm::greaterThanEqual(w, lo - kFloatTol_m)) &&
+                  glm::all(glm::lessThanEqual(w, hi + kFloatTol_m)))
+          << "t = " << i / 200.0;
+    }
+  }
+  // Sampling: 90 deg of turn in 1 deg steps would be 90, capped at kMaxSweepSteps (64): 90 / 64 deg each,
+  // padded by the bar's half diagonal times that.
+  const SweepSamples sw = sweepSamples(*d.environment[0].animation);
+  EXPECT_EQ(sw.times_s.size(), size_t(kMaxSweepSteps) + 1);
+  EXPECT_NEAR(sw.max_step_rad, radians(90.0 / kMaxSweepSteps), kTol);
+}
+
+// The animated car moves in the ray scene in place: a ray at where it is now hits it, where it was misses
+// it, as in a ray scene built anew at that instant; the static ground is hit all along.
+TEST(Animation, TheRaySceneMovesAnimatedMeshesInPlace) {
+  const SceneDesc d = parseScene(kScene, "t.json", "");
+  Scene s = buildScene(d);
+  RayScene rays(s);
+  EXPECT_TRUE(rays.hasDynamicMeshes());
+  const Vec3 down(0, -1, 0);
+  const auto meshHit = [&](const RayScene& r, double z) { return r.intersect(Vec3(2, 5, z), down).mesh; };
+  EXPECT_EQ(meshHit(rays, 10), 0);  // the car at t = 0
+  applyAnimation(s, d, 1.0);        // 10 m on
+  EXPECT_EQ(rays.updateEnvironmentMeshes(), 1);
+  EXPECT_EQ(rays.updateEnvironmentMeshes(), 0) << "nothing moved since";
+  RayScene fresh(s);
+  for (const double z : {10.0, 0.0, -10.0, 5.0}) {
+    const RayHit a = rays.intersect(Vec3(2, 5, z), down), b = fresh.intersect(Vec3(2, 5, z), down);
+    EXPECT_EQ(a.mesh, b.mesh) << z;
+    EXPECT_EQ(a.t, b.t) << z;
+    EXPECT_EQ(a.point, b.point) << z;
+  }
+  EXPECT_EQ(meshHit(rays, 10), 1) << "the car left: the ground";
+  EXPECT_EQ(meshHit(rays, 0), 0) << "the car is here now";
+  // A packet query goes through the same scene.
+  Vec3 o[2] = {Vec3(2, 5, 0), Vec3(2, 5, 10)}, dirs[2] = {down, down};
+  RayHit out[2];
+  rays.intersectPacket(o, dirs, 2, out);
+  EXPECT_EQ(out[0].mesh, 0);
+  EXPECT_EQ(out[1].mesh, 1);
 }
 
 }  // namespace
