@@ -12,6 +12,8 @@
 #include <optional>
 #include <thread>
 
+#include <time.h>
+
 #include "app/args.h"
 #include "app/commands.h"
 #include "app/report.h"
@@ -27,16 +29,26 @@
 #include "pvrr/analysis/accuracy.h"
 #include "pvrr/base/error.h"
 #include "pvrr/base/format.h"
+#include "pvrr/gl/program.h"
 #include "pvrr/scene/scene_json.h"
 
 namespace pvrr::app {
 namespace view {
+namespace {
+
+// This thread's CPU time (ms): what a step costs the window's thread, apart from the time others held the cores.
+double threadCpuMs() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
+}
+
+}  // namespace
 
 void Viewer::rebuild(bool keep_mode) {
   if (reference_) discardReference("discarded: the scene was rebuilt (a setting changed)");
   const auto t0 = Clock::now();
   window_.context().makeCurrent();
-  seen_renderer_.reset();
   renderer_.reset();
   ++scene_builds_;
   rays_.reset();
@@ -169,6 +181,12 @@ void Viewer::frame() {
   const gl::RasterFrame f = renderer_->render(mode_, pending_screenshots_.empty() ? &cache_ : &whole);
   cache_.environment_changed = false;  // the environment never changes while the window is open
   const auto t_render = Clock::now();
+  if (!wipe_drawn_) {
+    // The wipe's first draw, where a software GL compiles its shaders' code: here, of the first frame, into the
+    // back buffer that the frame's present then overwrites, not at the first reference.
+    wipe_->present(renderer_->colorTexture(), ob.width, ob.height, 0.5 * ob.width, true);
+    wipe_drawn_ = true;
+  }
   presentFrame(ob);
   const auto t_present = Clock::now();
   if (!pending_screenshots_.empty()) {
@@ -277,29 +295,34 @@ const Observer& Viewer::updateObserver() {
   return current;
 }
 
+void Viewer::prepareReference() {
+  seen_ = std::make_unique<SeenFrames>(window_);
+  window_.context().makeCurrent();
+  wipe_ = std::make_unique<Wipe>(window_);
+  wipe_->reset(width_, height_);
+}
+
 void Viewer::startReference() {
   updateObserver();
   if (reference_ && (reference_->finished() || !(viewKey() == reference_key_))) reference_.reset();  // traced anew
   if (reference_ && viewKey() == reference_key_) return;  // this view's reference is being traced
   window_.context().makeCurrent();
+  if (programs_at_first_reference_ < 0) programs_at_first_reference_ = gl::programsBuiltOnThisThread();
   const auto t0 = Clock::now();
-  if (!seen_renderer_) {
-    gl::RendererOptions opt = gl::rendererOptionsFor(ls_.scene);
-    opt.seen_points = true;  // as pvrr compare draws the frame it measures
-    opt.read_back = true;
-    seen_renderer_ = std::make_unique<gl::Renderer>(ls_.scene, *rays_, opt);
-  }
-  gl::FrameCache fresh;  // every stage run, as compare's frame
-  gl::RasterFrame f = seen_renderer_->render(mode_, &fresh);
+  const double cpu0_ms = threadCpuMs();
+  // One copy of the view's scene, shared by the tracer and the seen-points worker.
+  auto snapshot = std::make_shared<const Scene>(ls_.scene);
+  std::shared_future<Frame> seen = seen_->request(snapshot, ls_.desc, scene_builds_, mode_);
   const int threads = std::max(1, int(std::thread::hardware_concurrency()) - 1);  // one core for the window
-  reference_ = std::make_unique<ReferenceRun>(ls_.scene, std::move(static_cast<Frame&>(f)), threads);
-  if (!wipe_) wipe_ = std::make_unique<Wipe>(window_);
+  reference_ = std::make_unique<ReferenceRun>(std::move(snapshot), std::move(seen), threads);
   wipe_->reset(reference_->width(), reference_->height());
   heat_uploaded_ = false;
   reference_key_ = viewKey();
   reference_note_.clear();
   ++references_started_;
-  reference_start_ms_ = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  reference_start_ms_ =
+      std::max(reference_start_ms_, std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+  reference_start_cpu_ms_ = std::max(reference_start_cpu_ms_, threadCpuMs() - cpu0_ms);
 }
 
 void Viewer::discardReference(const std::string& why) {
@@ -409,8 +432,15 @@ json Viewer::referenceStats() const {
   json j = {{"state", state},
             {"note", reference_note_},
             {"started", references_started_},
-            // Starting costs one frame of the mode drawn with seen points (the first time, its programs built too).
+            // The window thread's time to start one (the longest start): a copy of the scene and a request; the
+            // mode's frame with seen points is drawn on the worker, which built `worker_programs` programs.
             {"start_ms", reference_start_ms_},
+            {"start_cpu_ms", reference_start_cpu_ms_},  // the same in the thread's CPU time: without waits for a core
+            {"worker_frames", seen_ ? seen_->framesDrawn() : 0},
+            {"worker_programs", seen_ ? seen_->programsBuilt() : 0},
+            // Programs the window's thread built from the first start to the end of the run: none, by design.
+            {"window_programs_since_start",
+             programs_at_first_reference_ < 0 ? 0 : gl::programsBuiltOnThisThread() - programs_at_first_reference_},
             {"frames_while_tracing", frames_while_tracing_},
             {"frame_ms_max_while_tracing", frame_ms_max_while_tracing_}};
   j["wipe_x"] = wipe_x_;

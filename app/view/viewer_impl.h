@@ -18,6 +18,7 @@
 #include "app/view/lens_probe.h"
 #include "app/view/reference_tiles.h"
 #include "app/view/script.h"
+#include "app/view/seen_frames.h"
 #include "app/view/window.h"
 #include "app/view/wipe.h"
 
@@ -65,12 +66,13 @@ class Viewer {
       static_cast<Viewer*>(glfwGetWindowUserPointer(w))->onKey(key, action, mods);
     });
     rebuild();
+    prepareReference();
   }
   ~Viewer() {
-    reference_.reset();               // cancels a running trace and joins its threads
+    reference_.reset();  // cancels a running trace and joins its threads
+    seen_.reset();       // the seen-points worker: its GL objects go in its own context, on its thread
     window_.context().makeCurrent();  // GL objects go while their context is current
     wipe_.reset();
-    seen_renderer_.reset();
     renderer_.reset();
     glfwSetKeyCallback(window_.handle(), nullptr);
   }
@@ -101,8 +103,11 @@ class Viewer {
     const Observer& ob = ls_.scene.observer;
     return {ob.eye, ob.target, ob.up, ob.width, ob.height, mode_, scene_builds_};
   }
-  // The live reference: startReference traces the current view in the background (and draws the mode's frame
-  // of it once with seen points, for the errors); discardReference cancels or drops it, saying why.
+  // The live reference: startReference traces the current view in the background, and has the mode's frame of
+  // it drawn with seen points for the errors on the seen-points worker (app/view/seen_frames.h), so that the
+  // window's thread builds no program for it; discardReference cancels or drops it, saying why.
+  // prepareReference, at startup: the worker and the wipe's program (its first draw too), built before any frame.
+  void prepareReference();
   void startReference();
   void discardReference(const std::string& why);
   void presentFrame(const Observer& ob);
@@ -168,18 +173,22 @@ class Viewer {
   std::vector<std::string> pending_overrides_;
   double pending_yaw_rad_ = 0, pending_pitch_rad_ = 0;
   Vec3 pending_move_m_{0};
-  std::unique_ptr<gl::Renderer> seen_renderer_;  // the mode's frame with seen points, for the reference's errors
+  std::unique_ptr<SeenFrames> seen_;  // the mode's frame with seen points, for the reference's errors
   std::unique_ptr<ReferenceRun> reference_;
   std::unique_ptr<Wipe> wipe_;
   ViewKey reference_key_;
   bool reference_requested_ = false;  // by key or panel: started at the next frame
   bool waiting_reference_ = false;    // a script's "reference" event: later events wait for it
   bool heat_uploaded_ = false;
+  bool wipe_drawn_ = false;  // the wipe drawn once (prepareReference)
   double wipe_x_ = 0.5;  // the split line: 0 all reference, 1 all mode
   bool overlay_ = false;
   std::string reference_note_;  // why there is no reference now (cancelled, discarded)
   int references_started_ = 0, frames_while_tracing_ = 0;
-  double frame_ms_max_while_tracing_ = 0, reference_start_ms_ = 0;
+  // Programs the window's thread had built when the first reference started (gl::programsBuiltOnThisThread),
+  // -1 before: what it built since is in the stats (none, by design).
+  int programs_at_first_reference_ = -1;
+  double frame_ms_max_while_tracing_ = 0, reference_start_ms_ = 0, reference_start_cpu_ms_ = 0;
 };
 
 }  // namespace pvrr::app::view

@@ -30,11 +30,15 @@ constexpr int kNoErrorGrey = 40;
 
 json readJson(const fs::path& p) { return json::parse(std::ifstream(p)); }
 
+// The view traced second (after a reference of the design view, then a head turn): the seen-points worker
+// (app/view/seen_frames.h) draws it with the renderer it built for the first, moved to the new observer. The
+// window's thread builds no program for either: the worker does (structural, not timed).
 TEST(ViewReference, MatchesCompareForTheSameView) {
   const fs::path dir = freshTestDir("view-reference");
   const fs::path script = dir / "script.json", overlay = dir / "overlay.png", reference = dir / "reference.png",
                  view = dir / "view.json", stats = dir / "stats.json", cmp = dir / "compare";
   writeText(script, R"({"size": [320, 240], "events": [
+      {"at_frame": 1, "do": "reference"},
       {"at_frame": 2, "do": "turn_head", "yaw_deg": 3, "pitch_deg": -1},
       {"at_frame": 3, "do": "reference"},
       {"at_frame": 4, "do": "wipe", "x": 1},
@@ -59,6 +63,10 @@ TEST(ViewReference, MatchesCompareForTheSameView) {
 
   const json live = readJson(stats)["reference"], metrics = readJson(cmp / "metrics.json")["modes"]["pvrr"];
   ASSERT_EQ(live["state"], "done") << live.dump();
+  EXPECT_EQ(live["started"], 2);
+  EXPECT_EQ(live["worker_frames"], 2);
+  EXPECT_GT(live["worker_programs"].get<int>(), 0);          // the seen-points renderer's, built on the worker
+  EXPECT_EQ(live["window_programs_since_start"], 0) << live.dump();  // none on the window's thread
   EXPECT_EQ(live["pixels"], metrics["pixels"]);
   for (const char* q : {"median", "p95"}) {
     const double a = live["angular_error_arcmin"][q], b = metrics["angular_error_arcmin"][q];
