@@ -52,6 +52,8 @@ void Viewer::rebuild(bool keep_mode) {
   renderer_.reset();
   ++scene_builds_;
   rays_.reset();
+  lensmaps_.reset();  // its lens map read the old ray scene
+  planning_lines_.clear();
   ls_ = loadScene(scene_path_, overrides_, width_, height_);
   design_ = ls_.scene.observer;
   if (!keep_mode || scene_builds_ == 1) mode_ = cli_mode_ ? *cli_mode_ : ls_.scene.render.mode;
@@ -169,7 +171,7 @@ void Viewer::frame() {
   const bool tracing = reference_ && !reference_->finished();
   if (has_lens_ && probe_asked_ &&
       (!probe_fresh_ || !(viewKey() == probe_key_) || int(probe_.px) != probe_x_ || int(probe_.py) != probe_y_)) {
-    probe_ = probeLens(ls_.scene, *rays_, probe_x_, probe_y_);
+    probe_ = probeLens(ls_.scene, *rays_, probe_x_, probe_y_, &lensmaps_);
     probe_key_ = viewKey();
     probe_fresh_ = true;
   }
@@ -267,7 +269,10 @@ void Viewer::turnElement(int index, double yaw_rad, double pitch_rad) {
 
 json Viewer::probeStats() const {
   if (!probe_asked_ || !probe_fresh_) return nullptr;
-  json j = {{"pixel", {probe_.px, probe_.py}}, {"valid", probe_.valid}, {"reason", probe_.reason}};
+  json j = {{"pixel", {probe_.px, probe_.py}},
+            {"valid", probe_.valid},
+            {"reason", probe_.reason},
+            {"lensmaps_built", lensmaps_.builds}};  // lens maps the probe built (LensmapCache)
   if (probe_.element >= 0) j["element"] = ls_.scene.elements[size_t(probe_.element)].name;
   if (!probe_.valid) return j;
   const LensmapPoint& r = probe_.reading;

@@ -35,6 +35,8 @@ inline constexpr double kLookDegPerPixel = 0.1;
 inline constexpr double kWipeGrabPx = 8;
 // The panel's step of moving an element (metres).
 inline constexpr double kMoveStepM = 0.001;
+// How often the panel's planning lines are made anew (ms): text a reader can follow, not every frame's.
+inline constexpr double kPlanningRefreshMs = 250;
 
 // What a reference belongs to: the view it traced. Any change (the head, the eye, the window's size, the mode,
 // a setting, which rebuilds the scene) makes it another view's reference, and it is discarded.
@@ -91,6 +93,8 @@ class Viewer {
   void moveElement(int index, const Vec3& by_m);
   int elementIndex(const std::string& name) const;
   void elementsPanel();
+  // The panel's lines on each element's planning: made anew at most every kPlanningRefreshMs (and after a
+  // rebuild or a mode change), not every frame.
   void planningLines(const gl::RasterFrame& f);
   void lensPanel();
   json probeStats() const;
@@ -166,8 +170,12 @@ class Viewer {
   int probe_x_ = 0, probe_y_ = 0;
   double cursor_x_ = 0, cursor_y_ = 0;
   LensProbe probe_;
+  LensmapCache lensmaps_;
   bool probe_fresh_ = false;
   ViewKey probe_key_;
+  std::vector<std::string> planning_lines_;
+  Clock::time_point planning_made_{};
+  RenderMode planning_mode_ = RenderMode::Pvrr;
   int selected_ = 0;  // the element the panel and the keys I/K/J/L turn
   // Changes asked for by the panel or the keys, applied at the next frame (not inside the panel's frame).
   std::vector<std::string> pending_overrides_;
