@@ -36,6 +36,7 @@ const std::map<std::string, std::pair<EventKind, std::vector<std::string>>>& kin
       {"turn_element", {EventKind::TurnElement, {"element", "yaw_deg", "pitch_deg"}}},
       {"cursor", {EventKind::Cursor, {"at"}}},
       {"move_element", {EventKind::MoveElement, {"element", "by"}}},
+      {"time", {EventKind::Time, {"t", "play"}}},
   };
   return table;
 }
@@ -49,7 +50,7 @@ const std::map<std::string, int>& keyCodes() {
       {"LEFT", GLFW_KEY_LEFT}, {"RIGHT", GLFW_KEY_RIGHT}, {"UP", GLFW_KEY_UP},   {"DOWN", GLFW_KEY_DOWN},
       {"HOME", GLFW_KEY_HOME}, {"TAB", GLFW_KEY_TAB},     {"F12", GLFW_KEY_F12}, {"ESCAPE", GLFW_KEY_ESCAPE},
       {"T", GLFW_KEY_T},       {"E", GLFW_KEY_E},         {"J", GLFW_KEY_J},     {"L", GLFW_KEY_L},
-      {"I", GLFW_KEY_I},       {"K", GLFW_KEY_K},
+      {"I", GLFW_KEY_I},       {"K", GLFW_KEY_K},         {"SPACE", GLFW_KEY_SPACE},
   };
   return table;
 }
@@ -197,6 +198,14 @@ ScriptEvent readEvent(const Reader& r, const json& e, const std::string& path) {
       point("to", &ev.to_px);
       break;
     }
+    case EventKind::Time:
+      ev.time_s = r.number(r.need(e, path, "t"), path + ".t");
+      if (!(ev.time_s >= 0) || ev.time_s > 1e6) r.expected(path + ".t", "a time in seconds from 0 to 1e6", e.at("t"));
+      if (e.contains("play")) {
+        if (!e.at("play").is_boolean()) r.expected(path + ".play", "true or false", e.at("play"));
+        ev.on = e.at("play").get<bool>();
+      }
+      break;
     case EventKind::Cursor: {
       const json& v = r.need(e, path, "at");
       if (!v.is_array() || v.size() != 2) r.expected(path + ".at", "[x, y] in window pixels", v);

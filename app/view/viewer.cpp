@@ -66,6 +66,23 @@ void Viewer::rebuild(bool keep_mode) {
   probe_fresh_ = false;
   any_attached_ = std::any_of(ls_.scene.elements.begin(), ls_.scene.elements.end(),
                               [](const Element& e) { return e.attached_to_observer; });
+  animated_ = isAnimated(ls_.desc);
+  duration_s_ = 0;
+  for (const EnvObjectDesc& o : ls_.desc.environment)
+    if (o.animation) duration_s_ = std::max(duration_s_, o.animation->keys.back().time_s);
+  for (const ElementDesc& e : ls_.desc.elements)
+    if (e.animation) duration_s_ = std::max(duration_s_, e.animation->keys.back().time_s);
+  if (animated_) applyAnimation(ls_.scene, ls_.desc, time_s_);  // the time shown stays
+  buildRenderer();
+  if (scene_builds_ > 1)
+    rebuild_ms_max_ = std::max(rebuild_ms_max_, std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+}
+
+void Viewer::buildRenderer() {
+  window_.context().makeCurrent();
+  renderer_.reset();  // before the ray scene it refers to
+  rays_.reset();
+  lensmaps_.reset();
   RaySceneOptions ro;
   ro.moving_elements = any_attached_;  // the head moves them
   rays_ = std::make_unique<RayScene>(ls_.scene, ro);
@@ -74,8 +91,15 @@ void Viewer::rebuild(bool keep_mode) {
   opt.read_back = false;    // presented from the GPU
   renderer_ = std::make_unique<gl::Renderer>(ls_.scene, *rays_, opt);
   cache_ = gl::FrameCache{};
-  if (scene_builds_ > 1)
-    rebuild_ms_max_ = std::max(rebuild_ms_max_, std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+  probe_fresh_ = false;
+  ++pose_builds_;
+}
+
+void Viewer::setTime(double t_s) {
+  time_s_ = std::max(0.0, t_s);
+  if (!animated_) return;
+  updateObserver();  // attached elements are posed from the observer as it stands
+  if (applyAnimation(ls_.scene, ls_.desc, time_s_)) buildRenderer();
 }
 
 void Viewer::runEvents() {
@@ -110,6 +134,11 @@ void Viewer::runEvents() {
         case EventKind::Reference:
           startReference();
           waiting_reference_ = true;
+          break;
+        case EventKind::Time:
+          setTime(e.time_s);
+          playing_ = e.on;
+          played_at_ = Clock::now();
           break;
         case EventKind::Cursor:
           probe_asked_ = true;
@@ -157,6 +186,18 @@ void Viewer::frame() {
     overrides_.insert(overrides_.end(), pending_overrides_.begin(), pending_overrides_.end());
     pending_overrides_.clear();
     rebuild(true);
+  }
+  if (pending_time_s_) {
+    setTime(*pending_time_s_);
+    pending_time_s_.reset();
+  }
+  if (playing_ && animated_) {
+    // Real time; after the last key (and half a second of its pose) it starts again.
+    const auto now = Clock::now();
+    double t = time_s_ + std::chrono::duration<double>(now - played_at_).count();
+    if (t > duration_s_ + kLoopPauseS) t = 0;
+    played_at_ = now;
+    setTime(t);
   }
   if (reference_requested_) {
     reference_requested_ = false;
@@ -317,7 +358,7 @@ void Viewer::startReference() {
   const double cpu0_ms = threadCpuMs();
   // One copy of the view's scene, shared by the tracer and the seen-points worker.
   auto snapshot = std::make_shared<const Scene>(ls_.scene);
-  std::shared_future<Frame> seen = seen_->request(snapshot, ls_.desc, scene_builds_, mode_);
+  std::shared_future<Frame> seen = seen_->request(snapshot, ls_.desc, pose_builds_, mode_);
   const int threads = std::max(1, int(std::thread::hardware_concurrency()) - 1);  // one core for the window
   reference_ = std::make_unique<ReferenceRun>(std::move(snapshot), std::move(seen), threads);
   wipe_->reset(reference_->width(), reference_->height());
@@ -388,6 +429,10 @@ void Viewer::onKey(int key, int action, int mods) {
     case GLFW_KEY_3: setMode(RenderMode::Impostor); break;
     case GLFW_KEY_4: setMode(RenderMode::Raster); break;
     case GLFW_KEY_TAB: show_panel_ = !show_panel_; break;
+    case GLFW_KEY_SPACE:
+      playing_ = animated_ && !playing_;
+      played_at_ = Clock::now();
+      break;
     case GLFW_KEY_T:
       reference_requested_ = true;
       break;
@@ -483,6 +528,10 @@ json Viewer::stats() const {
           // Rebuilds of the scene after the first (a "set", a panel setting, a turned element), and the slowest
           // one's time (ms; the renderer's first frame after it, with its programs, is in frame_ms_max).
           {"rebuilds", scene_builds_ - 1},
+          // Animated scenes: the time shown (s) and whether it plays; renderers built (rebuilds and moving times).
+          {"time_s", time_s_},
+          {"playing", playing_},
+          {"renderer_builds", pose_builds_},
           {"rebuild_ms_max", rebuild_ms_max_},
           {"gl", glName()}};
 }

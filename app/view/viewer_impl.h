@@ -35,6 +35,8 @@ inline constexpr double kLookDegPerPixel = 0.1;
 inline constexpr double kWipeGrabPx = 8;
 // The panel's step of moving an element (metres).
 inline constexpr double kMoveStepM = 0.001;
+// Playing time: how long the last key's pose is held before it starts again (s).
+inline constexpr double kLoopPauseS = 0.5;
 // How often the panel's planning lines are made anew (ms): text a reader can follow, not every frame's.
 inline constexpr double kPlanningRefreshMs = 250;
 
@@ -89,6 +91,12 @@ class Viewer {
   void rebuild(bool keep_mode = false);
   // Element `index` turned about its vertex (app/view/element_pose.h): its pose written as overrides, rebuilt.
   void turnElement(int index, double yaw_rad, double pitch_rad);
+  // An animated scene's time (issue 24 item 1): the scene posed at t_s as pvrr render --time poses it; where
+  // anything moved, the renderer and the ray scene are built again (they hold the geometry), as render does.
+  void setTime(double t_s);
+  // The renderer and the Embree scene of ls_.scene as it stands, with a fresh frame cache.
+  void buildRenderer();
+  void timePanel();
   // Element `index` moved by `by_m` in its own frame (x right, y up, z along its normal), rebuilt likewise.
   void moveElement(int index, const Vec3& by_m);
   int elementIndex(const std::string& name) const;
@@ -105,7 +113,7 @@ class Viewer {
   const Observer& updateObserver();
   ViewKey viewKey() const {
     const Observer& ob = ls_.scene.observer;
-    return {ob.eye, ob.target, ob.up, ob.width, ob.height, mode_, scene_builds_};
+    return {ob.eye, ob.target, ob.up, ob.width, ob.height, mode_, pose_builds_};
   }
   // The live reference: startReference traces the current view in the background, and has the mode's frame of
   // it drawn with seen points for the errors on the seen-points worker (app/view/seen_frames.h), so that the
@@ -162,6 +170,11 @@ class Viewer {
   double last_x_ = 0, last_y_ = 0;
 
   int scene_builds_ = 0;
+  int pose_builds_ = 0;  // renderers built (a rebuild, or a time that moved something): the geometry's version
+  // Time: animated scenes only (isAnimated). Playing advances it by the wall clock, looping after the last key.
+  bool animated_ = false, playing_ = false;
+  double time_s_ = 0, duration_s_ = 0;
+  Clock::time_point played_at_{};
   double rebuild_ms_max_ = 0;  // the slowest rebuild after the first (a setting, a turned element)
   // The lens probe (scenes with a lens): the pixel under the cursor (the mouse when it moves, or a script's
   // "cursor"), read again when that pixel or the view changes.
@@ -181,6 +194,7 @@ class Viewer {
   std::vector<std::string> pending_overrides_;
   double pending_yaw_rad_ = 0, pending_pitch_rad_ = 0;
   Vec3 pending_move_m_{0};
+  std::optional<double> pending_time_s_;
   std::unique_ptr<SeenFrames> seen_;  // the mode's frame with seen points, for the reference's errors
   std::unique_ptr<ReferenceRun> reference_;
   std::unique_ptr<Wipe> wipe_;

@@ -65,6 +65,20 @@ void Viewer::planningLines(const gl::RasterFrame& f) {
   for (const std::string& line : planning_lines_) ImGui::TextWrapped("%s", line.c_str());
 }
 
+void Viewer::timePanel() {
+  if (!animated_) return;
+  float t = float(time_s_);
+  if (ImGui::SliderFloat("time (s)", &t, 0.0f, float(duration_s_), "%.2f")) {
+    playing_ = false;
+    pending_time_s_ = double(t);  // at the next frame
+  }
+  ImGui::SameLine();
+  if (ImGui::Button(playing_ ? "pause (Space)" : "play (Space)")) {
+    playing_ = !playing_;
+    played_at_ = Clock::now();
+  }
+}
+
 void Viewer::elementsPanel() {
   if (ls_.scene.elements.empty() || !ImGui::CollapsingHeader("elements and settings")) return;
   const Element& sel = ls_.scene.elements[size_t(selected_)];
@@ -199,6 +213,7 @@ void Viewer::panel(const gl::RasterFrame& f, double frame_ms) {
     }
     ImGui::EndTable();
   }
+  timePanel();
   planningLines(f);
   referencePanel();
   lensPanel();
@@ -214,6 +229,7 @@ void Viewer::panel(const gl::RasterFrame& f, double frame_ms) {
         "T                   trace the reference of this view (again: cancel)\n"
         "E                   error overlay on or off\n"
         "drag the split line wipe between the mode and the reference\n"
+        "Space               play or pause an animated scene's time\n"
         "Tab                 hide or show this panel\n"
         "F12 / V             screenshot / save view (out/view-N.png, .json)\n"
         "Esc                 quit");

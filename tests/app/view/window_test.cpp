@@ -158,6 +158,37 @@ TEST(ViewWindow, KeysTurnTheHeadAndReturnToTheDesignEye) {
   fs::remove_all(dir);
 }
 
+// Time in an animated scene (issue 24 item 1): the "time" event poses the scene as pvrr render --time does, so the
+// window's picture at t = 1.5 s is render's of the saved view at 1.5 s; and it is not the picture at 0 (the
+// overtaking car moved). Space (the keyboard's path) plays: the time runs on.
+TEST(ViewWindow, TimeShowsTheAnimatedSceneAsRenderAtThatTime) {
+  const fs::path dir = freshTestDir("view-time");
+  const fs::path script = dir / "script.json", shot = dir / "window.png", view = dir / "view.json",
+                 at_t = dir / "render.png", at_0 = dir / "render0.png", stats = dir / "stats.json";
+  writeText(script, R"({"size": [320, 240], "events": [
+      {"at_frame": 2, "do": "time", "t": 1.5},
+      {"at_frame": 4, "do": "screenshot", "file": ")" + shot.string() + R"("},
+      {"at_frame": 4, "do": "save_view", "file": ")" + view.string() + R"("},
+      {"at_frame": 5, "do": "key", "key": "SPACE"},
+      {"at_frame": 8, "do": "quit"}]})");
+  CliResult r;
+  RUN_VIEW_OR_SKIP("models/overtaking-car.json --script '" + script.string() + "' --stats '" + stats.string() + "'",
+                   &r);
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const auto& [t, out] : {std::pair{"1.5", at_t}, std::pair{"0", at_0}}) {
+    const CliResult rr = runPvrr("render '" + view.string() + "' --time " + t + " --out '" + out.string() + "'");
+    ASSERT_EQ(rr.code, 0) << rr.err;
+  }
+  const ImageRGB8 window = readPng(shot.string());
+  const ImageDiff d = compareImages(window, readPng(at_t.string()), kWindowVsRenderCodes);
+  EXPECT_EQ(d.failing_pixels, 0) << describe(d);
+  EXPECT_GT(compareImages(window, readPng(at_0.string()), kWindowVsRenderCodes).failing_pixels, 0);  // it moved
+  const nlohmann::json st = nlohmann::json::parse(std::ifstream(stats));
+  EXPECT_TRUE(st["playing"].get<bool>());
+  EXPECT_GT(st["time_s"].get<double>(), 1.5);  // played on from 1.5 s
+  fs::remove_all(dir);
+}
+
 // "set" rebuilds the scene: a mode change by script shows that mode's picture.
 TEST(ViewWindow, SetChangesTheModeLive) {
   const fs::path dir = freshTestDir("view-set");
