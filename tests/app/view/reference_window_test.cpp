@@ -90,6 +90,37 @@ TEST(ViewReference, MatchesCompareForTheSameView) {
   fs::remove_all(dir);
 }
 
+// Spectacles move with the head: the worker's renderer, kept from the first reference, re-poses the lens for the
+// turned head as the window does, and the second reference's errors are compare's of the saved view.
+TEST(ViewReference, SpectaclesTurnedWithTheHeadMatchCompare) {
+  const fs::path dir = freshTestDir("view-reference-lens");
+  const fs::path script = dir / "script.json", view = dir / "view.json", stats = dir / "stats.json",
+                 cmp = dir / "compare";
+  writeText(script, R"({"size": [200, 150], "events": [
+      {"at_frame": 1, "do": "reference"},
+      {"at_frame": 2, "do": "turn_head", "yaw_deg": 4, "pitch_deg": 2},
+      {"at_frame": 3, "do": "reference"},
+      {"at_frame": 4, "do": "save_view", "file": ")" +
+                        view.string() + R"("},
+      {"at_frame": 5, "do": "quit"}]})");
+  CliResult r;
+  RUN_VIEW_OR_SKIP("models/spectacle-lens.json --script '" + script.string() + "' --stats '" + stats.string() + "'",
+                   &r);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const CliResult c = runPvrr("compare '" + view.string() + "' --modes pvrr --frames 1 --out '" + cmp.string() + "'");
+  ASSERT_EQ(c.code, 0) << c.err;
+  const json live = readJson(stats)["reference"], metrics = readJson(cmp / "metrics.json")["modes"]["pvrr"];
+  ASSERT_EQ(live["state"], "done") << live.dump();
+  EXPECT_EQ(live["worker_frames"], 2);
+  EXPECT_EQ(live["window_programs_since_start"], 0);
+  EXPECT_EQ(live["pixels"], metrics["pixels"]);
+  for (const char* q : {"median", "p95"}) {
+    const double a = live["angular_error_arcmin"][q], b = metrics["angular_error_arcmin"][q];
+    EXPECT_NEAR(a, b, kMedianRelTol * b) << q;
+  }
+  fs::remove_all(dir);
+}
+
 // The split line follows a drag that starts on it; a drag elsewhere turns the head, which makes the reference
 // another view's: it is discarded, saying why.
 TEST(ViewReference, DragMovesTheSplitLineOrTurnsTheHead) {
