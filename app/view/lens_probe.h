@@ -31,7 +31,10 @@ struct LensmapCache {
   std::unique_ptr<Lensmap> map;
   LensmapPoint centre;
   int builds = 0;  // lens maps built through this cache
-  void reset() { map.reset(); element = -1; }
+  void reset() {
+    map.reset();
+    element = -1;
+  }
 };
 
 // The probe at the centre of pixel (x, y) (integer parts of a cursor position) of `scene`'s observer. With a

@@ -44,12 +44,12 @@ const std::map<std::string, std::pair<EventKind, std::vector<std::string>>>& kin
 // The keys the viewer answers to, by their GLFW names (GLFW_KEY_<name>).
 const std::map<std::string, int>& keyCodes() {
   static const std::map<std::string, int> table = {
-      {"W", GLFW_KEY_W},       {"A", GLFW_KEY_A},         {"S", GLFW_KEY_S},     {"D", GLFW_KEY_D},
-      {"R", GLFW_KEY_R},       {"F", GLFW_KEY_F},         {"H", GLFW_KEY_H},     {"V", GLFW_KEY_V},
-      {"1", GLFW_KEY_1},       {"2", GLFW_KEY_2},         {"3", GLFW_KEY_3},     {"4", GLFW_KEY_4},
-      {"LEFT", GLFW_KEY_LEFT}, {"RIGHT", GLFW_KEY_RIGHT}, {"UP", GLFW_KEY_UP},   {"DOWN", GLFW_KEY_DOWN},
-      {"HOME", GLFW_KEY_HOME}, {"TAB", GLFW_KEY_TAB},     {"F12", GLFW_KEY_F12}, {"ESCAPE", GLFW_KEY_ESCAPE},
-      {"T", GLFW_KEY_T},       {"E", GLFW_KEY_E},         {"J", GLFW_KEY_J},     {"L", GLFW_KEY_L},
+      {"W", GLFW_KEY_W},       {"A", GLFW_KEY_A},         {"S", GLFW_KEY_S},         {"D", GLFW_KEY_D},
+      {"R", GLFW_KEY_R},       {"F", GLFW_KEY_F},         {"H", GLFW_KEY_H},         {"V", GLFW_KEY_V},
+      {"1", GLFW_KEY_1},       {"2", GLFW_KEY_2},         {"3", GLFW_KEY_3},         {"4", GLFW_KEY_4},
+      {"LEFT", GLFW_KEY_LEFT}, {"RIGHT", GLFW_KEY_RIGHT}, {"UP", GLFW_KEY_UP},       {"DOWN", GLFW_KEY_DOWN},
+      {"HOME", GLFW_KEY_HOME}, {"TAB", GLFW_KEY_TAB},     {"F12", GLFW_KEY_F12},     {"ESCAPE", GLFW_KEY_ESCAPE},
+      {"T", GLFW_KEY_T},       {"E", GLFW_KEY_E},         {"J", GLFW_KEY_J},         {"L", GLFW_KEY_L},
       {"I", GLFW_KEY_I},       {"K", GLFW_KEY_K},         {"SPACE", GLFW_KEY_SPACE},
   };
   return table;

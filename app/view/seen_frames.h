@@ -61,8 +61,8 @@ class SeenFrames {
   std::unique_ptr<WorkerContext> context_;
   mutable std::mutex mutex_;
   std::condition_variable wake_;
-  std::optional<Job> pending_;  // guarded by mutex_
-  bool stop_ = false;           // guarded by mutex_
+  std::optional<Job> pending_;     // guarded by mutex_
+  bool stop_ = false;              // guarded by mutex_
   int frames_ = 0, programs_ = 0;  // guarded by mutex_
   std::thread thread_;
 };

@@ -73,8 +73,8 @@ class Viewer {
     prepareReference();
   }
   ~Viewer() {
-    reference_.reset();  // cancels a running trace and joins its threads
-    seen_.reset();       // the seen-points worker: its GL objects go in its own context, on its thread
+    reference_.reset();               // cancels a running trace and joins its threads
+    seen_.reset();                    // the seen-points worker: its GL objects go in its own context, on its thread
     window_.context().makeCurrent();  // GL objects go while their context is current
     wipe_.reset();
     renderer_.reset();

@@ -65,7 +65,7 @@ TEST(ViewReference, MatchesCompareForTheSameView) {
   ASSERT_EQ(live["state"], "done") << live.dump();
   EXPECT_EQ(live["started"], 2);
   EXPECT_EQ(live["worker_frames"], 2);
-  EXPECT_GT(live["worker_programs"].get<int>(), 0);          // the seen-points renderer's, built on the worker
+  EXPECT_GT(live["worker_programs"].get<int>(), 0);                  // the seen-points renderer's, built on the worker
   EXPECT_EQ(live["window_programs_since_start"], 0) << live.dump();  // none on the window's thread
   EXPECT_EQ(live["pixels"], metrics["pixels"]);
   for (const char* q : {"median", "p95"}) {

@@ -167,8 +167,10 @@ TEST(ViewWindow, TimeShowsTheAnimatedSceneAsRenderAtThatTime) {
                  at_t = dir / "render.png", at_0 = dir / "render0.png", stats = dir / "stats.json";
   writeText(script, R"({"size": [320, 240], "events": [
       {"at_frame": 2, "do": "time", "t": 1.5},
-      {"at_frame": 4, "do": "screenshot", "file": ")" + shot.string() + R"("},
-      {"at_frame": 4, "do": "save_view", "file": ")" + view.string() + R"("},
+      {"at_frame": 4, "do": "screenshot", "file": ")" +
+                        shot.string() + R"("},
+      {"at_frame": 4, "do": "save_view", "file": ")" +
+                        view.string() + R"("},
       {"at_frame": 5, "do": "key", "key": "SPACE"},
       {"at_frame": 8, "do": "quit"}]})");
   CliResult r;
