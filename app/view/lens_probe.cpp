@@ -5,7 +5,7 @@
 
 namespace pvrr::app::view {
 
-LensProbe probeLens(const Scene& scene, const RayScene& rays, int x, int y) {
+LensProbe probeLens(const Scene& scene, const RayScene& rays, int x, int y, LensmapCache* cache) {
   LensProbe p;
   p.px = x + 0.5;
   p.py = y + 0.5;
@@ -27,14 +27,22 @@ LensProbe probeLens(const Scene& scene, const RayScene& rays, int x, int y) {
   const Element& el = scene.elements[size_t(hit.element)];
   LensmapOptions o;
   o.rotation_centre_m = el.eye_rotation_centre_m;
-  const Lensmap map(rays, hit.element, o);
+  LensmapCache local;
+  LensmapCache& c = cache ? *cache : local;
+  if (!c.map || c.element != hit.element || c.local_to_world != el.local_to_world) {
+    c.map = std::make_unique<Lensmap>(rays, hit.element, o);
+    c.element = hit.element;
+    c.local_to_world = el.local_to_world;
+    c.centre = c.map->evaluate(0, 0);
+    ++c.builds;
+  }
+  const Lensmap& map = *c.map;
   // The gaze through p from the centre of rotation (0, 0, r) of the lens frame, as Fick angles
   // (pvrr/analysis/lensmap.h: g = (cos gy sin gx, sin gy, -cos gy cos gx)).
   p.lens_point_local = el.toLocalPoint(hit.point);
   const Vec3 g = glm::normalize(p.lens_point_local - Vec3(0, 0, o.rotation_centre_m));
   const double gaze_y = std::asin(std::clamp(g.y, -1.0, 1.0)), gaze_x = std::atan2(g.x, -g.z);
-  const LensmapPoint centre = map.evaluate(0, 0);
-  p.reading = map.evaluate(degrees(gaze_x), degrees(gaze_y), centre.valid ? &centre : nullptr);
+  p.reading = map.evaluate(degrees(gaze_x), degrees(gaze_y), c.centre.valid ? &c.centre : nullptr);
   p.valid = p.reading.valid;
   if (!p.valid) p.reason = p.reading.reason;
   return p;

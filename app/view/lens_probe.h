@@ -4,6 +4,7 @@
 // `eye` block; the chief ray of that gaze runs straight from the centre to p), for a distant object, with the
 // power error and unwanted cylinder against the lens's centre (gaze 0, 0).
 #pragma once
+#include <memory>
 #include <string>
 
 #include "pvrr/analysis/lensmap.h"
@@ -21,7 +22,23 @@ struct LensProbe {
   LensmapPoint reading;      // valid: the lens map at p's gaze
 };
 
-// The probe at the centre of pixel (x, y) (integer parts of a cursor position) of `scene`'s observer.
-LensProbe probeLens(const Scene& scene, const RayScene& rays, int x, int y);
+// The lens map of the last lens probed and its centre's reading, kept while that lens stands where it stood (its
+// local_to_world unchanged) in the same ray scene: building a Lensmap costs far more than evaluating it, and the
+// probe follows every mouse move. Clear it (reset()) when the ray scene is rebuilt.
+struct LensmapCache {
+  int element = -1;
+  Mat4 local_to_world{1.0};
+  std::unique_ptr<Lensmap> map;
+  LensmapPoint centre;
+  int builds = 0;  // lens maps built through this cache
+  void reset() {
+    map.reset();
+    element = -1;
+  }
+};
+
+// The probe at the centre of pixel (x, y) (integer parts of a cursor position) of `scene`'s observer. With a
+// cache, its lens map is reused while it fits (LensmapCache).
+LensProbe probeLens(const Scene& scene, const RayScene& rays, int x, int y, LensmapCache* cache = nullptr);
 
 }  // namespace pvrr::app::view

@@ -19,6 +19,8 @@ namespace {
 
 // Nice value of the tracing threads: the window's own thread keeps its frame rate while they run.
 constexpr int kTracingNice = 10;
+// How often a run waiting for the mode's frame looks for a cancel (ms).
+constexpr int kWaitStepMs = 5;
 
 void prepareTracingThread() {
   // Denormals only slow the traversal down; flushed in every tracing thread, as Tracer::render does.
@@ -29,14 +31,18 @@ void prepareTracingThread() {
 
 }  // namespace
 
-ReferenceRun::ReferenceRun(const Scene& scene, Frame mode_frame, int threads)
-    : scene_(std::make_unique<Scene>(scene)),
+ReferenceRun::ReferenceRun(std::shared_ptr<const Scene> scene, std::shared_future<Frame> mode_frame, int threads)
+    : scene_(std::move(scene)),
       mode_frame_(std::move(mode_frame)),
-      width_(scene.observer.width),
-      height_(scene.observer.height),
+      width_(scene_->observer.width),
+      height_(scene_->observer.height),
       threads_(std::max(1, threads)) {
   tiles_x_ = (width_ + kTile - 1) / kTile;
   tile_count_ = tiles_x_ * ((height_ + kTile - 1) / kTile);
+  thread_ = std::thread([this] { run(); });
+}
+
+void ReferenceRun::allocate() {
   const size_t n = size_t(width_) * size_t(height_);
   ref_.width = width_;
   ref_.height = height_;
@@ -46,7 +52,6 @@ ReferenceRun::ReferenceRun(const Scene& scene, Frame mode_frame, int threads)
   ref_.element_point.assign(n, Vec3(0));
   ref_.bounces.assign(n, 0);
   rgba_.assign(n * 4, 0);
-  thread_ = std::thread([this] { run(); });
 }
 
 ReferenceRun::~ReferenceRun() {
@@ -85,6 +90,7 @@ void ReferenceRun::fail(const std::string& why) {
 void ReferenceRun::traceAndMeasure() {
   prepareTracingThread();
   const auto t0 = std::chrono::steady_clock::now();
+  allocate();
   // The scene's own Embree scene and tracer, with the options pvrr render and compare give the reference.
   RayScene rays(*scene_);
   TraceOptions to;
@@ -110,7 +116,10 @@ void ReferenceRun::traceAndMeasure() {
   if (cancel_) return;
   trace_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   ref_.frame_ms = trace_ms_;
-  computeErrors();
+  // The mode's frame: drawn meanwhile by another thread; waited for in steps, so that a cancel is heard.
+  while (mode_frame_.wait_for(std::chrono::milliseconds(kWaitStepMs)) != std::future_status::ready)
+    if (cancel_) return;
+  computeErrors(mode_frame_.get());  // rethrows the drawing's error: the run fails with it
   finished_.store(true, std::memory_order_release);
 }
 
@@ -141,13 +150,13 @@ void ReferenceRun::traceTiles(const Tracer& tracer) {
   }
 }
 
-void ReferenceRun::computeErrors() {
+void ReferenceRun::computeErrors(const Frame& mode_frame) {
   const size_t n = size_t(width_) * size_t(height_);
-  has_errors_ = mode_frame_.seen.size() == n;
+  has_errors_ = mode_frame.seen.size() == n;
   heat_rgba_.assign(n * 4, 0);
   if (!has_errors_) return;
   // pvrr compare's figures: the angular error of the mode's seen points against the reference's, summarised.
-  errors_ = angularErrors(ref_, ref_.seen, mode_frame_.seen);
+  errors_ = angularErrors(ref_, ref_.seen, mode_frame.seen);
   stats_ = summarizeErrors(errors_);
   scale_arcmin_ = heatMapScaleArcmin(stats_);
   for (size_t i = 0; i < n; ++i) {

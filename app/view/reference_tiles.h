@@ -5,12 +5,15 @@
 // compare's heat map of it.
 //
 // Each pixel is Tracer::tracePixel at its centre, which is what Tracer::render computes (its packets give the
-// same exact primary hits), so the finished reference is compare's reference picture. The run holds its own
-// copy of the scene and its own Embree scene: the window's may move while it traces. Destroying a run cancels
-// it (the threads stop after their current tile) and joins; a run writes no file.
+// same exact primary hits), so the finished reference is compare's reference picture. The run holds a copy of
+// the scene as it was (shared with whoever draws the mode's frame, app/view/seen_frames.h) and its own Embree
+// scene: the window's may move while it traces. The mode's frame may arrive while the tiles are traced; the
+// errors wait for it. Destroying a run cancels it (the threads stop after their current tile, or stop waiting)
+// and joins; a run writes no file. The window's thread only starts it: every allocation is on the run's thread.
 #pragma once
 #include <atomic>
 #include <cstdint>
+#include <future>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -39,8 +42,8 @@ class ReferenceRun {
 
   // Starts tracing `scene` as its observer sees it, in `threads` threads (at least 1) of lowered priority.
   // `mode_frame`: the mode's frame of the same view with seen points (gl::RendererOptions::seen_points), or a
-  // frame without them (no error figures then).
-  ReferenceRun(const Scene& scene, Frame mode_frame, int threads);
+  // frame without them (no error figures then); an error in it fails the run, saying so.
+  ReferenceRun(std::shared_ptr<const Scene> scene, std::shared_future<Frame> mode_frame, int threads);
   ~ReferenceRun();
   ReferenceRun(const ReferenceRun&) = delete;
   ReferenceRun& operator=(const ReferenceRun&) = delete;
@@ -73,13 +76,14 @@ class ReferenceRun {
 
  private:
   void run();
+  void allocate();
   void traceAndMeasure();
   void fail(const std::string& why);
   void traceTiles(const Tracer& tracer);
-  void computeErrors();
+  void computeErrors(const Frame& mode_frame);
 
-  std::unique_ptr<Scene> scene_;
-  Frame mode_frame_;
+  std::shared_ptr<const Scene> scene_;
+  std::shared_future<Frame> mode_frame_;
   int width_ = 0, height_ = 0, threads_ = 1, tiles_x_ = 0, tile_count_ = 0;
   Frame ref_;
   std::vector<std::uint8_t> rgba_;

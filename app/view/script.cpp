@@ -36,6 +36,7 @@ const std::map<std::string, std::pair<EventKind, std::vector<std::string>>>& kin
       {"turn_element", {EventKind::TurnElement, {"element", "yaw_deg", "pitch_deg"}}},
       {"cursor", {EventKind::Cursor, {"at"}}},
       {"move_element", {EventKind::MoveElement, {"element", "by"}}},
+      {"time", {EventKind::Time, {"t", "play"}}},
   };
   return table;
 }
@@ -43,13 +44,13 @@ const std::map<std::string, std::pair<EventKind, std::vector<std::string>>>& kin
 // The keys the viewer answers to, by their GLFW names (GLFW_KEY_<name>).
 const std::map<std::string, int>& keyCodes() {
   static const std::map<std::string, int> table = {
-      {"W", GLFW_KEY_W},       {"A", GLFW_KEY_A},         {"S", GLFW_KEY_S},     {"D", GLFW_KEY_D},
-      {"R", GLFW_KEY_R},       {"F", GLFW_KEY_F},         {"H", GLFW_KEY_H},     {"V", GLFW_KEY_V},
-      {"1", GLFW_KEY_1},       {"2", GLFW_KEY_2},         {"3", GLFW_KEY_3},     {"4", GLFW_KEY_4},
-      {"LEFT", GLFW_KEY_LEFT}, {"RIGHT", GLFW_KEY_RIGHT}, {"UP", GLFW_KEY_UP},   {"DOWN", GLFW_KEY_DOWN},
-      {"HOME", GLFW_KEY_HOME}, {"TAB", GLFW_KEY_TAB},     {"F12", GLFW_KEY_F12}, {"ESCAPE", GLFW_KEY_ESCAPE},
-      {"T", GLFW_KEY_T},       {"E", GLFW_KEY_E},         {"J", GLFW_KEY_J},     {"L", GLFW_KEY_L},
-      {"I", GLFW_KEY_I},       {"K", GLFW_KEY_K},         {"O", GLFW_KEY_O},
+      {"W", GLFW_KEY_W},       {"A", GLFW_KEY_A},         {"S", GLFW_KEY_S},         {"D", GLFW_KEY_D},
+      {"R", GLFW_KEY_R},       {"F", GLFW_KEY_F},         {"H", GLFW_KEY_H},         {"V", GLFW_KEY_V},
+      {"1", GLFW_KEY_1},       {"2", GLFW_KEY_2},         {"3", GLFW_KEY_3},         {"4", GLFW_KEY_4},
+      {"LEFT", GLFW_KEY_LEFT}, {"RIGHT", GLFW_KEY_RIGHT}, {"UP", GLFW_KEY_UP},       {"DOWN", GLFW_KEY_DOWN},
+      {"HOME", GLFW_KEY_HOME}, {"TAB", GLFW_KEY_TAB},     {"F12", GLFW_KEY_F12},     {"ESCAPE", GLFW_KEY_ESCAPE},
+      {"T", GLFW_KEY_T},       {"E", GLFW_KEY_E},         {"J", GLFW_KEY_J},         {"L", GLFW_KEY_L},
+      {"I", GLFW_KEY_I},       {"K", GLFW_KEY_K},         {"SPACE", GLFW_KEY_SPACE}, {"O", GLFW_KEY_O},
   };
   return table;
 }
@@ -197,6 +198,14 @@ ScriptEvent readEvent(const Reader& r, const json& e, const std::string& path) {
       point("to", &ev.to_px);
       break;
     }
+    case EventKind::Time:
+      ev.time_s = r.number(r.need(e, path, "t"), path + ".t");
+      if (!(ev.time_s >= 0) || ev.time_s > 1e6) r.expected(path + ".t", "a time in seconds from 0 to 1e6", e.at("t"));
+      if (e.contains("play")) {
+        if (!e.at("play").is_boolean()) r.expected(path + ".play", "true or false", e.at("play"));
+        ev.on = e.at("play").get<bool>();
+      }
+      break;
     case EventKind::Cursor: {
       const json& v = r.need(e, path, "at");
       if (!v.is_array() || v.size() != 2) r.expected(path + ".at", "[x, y] in window pixels", v);

@@ -12,7 +12,7 @@ namespace pvrr::app::view {
 
 // clang-format off
 enum class EventKind { Set, TurnHead, MoveEye, Screenshot, SaveView, Quit, Key, Reference, Wipe, Overlay, Drag,
-                       TurnElement, Cursor, MoveElement };
+                       TurnElement, Cursor, MoveElement, Time };
 // clang-format on
 
 struct ScriptEvent {
@@ -34,7 +34,8 @@ struct ScriptEvent {
   // reference: start the live reference of the current view and run no later event until it is finished
   // (the window keeps drawing meanwhile).
   double wipe_x = 0.5;        // wipe: the split line's position, 0 (all reference) to 1 (all mode)
-  bool on = false;            // overlay: show ("on": true) or hide the error heat map
+  bool on = false;            // overlay: show ("on": true) or hide the error heat map; time: play on from t ("play")
+  double time_s = 0;          // time: the animated scene's time "t" (s), as pvrr render --time; playing stops
   Vec2 from_px{0}, to_px{0};  // drag (left button): press at "from", move to "to", release; window pixels
 };
 

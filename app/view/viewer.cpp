@@ -12,6 +12,8 @@
 #include <optional>
 #include <thread>
 
+#include <time.h>
+
 #include "app/args.h"
 #include "app/commands.h"
 #include "app/report.h"
@@ -27,19 +29,31 @@
 #include "pvrr/analysis/accuracy.h"
 #include "pvrr/base/error.h"
 #include "pvrr/base/format.h"
+#include "pvrr/gl/program.h"
 #include "pvrr/scene/scene_json.h"
 
 namespace pvrr::app {
 namespace view {
+namespace {
+
+// This thread's CPU time (ms): what a step costs the window's thread, apart from the time others held the cores.
+double threadCpuMs() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
+}
+
+}  // namespace
 
 void Viewer::rebuild(bool keep_mode) {
   if (reference_) discardReference("discarded: the scene was rebuilt (a setting changed)");
   const auto t0 = Clock::now();
   window_.context().makeCurrent();
-  seen_renderer_.reset();
   renderer_.reset();
   ++scene_builds_;
   rays_.reset();
+  lensmaps_.reset();  // its lens map read the old ray scene
+  planning_lines_.clear();
   ls_ = loadScene(scene_path_, overrides_, width_, height_);
   design_ = ls_.scene.observer;
   if (!keep_mode || scene_builds_ == 1) mode_ = cli_mode_ ? *cli_mode_ : ls_.scene.render.mode;
@@ -52,6 +66,23 @@ void Viewer::rebuild(bool keep_mode) {
   probe_fresh_ = false;
   any_attached_ = std::any_of(ls_.scene.elements.begin(), ls_.scene.elements.end(),
                               [](const Element& e) { return e.attached_to_observer; });
+  animated_ = isAnimated(ls_.desc);
+  duration_s_ = 0;
+  for (const EnvObjectDesc& o : ls_.desc.environment)
+    if (o.animation) duration_s_ = std::max(duration_s_, o.animation->keys.back().time_s);
+  for (const ElementDesc& e : ls_.desc.elements)
+    if (e.animation) duration_s_ = std::max(duration_s_, e.animation->keys.back().time_s);
+  if (animated_) applyAnimation(ls_.scene, ls_.desc, time_s_);  // the time shown stays
+  buildRenderer();
+  if (scene_builds_ > 1)
+    rebuild_ms_max_ = std::max(rebuild_ms_max_, std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+}
+
+void Viewer::buildRenderer() {
+  window_.context().makeCurrent();
+  renderer_.reset();  // before the ray scene it refers to
+  rays_.reset();
+  lensmaps_.reset();
   RaySceneOptions ro;
   ro.moving_elements = any_attached_;  // the head moves them
   rays_ = std::make_unique<RayScene>(ls_.scene, ro);
@@ -60,8 +91,15 @@ void Viewer::rebuild(bool keep_mode) {
   opt.read_back = false;    // presented from the GPU
   renderer_ = std::make_unique<gl::Renderer>(ls_.scene, *rays_, opt);
   cache_ = gl::FrameCache{};
-  if (scene_builds_ > 1)
-    rebuild_ms_max_ = std::max(rebuild_ms_max_, std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+  probe_fresh_ = false;
+  ++pose_builds_;
+}
+
+void Viewer::setTime(double t_s) {
+  time_s_ = std::max(0.0, t_s);
+  if (!animated_) return;
+  updateObserver();  // attached elements are posed from the observer as it stands
+  if (applyAnimation(ls_.scene, ls_.desc, time_s_)) buildRenderer();
 }
 
 void Viewer::runEvents() {
@@ -96,6 +134,11 @@ void Viewer::runEvents() {
         case EventKind::Reference:
           startReference();
           waiting_reference_ = true;
+          break;
+        case EventKind::Time:
+          setTime(e.time_s);
+          playing_ = e.on;
+          played_at_ = Clock::now();
           break;
         case EventKind::Cursor:
           probe_asked_ = true;
@@ -144,6 +187,18 @@ void Viewer::frame() {
     pending_overrides_.clear();
     rebuild(true);
   }
+  if (pending_time_s_) {
+    setTime(*pending_time_s_);
+    pending_time_s_.reset();
+  }
+  if (playing_ && animated_) {
+    // Real time; after the last key (and half a second of its pose) it starts again.
+    const auto now = Clock::now();
+    double t = time_s_ + std::chrono::duration<double>(now - played_at_).count();
+    if (t > duration_s_ + kLoopPauseS) t = 0;
+    played_at_ = now;
+    setTime(t);
+  }
   if (reference_requested_) {
     reference_requested_ = false;
     if (reference_ && !reference_->finished())
@@ -157,7 +212,7 @@ void Viewer::frame() {
   const bool tracing = reference_ && !reference_->finished();
   if (has_lens_ && probe_asked_ &&
       (!probe_fresh_ || !(viewKey() == probe_key_) || int(probe_.px) != probe_x_ || int(probe_.py) != probe_y_)) {
-    probe_ = probeLens(ls_.scene, *rays_, probe_x_, probe_y_);
+    probe_ = probeLens(ls_.scene, *rays_, probe_x_, probe_y_, &lensmaps_);
     probe_key_ = viewKey();
     probe_fresh_ = true;
   }
@@ -169,6 +224,12 @@ void Viewer::frame() {
   const gl::RasterFrame f = renderer_->render(mode_, pending_screenshots_.empty() ? &cache_ : &whole);
   cache_.environment_changed = false;  // the environment never changes while the window is open
   const auto t_render = Clock::now();
+  if (!wipe_drawn_) {
+    // The wipe's first draw, where a software GL compiles its shaders' code: here, of the first frame, into the
+    // back buffer that the frame's present then overwrites, not at the first reference.
+    wipe_->present(renderer_->colorTexture(), ob.width, ob.height, 0.5 * ob.width, true);
+    wipe_drawn_ = true;
+  }
   presentFrame(ob);
   const auto t_present = Clock::now();
   if (!pending_screenshots_.empty()) {
@@ -250,7 +311,10 @@ void Viewer::turnElement(int index, double yaw_rad, double pitch_rad) {
 
 json Viewer::probeStats() const {
   if (!probe_asked_ || !probe_fresh_) return nullptr;
-  json j = {{"pixel", {probe_.px, probe_.py}}, {"valid", probe_.valid}, {"reason", probe_.reason}};
+  json j = {{"pixel", {probe_.px, probe_.py}},
+            {"valid", probe_.valid},
+            {"reason", probe_.reason},
+            {"lensmaps_built", lensmaps_.builds}};  // lens maps the probe built (LensmapCache)
   if (probe_.element >= 0) j["element"] = ls_.scene.elements[size_t(probe_.element)].name;
   if (!probe_.valid) return j;
   const LensmapPoint& r = probe_.reading;
@@ -278,29 +342,34 @@ const Observer& Viewer::updateObserver() {
   return current;
 }
 
+void Viewer::prepareReference() {
+  seen_ = std::make_unique<SeenFrames>(window_);
+  window_.context().makeCurrent();
+  wipe_ = std::make_unique<Wipe>(window_);
+  wipe_->reset(width_, height_);
+}
+
 void Viewer::startReference() {
   updateObserver();
   if (reference_ && (reference_->finished() || !(viewKey() == reference_key_))) reference_.reset();  // traced anew
   if (reference_ && viewKey() == reference_key_) return;  // this view's reference is being traced
   window_.context().makeCurrent();
+  if (programs_at_first_reference_ < 0) programs_at_first_reference_ = gl::programsBuiltOnThisThread();
   const auto t0 = Clock::now();
-  if (!seen_renderer_) {
-    gl::RendererOptions opt = gl::rendererOptionsFor(ls_.scene);
-    opt.seen_points = true;  // as pvrr compare draws the frame it measures
-    opt.read_back = true;
-    seen_renderer_ = std::make_unique<gl::Renderer>(ls_.scene, *rays_, opt);
-  }
-  gl::FrameCache fresh;  // every stage run, as compare's frame
-  gl::RasterFrame f = seen_renderer_->render(mode_, &fresh);
+  const double cpu0_ms = threadCpuMs();
+  // One copy of the view's scene, shared by the tracer and the seen-points worker.
+  auto snapshot = std::make_shared<const Scene>(ls_.scene);
+  std::shared_future<Frame> seen = seen_->request(snapshot, ls_.desc, pose_builds_, mode_);
   const int threads = std::max(1, int(std::thread::hardware_concurrency()) - 1);  // one core for the window
-  reference_ = std::make_unique<ReferenceRun>(ls_.scene, std::move(static_cast<Frame&>(f)), threads);
-  if (!wipe_) wipe_ = std::make_unique<Wipe>(window_);
+  reference_ = std::make_unique<ReferenceRun>(std::move(snapshot), std::move(seen), threads);
   wipe_->reset(reference_->width(), reference_->height());
   heat_uploaded_ = false;
   reference_key_ = viewKey();
   reference_note_.clear();
   ++references_started_;
-  reference_start_ms_ = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  reference_start_ms_ =
+      std::max(reference_start_ms_, std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+  reference_start_cpu_ms_ = std::max(reference_start_cpu_ms_, threadCpuMs() - cpu0_ms);
 }
 
 void Viewer::discardReference(const std::string& why) {
@@ -361,6 +430,10 @@ void Viewer::onKey(int key, int action, int mods) {
     case GLFW_KEY_3: setMode(RenderMode::Impostor); break;
     case GLFW_KEY_4: setMode(RenderMode::Raster); break;
     case GLFW_KEY_TAB: show_panel_ = !show_panel_; break;
+    case GLFW_KEY_SPACE:
+      playing_ = animated_ && !playing_;
+      played_at_ = Clock::now();
+      break;
     case GLFW_KEY_T:
       reference_requested_ = true;
       break;
@@ -413,8 +486,15 @@ json Viewer::referenceStats() const {
   json j = {{"state", state},
             {"note", reference_note_},
             {"started", references_started_},
-            // Starting costs one frame of the mode drawn with seen points (the first time, its programs built too).
+            // The window thread's time to start one (the longest start): a copy of the scene and a request; the
+            // mode's frame with seen points is drawn on the worker, which built `worker_programs` programs.
             {"start_ms", reference_start_ms_},
+            {"start_cpu_ms", reference_start_cpu_ms_},  // the same in the thread's CPU time: without waits for a core
+            {"worker_frames", seen_ ? seen_->framesDrawn() : 0},
+            {"worker_programs", seen_ ? seen_->programsBuilt() : 0},
+            // Programs the window's thread built from the first start to the end of the run: none, by design.
+            {"window_programs_since_start",
+             programs_at_first_reference_ < 0 ? 0 : gl::programsBuiltOnThisThread() - programs_at_first_reference_},
             {"frames_while_tracing", frames_while_tracing_},
             {"frame_ms_max_while_tracing", frame_ms_max_while_tracing_}};
   j["wipe_x"] = wipe_x_;
@@ -453,6 +533,10 @@ json Viewer::stats() const {
           // Rebuilds of the scene after the first (a "set", a panel setting, a turned element), and the slowest
           // one's time (ms; the renderer's first frame after it, with its programs, is in frame_ms_max).
           {"rebuilds", scene_builds_ - 1},
+          // Animated scenes: the time shown (s) and whether it plays; renderers built (rebuilds and moving times).
+          {"time_s", time_s_},
+          {"playing", playing_},
+          {"renderer_builds", pose_builds_},
           {"rebuild_ms_max", rebuild_ms_max_},
           {"gl", glName()}};
 }

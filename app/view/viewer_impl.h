@@ -19,6 +19,7 @@
 #include "app/view/lens_probe.h"
 #include "app/view/reference_tiles.h"
 #include "app/view/script.h"
+#include "app/view/seen_frames.h"
 #include "app/view/window.h"
 #include "app/view/wipe.h"
 
@@ -35,6 +36,10 @@ inline constexpr double kLookDegPerPixel = 0.1;
 inline constexpr double kWipeGrabPx = 8;
 // The panel's step of moving an element (metres).
 inline constexpr double kMoveStepM = 0.001;
+// Playing time: how long the last key's pose is held before it starts again (s).
+inline constexpr double kLoopPauseS = 0.5;
+// How often the panel's planning lines are made anew (ms): text a reader can follow, not every frame's.
+inline constexpr double kPlanningRefreshMs = 250;
 
 // What a reference belongs to: the view it traced. Any change (the head, the eye, the window's size, the mode,
 // a setting, which rebuilds the scene) makes it another view's reference, and it is discarded.
@@ -66,12 +71,13 @@ class Viewer {
       static_cast<Viewer*>(glfwGetWindowUserPointer(w))->onKey(key, action, mods);
     });
     rebuild();
+    prepareReference();
   }
   ~Viewer() {
     reference_.reset();               // cancels a running trace and joins its threads
+    seen_.reset();                    // the seen-points worker: its GL objects go in its own context, on its thread
     window_.context().makeCurrent();  // GL objects go while their context is current
     wipe_.reset();
-    seen_renderer_.reset();
     renderer_.reset();
     glfwSetKeyCallback(window_.handle(), nullptr);
   }
@@ -86,10 +92,18 @@ class Viewer {
   void rebuild(bool keep_mode = false);
   // Element `index` turned about its vertex (app/view/element_pose.h): its pose written as overrides, rebuilt.
   void turnElement(int index, double yaw_rad, double pitch_rad);
+  // An animated scene's time (issue 24 item 1): the scene posed at t_s as pvrr render --time poses it; where
+  // anything moved, the renderer and the ray scene are built again (they hold the geometry), as render does.
+  void setTime(double t_s);
+  // The renderer and the Embree scene of ls_.scene as it stands, with a fresh frame cache.
+  void buildRenderer();
+  void timePanel();
   // Element `index` moved by `by_m` in its own frame (x right, y up, z along its normal), rebuilt likewise.
   void moveElement(int index, const Vec3& by_m);
   int elementIndex(const std::string& name) const;
   void elementsPanel();
+  // The panel's lines on each element's planning: made anew at most every kPlanningRefreshMs (and after a
+  // rebuild or a mode change), not every frame.
   void planningLines(const gl::RasterFrame& f);
   void lensPanel();
   json probeStats() const;
@@ -100,10 +114,13 @@ class Viewer {
   const Observer& updateObserver();
   ViewKey viewKey() const {
     const Observer& ob = ls_.scene.observer;
-    return {ob.eye, ob.target, ob.up, ob.width, ob.height, mode_, scene_builds_};
+    return {ob.eye, ob.target, ob.up, ob.width, ob.height, mode_, pose_builds_};
   }
-  // The live reference: startReference traces the current view in the background (and draws the mode's frame
-  // of it once with seen points, for the errors); discardReference cancels or drops it, saying why.
+  // The live reference: startReference traces the current view in the background, and has the mode's frame of
+  // it drawn with seen points for the errors on the seen-points worker (app/view/seen_frames.h), so that the
+  // window's thread builds no program for it; discardReference cancels or drops it, saying why.
+  // prepareReference, at startup: the worker and the wipe's program (its first draw too), built before any frame.
+  void prepareReference();
   void startReference();
   void discardReference(const std::string& why);
   void presentFrame(const Observer& ob);
@@ -154,6 +171,11 @@ class Viewer {
   double last_x_ = 0, last_y_ = 0;
 
   int scene_builds_ = 0;
+  int pose_builds_ = 0;  // renderers built (a rebuild, or a time that moved something): the geometry's version
+  // Time: animated scenes only (isAnimated). Playing advances it by the wall clock, looping after the last key.
+  bool animated_ = false, playing_ = false;
+  double time_s_ = 0, duration_s_ = 0;
+  Clock::time_point played_at_{};
   double rebuild_ms_max_ = 0;  // the slowest rebuild after the first (a setting, a turned element)
   // The lens probe (scenes with a lens): the pixel under the cursor (the mouse when it moves, or a script's
   // "cursor"), read again when that pixel or the view changes.
@@ -162,26 +184,35 @@ class Viewer {
   int probe_x_ = 0, probe_y_ = 0;
   double cursor_x_ = 0, cursor_y_ = 0;
   LensProbe probe_;
+  LensmapCache lensmaps_;
   bool probe_fresh_ = false;
   ViewKey probe_key_;
+  std::vector<std::string> planning_lines_;
+  Clock::time_point planning_made_{};
+  RenderMode planning_mode_ = RenderMode::Pvrr;
   int selected_ = 0;  // the element the panel and the keys I/K/J/L turn
   // Changes asked for by the panel or the keys, applied at the next frame (not inside the panel's frame).
   std::vector<std::string> pending_overrides_;
   double pending_yaw_rad_ = 0, pending_pitch_rad_ = 0;
   Vec3 pending_move_m_{0};
-  std::unique_ptr<gl::Renderer> seen_renderer_;  // the mode's frame with seen points, for the reference's errors
+  std::optional<double> pending_time_s_;
+  std::unique_ptr<SeenFrames> seen_;  // the mode's frame with seen points, for the reference's errors
   std::unique_ptr<ReferenceRun> reference_;
   std::unique_ptr<Wipe> wipe_;
   ViewKey reference_key_;
   bool reference_requested_ = false;  // by key or panel: started at the next frame
   bool waiting_reference_ = false;    // a script's "reference" event: later events wait for it
   bool heat_uploaded_ = false;
+  bool wipe_drawn_ = false;  // the wipe drawn once (prepareReference)
   double wipe_x_ = 0.5;  // the split line: 0 all reference, 1 all mode
   bool overlay_ = false;
   FovOverlay fov_overlay_;  // the mirror's road footprint over the frame (O)
   std::string reference_note_;  // why there is no reference now (cancelled, discarded)
   int references_started_ = 0, frames_while_tracing_ = 0;
-  double frame_ms_max_while_tracing_ = 0, reference_start_ms_ = 0;
+  // Programs the window's thread had built when the first reference started (gl::programsBuiltOnThisThread),
+  // -1 before: what it built since is in the stats (none, by design).
+  int programs_at_first_reference_ = -1;
+  double frame_ms_max_while_tracing_ = 0, reference_start_ms_ = 0, reference_start_cpu_ms_ = 0;
 };
 
 }  // namespace pvrr::app::view

@@ -3,6 +3,8 @@
 #include <imgui.h>
 
 #include <algorithm>
+#include <chrono>
+#include <cstdio>
 #include <tuple>
 
 #include "app/view/viewer_impl.h"
@@ -32,24 +34,48 @@ void Viewer::lensPanel() {
 }
 
 void Viewer::planningLines(const gl::RasterFrame& f) {
-  // What the pvrr mode's planning made of each element this frame (nothing where another mode drew it).
-  const gl::RendererOptions opt = gl::rendererOptionsFor(ls_.scene);
-  for (const ElementFrame& ef : f.elements) {
-    if (ef.views.empty()) continue;
-    double worst = 0;
-    int fallbacks = 0, smallest = 1 << 30, largest = 0;
-    for (const PatchView& pv : ef.views) {
-      worst = std::max(worst, pv.fit.condition_number);
-      fallbacks += pv.fit.fallback.empty() ? 0 : 1;
-      const int side = gl::topLevelMapSide(ls_.scene, ef, pv, opt);
-      smallest = std::min(smallest, side);
-      largest = std::max(largest, side);
+  // What the pvrr mode's planning made of each element (nothing where another mode drew it).
+  const auto now = Clock::now();
+  if (planning_lines_.empty() || planning_mode_ != mode_ ||
+      std::chrono::duration<double, std::milli>(now - planning_made_).count() >= kPlanningRefreshMs) {
+    planning_lines_.clear();
+    planning_made_ = now;
+    planning_mode_ = mode_;
+    const gl::RendererOptions opt = gl::rendererOptionsFor(ls_.scene);
+    for (const ElementFrame& ef : f.elements) {
+      if (ef.views.empty()) continue;
+      double worst = 0;
+      int fallbacks = 0, smallest = 1 << 30, largest = 0;
+      for (const PatchView& pv : ef.views) {
+        worst = std::max(worst, pv.fit.condition_number);
+        fallbacks += pv.fit.fallback.empty() ? 0 : 1;
+        const int side = gl::topLevelMapSide(ls_.scene, ef, pv, opt);
+        smallest = std::min(smallest, side);
+        largest = std::max(largest, side);
+      }
+      char line[512];
+      std::snprintf(line, sizeof line,
+                    "%s: %zu patch%s, %zu vertices; maps %d..%d texels (longer side); viewpoint fit condition at "
+                    "most %.3g, %d fallbacks",
+                    ls_.scene.elements[size_t(ef.element)].name.c_str(), ef.views.size(),
+                    ef.views.size() == 1 ? "" : "es", ef.world_pos.size(), smallest, largest, worst, fallbacks);
+      planning_lines_.push_back(line);
     }
-    ImGui::TextWrapped(
-        "%s: %zu patch%s, %zu vertices; maps %d..%d texels (longer side); viewpoint fit condition "
-        "at most %.3g, %d fallbacks",
-        ls_.scene.elements[size_t(ef.element)].name.c_str(), ef.views.size(), ef.views.size() == 1 ? "" : "es",
-        ef.world_pos.size(), smallest, largest, worst, fallbacks);
+  }
+  for (const std::string& line : planning_lines_) ImGui::TextWrapped("%s", line.c_str());
+}
+
+void Viewer::timePanel() {
+  if (!animated_) return;
+  float t = float(time_s_);
+  if (ImGui::SliderFloat("time (s)", &t, 0.0f, float(duration_s_), "%.2f")) {
+    playing_ = false;
+    pending_time_s_ = double(t);  // at the next frame
+  }
+  ImGui::SameLine();
+  if (ImGui::Button(playing_ ? "pause (Space)" : "play (Space)")) {
+    playing_ = !playing_;
+    played_at_ = Clock::now();
   }
 }
 
@@ -187,6 +213,7 @@ void Viewer::panel(const gl::RasterFrame& f, double frame_ms) {
     }
     ImGui::EndTable();
   }
+  timePanel();
   planningLines(f);
   referencePanel();
   lensPanel();
@@ -204,6 +231,7 @@ void Viewer::panel(const gl::RasterFrame& f, double frame_ms) {
         "E                   error overlay on or off\n"
         "O                   field of view on the road (the mirror's footprint) on or off\n"
         "drag the split line wipe between the mode and the reference\n"
+        "Space               play or pause an animated scene's time\n"
         "Tab                 hide or show this panel\n"
         "F12 / V             screenshot / save view (out/view-N.png, .json)\n"
         "Esc                 quit");

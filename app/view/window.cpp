@@ -51,8 +51,9 @@ GLuint compile(GLenum kind, const char* source, const std::string& what) {
   return s;
 }
 
-GLFWwindow* openWindow(int width, int height, int api, const std::string& title) {
+GLFWwindow* openWindow(int width, int height, int api, const std::string& title, bool visible = true) {
   glfwDefaultWindowHints();
+  glfwWindowHint(GLFW_VISIBLE, visible ? GLFW_TRUE : GLFW_FALSE);
   glfwWindowHint(GLFW_CLIENT_API, GLFW_OPENGL_API);
   glfwWindowHint(GLFW_CONTEXT_CREATION_API, api);
   glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
@@ -115,6 +116,7 @@ Window::Window(int width, int height, WindowGl api, bool vsync, const std::strin
     window_ = openWindow(width, height, api_hint, title);
     if (window_) {
       name = std::string("glfw-") + label;
+      api_hint_ = api_hint;
       break;
     }
     tried += std::string("\n  ") + label + ": " + g_glfw_error;
@@ -172,6 +174,26 @@ Window::~Window() {
   }
   if (window_) glfwDestroyWindow(window_);
   glfwTerminate();
+}
+
+WorkerContext::WorkerContext(Window& window) : window_(window) {
+  hidden_ = openWindow(1, 1, window.api_hint_, "pvrr view: worker", /*visible=*/false);
+  if (!hidden_) throw Error("pvrr view: could not open a second GL context for the worker thread: " + g_glfw_error);
+}
+
+WorkerContext::~WorkerContext() { glfwDestroyWindow(hidden_); }
+
+gl::ForeignContext WorkerContext::foreign() const {
+  GLFWwindow* w = hidden_;
+  gl::ForeignContext fc;
+  fc.backend_name = window_.context().backendName() + " (worker)";
+  fc.make_current = [w] { glfwMakeContextCurrent(w); };
+  fc.release_current = [w] {
+    if (glfwGetCurrentContext() == w) glfwMakeContextCurrent(nullptr);
+  };
+  fc.get_proc_address = glfwGetProcAddress;
+  fc.entry_points_of = &window_.context();
+  return fc;
 }
 
 bool Window::closeRequested() const { return glfwWindowShouldClose(window_); }

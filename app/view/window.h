@@ -31,6 +31,25 @@ extern const char* const kFullScreenVs;
 // and Wipe::present.
 void beginPresentPass(int width, int height);
 
+class Window;
+
+// A second GL context of the window's kind (a hidden 1 x 1 window of the same API), for GL work on another thread
+// (the live reference's seen points, app/view/seen_frames.h): made and destroyed on the window's thread (GLFW's
+// rule), adopted (gl::GlContext::adopt(foreign())) and used on one other thread, and current on no thread when
+// destroyed. Its entry points are the window's (ForeignContext::entry_points_of): glad's are not reloaded for it.
+class WorkerContext {
+ public:
+  explicit WorkerContext(Window& window);
+  ~WorkerContext();
+  WorkerContext(const WorkerContext&) = delete;
+  WorkerContext& operator=(const WorkerContext&) = delete;
+  gl::ForeignContext foreign() const;
+
+ private:
+  Window& window_;
+  GLFWwindow* hidden_ = nullptr;
+};
+
 class Window {
  public:
   // Opens a width x height window (framebuffer pixels). `vsync`: swap interval 1, else 0 (scripted runs, which
@@ -60,7 +79,9 @@ class Window {
   unsigned emptyVertexArray() const { return vao_; }
 
  private:
+  friend class WorkerContext;
   GLFWwindow* window_ = nullptr;
+  int api_hint_ = 0;  // the GLFW context creation API that opened it
   std::unique_ptr<gl::GlContext> context_;
   unsigned program_ = 0, vao_ = 0, srgb_table_ = 0;
   bool imgui_ = false;

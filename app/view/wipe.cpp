@@ -46,13 +46,23 @@ unsigned makeTexture(int width, int height) {
   GLuint t = 0;
   glGenTextures(1, &t);
   glBindTexture(GL_TEXTURE_2D, t);
-  const std::vector<std::uint8_t> zero(size_t(width) * size_t(height) * 4, 0);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, zero.data());
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);  // cleared after
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
   glBindTexture(GL_TEXTURE_2D, 0);
   return t;
+}
+
+// Clears `texture` to 0 (alpha 0: nothing traced, no error) by drawing, not by uploading zeros: at the start of a
+// reference the window's thread only queues it.
+void clearTexture(unsigned framebuffer, unsigned texture) {
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture, 0);
+  glDisable(GL_SCISSOR_TEST);
+  const GLfloat zero[4] = {0, 0, 0, 0};
+  glClearBufferfv(GL_COLOR, 0, zero);
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, 0, 0);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
 }  // namespace
@@ -64,15 +74,21 @@ Wipe::~Wipe() {
   glDeleteProgram(program_);
   if (reference_) glDeleteTextures(1, &reference_);
   if (heat_) glDeleteTextures(1, &heat_);
+  if (framebuffer_) glDeleteFramebuffers(1, &framebuffer_);
 }
 
 void Wipe::reset(int width, int height) {
-  if (reference_) glDeleteTextures(1, &reference_);
-  if (heat_) glDeleteTextures(1, &heat_);
-  width_ = width;
-  height_ = height;
-  reference_ = makeTexture(width, height);
-  heat_ = makeTexture(width, height);
+  if (!framebuffer_) glGenFramebuffers(1, &framebuffer_);
+  if (width != width_ || height != height_ || !reference_) {
+    if (reference_) glDeleteTextures(1, &reference_);
+    if (heat_) glDeleteTextures(1, &heat_);
+    width_ = width;
+    height_ = height;
+    reference_ = makeTexture(width, height);
+    heat_ = makeTexture(width, height);
+  }
+  clearTexture(framebuffer_, reference_);
+  clearTexture(framebuffer_, heat_);
   gl::checkGlError("creating the wipe's textures");
 }
 

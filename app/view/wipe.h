@@ -23,7 +23,8 @@ class Wipe {
   Wipe(const Wipe&) = delete;
   Wipe& operator=(const Wipe&) = delete;
 
-  // Sizes (and clears) the reference and heat-map textures for a new reference of width x height.
+  // Sizes (when the size changed) and clears the reference and heat-map textures for a new reference of width x
+  // height.
   void reset(int width, int height);
   // Uploads the given tiles of `rgba` (width x height RGBA8, rows top-down) to the reference texture.
   void uploadTiles(const std::vector<TileRect>& tiles, const std::vector<std::uint8_t>& rgba);
@@ -36,7 +37,7 @@ class Wipe {
 
  private:
   Window& window_;
-  unsigned program_ = 0, reference_ = 0, heat_ = 0;
+  unsigned program_ = 0, reference_ = 0, heat_ = 0, framebuffer_ = 0;  // framebuffer_: for clearing them
   int width_ = 0, height_ = 0;
 };
 

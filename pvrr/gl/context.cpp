@@ -4,6 +4,7 @@
 
 #include <unistd.h>
 
+#include <atomic>
 #include <cstdlib>
 #include <functional>
 #include <sstream>
@@ -18,8 +19,9 @@ namespace {
 
 // The context current on this thread through GlContext (nullptr when none).
 thread_local GlContext* t_current = nullptr;
-// The context whose entry points glad's (process-wide) function pointers hold.
-const GlContext* g_loaded_for = nullptr;
+// The context whose entry points glad's (process-wide) function pointers hold. Atomic: a context that shares
+// another's entry points (ForeignContext::entry_points_of) reads it on its own thread.
+std::atomic<const GlContext*> g_loaded_for{nullptr};
 
 std::string glString(GLenum name) {
   const GLubyte* s = glGetString(name);
@@ -126,6 +128,10 @@ GlContext::~GlContext() {
 }
 
 GlContext* GlContext::current() { return t_current; }
+
+bool GlContext::entryPointsLoaded() const {
+  return g_loaded_for == this || (entry_points_of_ != nullptr && g_loaded_for == entry_points_of_);
+}
 
 void GlContext::loadEntryPoints() {
   const int version = gladLoadGL(backend_->loader());
@@ -241,10 +247,12 @@ std::unique_ptr<GlContext> GlContext::adopt(ForeignContext foreign) {
     t_current->backend_->releaseCurrent();
     t_current = nullptr;
   }
+  const GlContext* entry_points_of = foreign.entry_points_of;
   std::unique_ptr<GlContext> context(new GlContext(std::make_unique<ForeignBackend>(std::move(foreign))));
+  context->entry_points_of_ = entry_points_of;
   context->backend_->makeCurrent();
   t_current = context.get();
-  context->loadEntryPoints();
+  if (!context->entryPointsLoaded()) context->loadEntryPoints();
   context->queryStrings();
   context->is_hardware_ = !containsSoftwareRasteriser(context->gl_renderer_);
   checkGlError("adopting a GL context");
@@ -258,7 +266,7 @@ void GlContext::makeCurrent() {
   }
   backend_->makeCurrent();
   t_current = this;
-  if (g_loaded_for != this) loadEntryPoints();
+  if (!entryPointsLoaded()) loadEntryPoints();
 }
 
 std::string glErrorName(unsigned int code) {

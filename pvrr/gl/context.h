@@ -17,6 +17,7 @@ namespace pvrr::gl {
 namespace detail {
 class ContextBackend;
 }
+class GlContext;
 
 // Auto: EGL device (hardware, then Mesa software) > EGL surfaceless > OSMesa. Egl: only the EGL paths.
 // OsMesa: only OSMesa.
@@ -43,6 +44,10 @@ struct ForeignContext {
   std::function<void()> make_current;    // makes it current on this thread (throws pvrr::Error on failure)
   std::function<void()> release_current; // detaches it from this thread; never throws
   Proc (*get_proc_address)(const char* name) = nullptr;  // the entry-point loader while it is current
+  // Another adopted context whose entry points are this one's: a second context of the same toolkit on the same
+  // display (GLX's and EGL's entry points do not depend on the context). glad's process-wide pointers are then
+  // not reloaded for this one, so that it can be current on a worker thread while the other draws on its own.
+  const GlContext* entry_points_of = nullptr;
 };
 
 class GlContext {
@@ -85,9 +90,12 @@ class GlContext {
  private:
   explicit GlContext(std::unique_ptr<detail::ContextBackend> backend);
   void loadEntryPoints();
+  // Whether glad's pointers serve this context: loaded for it, or for the context it shares them with.
+  bool entryPointsLoaded() const;
   void queryStrings();  // GL_VERSION etc. of the current context; throws below the floor
 
   std::unique_ptr<detail::ContextBackend> backend_;
+  const GlContext* entry_points_of_ = nullptr;  // ForeignContext::entry_points_of
   std::string backend_name_, gl_version_, gl_renderer_, gl_vendor_, glsl_version_, creation_notes_;
   int gl_major_ = 0, gl_minor_ = 0;
   bool is_hardware_ = false;

@@ -26,6 +26,9 @@ extern const std::size_t kEmbeddedShaderCount;
 
 namespace {
 
+// Programs built on this thread (programsBuiltOnThisThread).
+thread_local int t_programs_built = 0;
+
 std::string joined(const std::vector<std::string>& items, const char* separator) {
   std::string out;
   for (const auto& s : items) out += (out.empty() ? "" : separator) + s;
@@ -243,6 +246,8 @@ std::string insertDefines(const std::string& source, const std::vector<std::stri
   return block + "#line 1\n" + source;
 }
 
+int programsBuiltOnThisThread() { return t_programs_built; }
+
 Program::Program(const std::string& vertex_file, const std::string& fragment_file,
                  const std::vector<std::string>& defines)
     : Program(fromSources(shaderWithIncludes(vertex_file), shaderWithIncludes(fragment_file), defines)) {}
@@ -251,6 +256,7 @@ Program Program::fromSources(const ShaderSource& vertex, const ShaderSource& fra
                              const std::vector<std::string>& defines) {
   const std::string label = vertex.name + " + " + fragment.name;
   requireCurrentContext(("building program " + label).c_str());
+  ++t_programs_built;
   const GLuint vs = compile(GL_VERTEX_SHADER, vertex, defines);
   GLuint fs = 0;
   try {

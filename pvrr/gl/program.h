@@ -66,6 +66,10 @@ std::string glslFloat(double value);
 // ("#define PVRR_REFRACT 1"); a line not starting with '#' gets "#define " prepended ("PVRR_REFRACT 1").
 std::string insertDefines(const std::string& source, const std::vector<std::string>& defines);
 
+// How many programs this thread has compiled and linked (Program::fromSources, which every Program goes through):
+// a window that must never compile while it draws (`pvrr view`'s live reference) checks that this stays put.
+int programsBuiltOnThisThread();
+
 class Program {
  public:
   // Compiles and links the embedded files `vertex_file` and `fragment_file`, their #includes resolved

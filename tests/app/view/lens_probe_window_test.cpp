@@ -27,15 +27,18 @@ TEST(ViewLensProbe, ReadingsUnderTheCursorAreTheLensMapsThere) {
   const fs::path dir = freshTestDir("view-lens-probe");
   const fs::path script = dir / "script.json", stats = dir / "stats.json";
   constexpr int kX = 230, kY = 80;  // right of and above the lens centre (the picture's centre is 160, 120)
+  // First another point of the lens: the reading checked below comes from the lens map built for that one.
   writeText(script, R"({"size": [320, 240], "events": [
-      {"at_frame": 1, "do": "cursor", "at": [230.3, 80.7]},
-      {"at_frame": 3, "do": "quit"}]})");
+      {"at_frame": 1, "do": "cursor", "at": [190.5, 130.5]},
+      {"at_frame": 2, "do": "cursor", "at": [230.3, 80.7]},
+      {"at_frame": 4, "do": "quit"}]})");
   CliResult r;
   RUN_VIEW_OR_SKIP("models/spectacle-lens.json --script '" + script.string() + "' --stats '" + stats.string() + "'",
                    &r);
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json probe = nlohmann::json::parse(std::ifstream(stats))["lens_probe"];
   ASSERT_TRUE(probe["valid"].get<bool>()) << probe.dump();
+  EXPECT_EQ(probe["lensmaps_built"], 1);  // one lens map for both points: the lens did not move
   EXPECT_EQ(probe["pixel"][0], kX + 0.5);
   EXPECT_EQ(probe["pixel"][1], kY + 0.5);
 

@@ -30,11 +30,15 @@ constexpr int kNoErrorGrey = 40;
 
 json readJson(const fs::path& p) { return json::parse(std::ifstream(p)); }
 
+// The view traced second (after a reference of the design view, then a head turn): the seen-points worker
+// (app/view/seen_frames.h) draws it with the renderer it built for the first, moved to the new observer. The
+// window's thread builds no program for either: the worker does (structural, not timed).
 TEST(ViewReference, MatchesCompareForTheSameView) {
   const fs::path dir = freshTestDir("view-reference");
   const fs::path script = dir / "script.json", overlay = dir / "overlay.png", reference = dir / "reference.png",
                  view = dir / "view.json", stats = dir / "stats.json", cmp = dir / "compare";
   writeText(script, R"({"size": [320, 240], "events": [
+      {"at_frame": 1, "do": "reference"},
       {"at_frame": 2, "do": "turn_head", "yaw_deg": 3, "pitch_deg": -1},
       {"at_frame": 3, "do": "reference"},
       {"at_frame": 4, "do": "wipe", "x": 1},
@@ -59,6 +63,10 @@ TEST(ViewReference, MatchesCompareForTheSameView) {
 
   const json live = readJson(stats)["reference"], metrics = readJson(cmp / "metrics.json")["modes"]["pvrr"];
   ASSERT_EQ(live["state"], "done") << live.dump();
+  EXPECT_EQ(live["started"], 2);
+  EXPECT_EQ(live["worker_frames"], 2);
+  EXPECT_GT(live["worker_programs"].get<int>(), 0);                  // the seen-points renderer's, built on the worker
+  EXPECT_EQ(live["window_programs_since_start"], 0) << live.dump();  // none on the window's thread
   EXPECT_EQ(live["pixels"], metrics["pixels"]);
   for (const char* q : {"median", "p95"}) {
     const double a = live["angular_error_arcmin"][q], b = metrics["angular_error_arcmin"][q];
@@ -79,6 +87,37 @@ TEST(ViewReference, MatchesCompareForTheSameView) {
     }
   EXPECT_EQ(compared, live["pixels"].get<int>());
   EXPECT_EQ(failing, 0) << "of " << compared << " heat-map pixels";
+  fs::remove_all(dir);
+}
+
+// Spectacles move with the head: the worker's renderer, kept from the first reference, re-poses the lens for the
+// turned head as the window does, and the second reference's errors are compare's of the saved view.
+TEST(ViewReference, SpectaclesTurnedWithTheHeadMatchCompare) {
+  const fs::path dir = freshTestDir("view-reference-lens");
+  const fs::path script = dir / "script.json", view = dir / "view.json", stats = dir / "stats.json",
+                 cmp = dir / "compare";
+  writeText(script, R"({"size": [200, 150], "events": [
+      {"at_frame": 1, "do": "reference"},
+      {"at_frame": 2, "do": "turn_head", "yaw_deg": 4, "pitch_deg": 2},
+      {"at_frame": 3, "do": "reference"},
+      {"at_frame": 4, "do": "save_view", "file": ")" +
+                        view.string() + R"("},
+      {"at_frame": 5, "do": "quit"}]})");
+  CliResult r;
+  RUN_VIEW_OR_SKIP("models/spectacle-lens.json --script '" + script.string() + "' --stats '" + stats.string() + "'",
+                   &r);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const CliResult c = runPvrr("compare '" + view.string() + "' --modes pvrr --frames 1 --out '" + cmp.string() + "'");
+  ASSERT_EQ(c.code, 0) << c.err;
+  const json live = readJson(stats)["reference"], metrics = readJson(cmp / "metrics.json")["modes"]["pvrr"];
+  ASSERT_EQ(live["state"], "done") << live.dump();
+  EXPECT_EQ(live["worker_frames"], 2);
+  EXPECT_EQ(live["window_programs_since_start"], 0);
+  EXPECT_EQ(live["pixels"], metrics["pixels"]);
+  for (const char* q : {"median", "p95"}) {
+    const double a = live["angular_error_arcmin"][q], b = metrics["angular_error_arcmin"][q];
+    EXPECT_NEAR(a, b, kMedianRelTol * b) << q;
+  }
   fs::remove_all(dir);
 }
 

@@ -81,7 +81,7 @@ TEST(ViewScript, ErrorsNameTheFileAndTheJsonPath) {
             "s.json: events[0].do: expected one of cursor, drag, key, move_element, move_eye, overlay, quit, "
             "reference, save_view, "
             "screenshot, "
-            "set, turn_element, turn_head, wipe, got \"teleport\"");
+            "set, time, turn_element, turn_head, wipe, got \"teleport\"");
   EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "quit"}, {"at_frame": -1, "do": "quit"}]})"),
             "s.json: events[1].at_frame: expected a frame number >= 0, got -1");
   EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "turn_head", "yaw_dg": 3}]})"),
@@ -90,6 +90,10 @@ TEST(ViewScript, ErrorsNameTheFileAndTheJsonPath) {
             "s.json: events[0].by: expected [x, y, z] in metres, got [1,2]");
   EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "screenshot", "file": "a.jpg"}]})"),
             "s.json: events[0].file: expected a file name ending in \".png\", got \"a.jpg\"");
+  EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "time", "t": -1}]})"),
+            "s.json: events[0].t: expected a time in seconds from 0 to 1e6, got -1");
+  EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "time", "t": 1, "play": "yes"}]})"),
+            "s.json: events[0].play: expected true or false, got \"yes\"");
   EXPECT_EQ(errorOf(R"({"size": [320], "events": []})"), "s.json: size: expected [width, height] in pixels, got [320]");
   EXPECT_EQ(errorOf(R"({"events": [{"at_frame": 1, "do": "wipe", "x": 1.5}]})"),
             "s.json: events[0].x: expected a number from 0 (all reference) to 1 (all mode), got 1.5");
