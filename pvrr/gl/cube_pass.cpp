@@ -4,6 +4,7 @@
 
 #include "pvrr/base/format.h"
 #include "pvrr/gl/gl.h"
+#include "pvrr/method/cube_quality.h"
 
 namespace pvrr::gl {
 
@@ -83,11 +84,25 @@ void CubePass::prepare(RenderMode frame_mode, FrameStages& stages, FrameCache* c
   // The elements other cubes show: each mesh uploaded once (MeshPool slots).
   cube_mesh.assign(n_el, 0);
   const bool cube_draws = !cubes_reused || (layers > 1 && !layer1_drawn);  // what draws into cubes this frame
+  std::vector<ElementFrame> in_cubes(n_el);
   for (size_t m = 0; m < n_el && cube_draws; ++m) {
     if (!inCubes(m)) continue;
-    const ElementFrame f = prepareElement(scene, int(m), &ctx.grid_cache.get(scene, int(m)));
+    in_cubes[m] = prepareElement(scene, int(m), &ctx.grid_cache.get(scene, int(m)));
     cube_mesh[m] = ctx.meshes.next();
-    uploadElementGrid(ctx.meshes.slot(), scene, f, Vec3(scene.elements[m].local_to_world[3]));
+    uploadElementGrid(ctx.meshes.slot(), scene, in_cubes[m], Vec3(scene.elements[m].local_to_world[3]));
+  }
+  // Near planes from what each cube draws: nothing clipped, the depth buffer's precision where it matters.
+  if (!cubes_reused || cube_near.size() != n_el) {
+    cube_near.assign(n_el, kMinCubeNear_m);
+    cube_far.assign(n_el, 1.0);
+    for (size_t e = 0; e < n_el; ++e) {
+      std::vector<const ElementFrame*> others;
+      for (size_t m = 0; m < n_el; ++m)
+        if (m != e && inCubes(m) && !in_cubes[m].world_pos.empty()) others.push_back(&in_cubes[m]);
+      const Vec3 centre = Vec3(scene.elements[e].local_to_world[3]);
+      cube_near[e] = cubeNearPlane(nearestSurface(scene, centre, others));
+      cube_far[e] = std::max(cubeFarPlane(scene, centre), 4.0 * cube_near[e]);
+    }
   }
   // No cube stays bound to the units the element programs read while cubes are drawn into.
   for (GLenum unit : {GL_TEXTURE0, GL_TEXTURE1}) {
@@ -156,8 +171,7 @@ std::pair<CullCount, int> CubePass::drawCubes(size_t e, int layer) {
   const Scene& scene = ctx.scene;
   const size_t n_el = scene.elements.size();
   const Vec3 centre = Vec3(scene.elements[e].local_to_world[3]);
-  const double near_m = 1e-3, far_m = 2.0 * (scene.boundsRadius() + glm::length(centre - scene.bounds_min)) + 1.0;
-  const Mat4 proj = glm::perspective(kPi / 2, 1.0, near_m, far_m);
+  const Mat4 proj = glm::perspective(kPi / 2, 1.0, cube_near[e], cube_far[e]);
   CubeTarget& c = layer ? *cubes1[e] : *cubes[e];
   if (layer) {  // the first layer's seen points, colour and normals (shaders/sky.frag, FIRST_LAYER)
     const std::vector<unsigned>& first = cubes[e]->colors;
@@ -240,6 +254,7 @@ std::string CubePass::drawElements(RenderMode, const PassCamera& eye, const Fram
   const Scene& scene = ctx.scene;
   const size_t n_el = scene.elements.size();
   element_slot.assign(n_el, 0);
+  frames.clear();
   for (size_t e = 0; e < n_el; ++e) {
     target.bind();
     ElementFrame f = prepareElement(scene, int(e), &ctx.grid_cache.get(scene, int(e)));
@@ -248,6 +263,10 @@ std::string CubePass::drawElements(RenderMode, const PassCamera& eye, const Fram
     element_slot[e] = ctx.meshes.next();
     uploadElementGrid(ctx.meshes.slot(), scene, f, Vec3(scene.elements[e].local_to_world[3]));
     drawElement(e, 0, eye);
+    std::vector<char> in_cube(n_el, 0);
+    for (size_t m = 0; m < n_el; ++m) in_cube[m] = inCubes(m);
+    assessCubeQuality(ctx.rays, f, mode, eye.origin, cube_near[e], cube_far[e], in_cube);
+    frames.push_back(std::move(f));
   }
   return second_layers ? drawSecondLayers(eye, target) : std::string();
 }

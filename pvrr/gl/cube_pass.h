@@ -21,6 +21,8 @@ class CubePass : public ModePass {
 
   void prepare(RenderMode mode, FrameStages& stages, FrameCache* cache) override;
   std::string drawElements(RenderMode mode, const PassCamera& eye, const Framebuffer& target) override;
+  // Each element's frame with its quality (pvrr/method/cube_quality.h), as drawn.
+  std::vector<ElementFrame> takeElements() override { return std::move(frames); }
 
  private:
   // The elements drawn in other elements' cubes: the mirrors, and the lens if it is the only one.
@@ -69,6 +71,9 @@ class CubePass : public ModePass {
   bool second_layers = false;   // the second layers are to be drawn where needed (layers > 1)
   std::vector<size_t> cube_mesh;     // per element drawn in other cubes: its mesh's pool index
   std::vector<size_t> element_slot;  // per element: its second-pass mesh's pool index
+  // Per element: its cubes' near plane (cubeNearPlane, set when they are drawn) and far plane.
+  std::vector<double> cube_near, cube_far;
+  std::vector<ElementFrame> frames;  // this frame's elements with their quality (drawElements)
 };
 
 }  // namespace pvrr::gl
