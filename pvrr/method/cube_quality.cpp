@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "pvrr/base/error.h"
 #include "pvrr/method/eye_side.h"
 #include "pvrr/method/vertex_stage.h"
 #include "pvrr/trace/ray_scene.h"
@@ -104,13 +105,21 @@ CubeQuality assessCubeQuality(const RayScene& rays, ElementFrame& f, RenderMode 
                               double far_m, const std::vector<char>& in_cube, const CubeQualityLimits& limits) {
   const Scene& scene = rays.scene();
   const Element& el = scene.elements[size_t(f.element)];
-  if (f.rays.empty()) traceVertexRays(rays, f, eye, VertexStageOptions{});
   f.quality = ElementQuality{};
   f.quality.action = "none";
+  CubeQuality q;
+  if (f.rays.empty()) {
+    try {
+      traceVertexRays(rays, f, eye, VertexStageOptions{});
+    } catch (const Error& e) {  // e.g. the eye on a vertex: the cube modes draw such an element all the same
+      f.rays.clear();
+      f.quality.action = std::string("not assessed: ") + e.what();
+      return q;
+    }
+  }
   const Vec3 centre = Vec3(el.local_to_world[3]);
   const std::vector<VertexRay>& vr = f.rays[f.rays.size() / 2];
   const bool lens = el.type == ElementType::Lens;
-  CubeQuality q;
   std::vector<double> parallax;
   // The vertices the observer sees (in its clip volume, with a margin for the triangles it sees in part).
   const Mat4 clip = scene.observer.visibilityProjection() * scene.observer.view();

@@ -196,6 +196,9 @@ struct ExtremeCase {
   std::vector<std::string> must_be_right;  // modes whose picture must be right (fixed, or right by design)
 };
 
+// Its name in gtest's messages (gtest prints a parameter's bytes otherwise).
+void PrintTo(const ExtremeCase& c, std::ostream* os) { *os << c.name; }
+
 std::vector<ExtremeCase> extremeCases() {
   const std::string small = " --size 64x48";
   return {
