@@ -56,6 +56,7 @@ uniform mat3 u_lens_to_local;     // world directions -> the lens's local frame 
   if (cur == k) {                                                                                                  \
     centre = u_cube_centre[k];                                                                                     \
     l = impostorHit(u_seen_cubes[k], x - centre, R);                                                               \
+    checkResolved(u_seen_cubes[k], l);                                                                             \
     c = texture(u_cubes[k], l).rgb;                                                                                \
     s = texture(u_seen_cubes[k], l);                                                                               \
     nid = texture(u_normal_cubes[k], l);                                                                           \

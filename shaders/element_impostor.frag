@@ -46,6 +46,7 @@ void envHit(vec3 x, vec3 R, out vec3 colour, out vec4 seen) {
   seen = layer == 1 ? texture(u_seen_cube1, l) : texture(u_seen_cube, l);
 #else
   vec3 l = impostorHit(u_seen_cube, x, R);
+  checkResolved(u_seen_cube, l);
   colour = texture(u_cube, l).rgb;
   seen = texture(u_seen_cube, l);
 #endif
@@ -112,7 +113,7 @@ void main() {
     }
   }
   o_color = vec4(weight * c, 1.0);
-  o_seen = vec4(seen.xyz + u_seen_offset, seen.w);
+  o_seen = vec4(seen.xyz + u_seen_offset, seen.w + (g_unresolved ? 2.0 : 0.0));
 #endif  // CUBE_GEOMETRY
 }
 #else
@@ -180,6 +181,6 @@ void main() {
   envHit(pos - u_seen_offset, reflect(view, n), c, seen);
 #endif
   o_color = vec4(weight * c, 1.0);
-  o_seen = vec4(seen.xyz + u_seen_offset, seen.w);
+  o_seen = vec4(seen.xyz + u_seen_offset, seen.w + (g_unresolved ? 2.0 : 0.0));
 }
 #endif  // LENS

@@ -4,6 +4,16 @@
 // its ray: a sure overshoot for every nearer point).
 float envDistance(samplerCube seen, vec3 dir) { return length(texture(seen, dir).xyz); }
 
+// Whether some search of this fragment ended off every layer of the distance maps: the maps do not hold what
+// its ray meets (a surface hidden from the cube's origin, or the search ran out of steps). The second pass
+// marks its seen point (w + 2), and the renderer counts those pixels (pvrr/method/cube_quality.h).
+bool g_unresolved = false;
+// The first layer's search ended within 1e-3 of the distance the cube holds there (onSurface's tolerance).
+void checkResolved(samplerCube seen, vec3 l) {
+  float d = envDistance(seen, l);
+  if (!(abs(length(l) - d) <= 1e-3 * d)) g_unresolved = true;
+}
+
 // [Szirmay-Kalos et al.], section 2.2: the point of the ray x + d R (x relative to the cube's origin, R unit, d >= 0) at the
 // distance the impostor holds for its own direction. The first guesses assume a surface perpendicular to R at
 // the distance seen along R, then a plane through the two samples; then false position between the last
@@ -115,6 +125,7 @@ vec3 layeredHit(samplerCube seen0, samplerCube seen1, vec3 x, vec3 R, out int la
     d_prev = d;
     r_prev = r;
   }
+  g_unresolved = true;  // no bracket on either layer's surface
   return l0;
 #endif
 }

@@ -6,6 +6,7 @@
 
 #include "pvrr/base/format.h"
 #include "pvrr/gl/gl.h"
+#include "pvrr/method/cube_quality.h"
 
 namespace pvrr::gl {
 
@@ -52,6 +53,8 @@ CubePass::Staleness CubePass::staleness(const FrameCache* cache, const CubeKey& 
   if (!all_animated) return {why + " (not only animated meshes)", {}};
   if (ctx.environment.shadowed())
     return {why + ", and a light casts shadows: their shadows on the static surfaces moved too", {}};
+  if (movedNearCube(moved))
+    return {why + ", nearer to a cube than twice its near plane (the cubes' depth range is drawn again)", {}};
   if (ctx.environment.occludes(moved))
     return {why + ", and an ambient occluder moved: its occlusion of the static surfaces moved too", {}};
   return {"", std::move(moved)};
@@ -61,10 +64,6 @@ namespace {
 
 // A cube face's camera at `centre`: view (world) and projection.
 Mat4 faceView(const Vec3& centre, int face) { return glm::lookAt(centre, centre + kCubeDir[face], kCubeUp[face]); }
-Mat4 cubeProjection(const Scene& scene, const Vec3& centre) {
-  const double near_m = 1e-3, far_m = 2.0 * (scene.boundsRadius() + glm::length(centre - scene.bounds_min)) + 1.0;
-  return glm::perspective(kPi / 2, 1.0, near_m, far_m);
-}
 
 // The window rectangle {x, y, width, height} of a face of side `size` that holds every texel the boxes (world)
 // can cover through view_proj, or nothing when no box reaches into the face's frustum. The part of a box
@@ -113,10 +112,29 @@ std::optional<std::array<int, 4>> faceRect(const Mat4& view_proj, const std::vec
 
 }  // namespace
 
+Mat4 CubePass::cubeProjection(size_t e) const {
+  return glm::perspective(kPi / 2, 1.0, cube_near[e], cube_far[e]);
+}
+
+// The near planes (cubeNearPlane) are half the distance to the nearest surface a cube drew: a moving mesh whose
+// box comes within twice that is as near as the nearest surface (or nearer), so a cube's depth range as a full
+// redraw would choose it may differ, or the mesh be clipped: the cubes are drawn again whole.
+bool CubePass::movedNearCube(const std::vector<size_t>& moved) const {
+  for (size_t e = 0; e < cube_near.size() && e < ctx.scene.elements.size(); ++e) {
+    const Vec3 centre = Vec3(ctx.scene.elements[e].local_to_world[3]);
+    for (const size_t m : moved) {
+      const std::array<Vec3, 2> box = ctx.environment.worldBox(m);
+      const Vec3 nearest = glm::clamp(centre, box[0], box[1]);
+      if (glm::length(nearest - centre) < 2.0 * cube_near[e]) return true;
+    }
+  }
+  return false;
+}
+
 int CubePass::redrawWhereMoved(size_t e, int layer, const std::vector<size_t>& moved,
                                const std::vector<std::array<Vec3, 2>>& before, CullCount& culled, size_t& texels) {
   const Vec3 centre = Vec3(ctx.scene.elements[e].local_to_world[3]);
-  const Mat4 proj = cubeProjection(ctx.scene, centre);
+  const Mat4 proj = cubeProjection(e);
   std::vector<std::array<Vec3, 2>> boxes;
   for (const size_t m : moved) {
     boxes.push_back(before[m]);
@@ -187,11 +205,25 @@ void CubePass::prepare(RenderMode frame_mode, FrameStages& stages, FrameCache* c
   cube_mesh.assign(n_el, 0);
   // What draws into cubes this frame.
   const bool cube_draws = !cubes_reused || partial || (layers > 1 && !layer1_drawn) || layer1_stale;
+  std::vector<ElementFrame> in_cubes(n_el);
   for (size_t m = 0; m < n_el && cube_draws; ++m) {
     if (!inCubes(m)) continue;
-    const ElementFrame f = prepareElement(scene, int(m), &ctx.grid_cache.get(scene, int(m)));
+    in_cubes[m] = prepareElement(scene, int(m), &ctx.grid_cache.get(scene, int(m)));
     cube_mesh[m] = ctx.meshes.next();
-    uploadElementGrid(ctx.meshes.slot(), scene, f, Vec3(scene.elements[m].local_to_world[3]));
+    uploadElementGrid(ctx.meshes.slot(), scene, in_cubes[m], Vec3(scene.elements[m].local_to_world[3]));
+  }
+  // Near planes from what each cube draws: nothing clipped, the depth buffer's precision where it matters.
+  if (!cubes_reused || cube_near.size() != n_el) {
+    cube_near.assign(n_el, kMinCubeNear_m);
+    cube_far.assign(n_el, 1.0);
+    for (size_t e = 0; e < n_el; ++e) {
+      std::vector<const ElementFrame*> others;
+      for (size_t m = 0; m < n_el; ++m)
+        if (m != e && inCubes(m) && !in_cubes[m].world_pos.empty()) others.push_back(&in_cubes[m]);
+      const Vec3 centre = Vec3(scene.elements[e].local_to_world[3]);
+      cube_near[e] = cubeNearPlane(nearestSurface(scene, centre, others));
+      cube_far[e] = std::max(cubeFarPlane(scene, centre), 4.0 * cube_near[e]);
+    }
   }
   // No cube stays bound to the units the element programs read while cubes are drawn into.
   for (GLenum unit : {GL_TEXTURE0, GL_TEXTURE1}) {
@@ -279,7 +311,7 @@ void CubePass::drawFace(size_t e, int layer, int face, CullCount& culled, int& d
   const Scene& scene = ctx.scene;
   const size_t n_el = scene.elements.size();
   const Vec3 centre = Vec3(scene.elements[e].local_to_world[3]);
-  const Mat4 proj = cubeProjection(scene, centre);
+  const Mat4 proj = cubeProjection(e);
   CubeTarget& c = layer ? *cubes1[e] : *cubes[e];
   if (layer) {  // the first layer's seen points, colour and normals (shaders/sky.frag, FIRST_LAYER)
     const std::vector<unsigned>& first = cubes[e]->colors;
@@ -357,6 +389,7 @@ std::string CubePass::drawElements(RenderMode, const PassCamera& eye, const Fram
   const Scene& scene = ctx.scene;
   const size_t n_el = scene.elements.size();
   element_slot.assign(n_el, 0);
+  frames.clear();
   for (size_t e = 0; e < n_el; ++e) {
     target.bind();
     ElementFrame f = prepareElement(scene, int(e), &ctx.grid_cache.get(scene, int(e)));
@@ -365,6 +398,10 @@ std::string CubePass::drawElements(RenderMode, const PassCamera& eye, const Fram
     element_slot[e] = ctx.meshes.next();
     uploadElementGrid(ctx.meshes.slot(), scene, f, Vec3(scene.elements[e].local_to_world[3]));
     drawElement(e, 0, eye);
+    std::vector<char> in_cube(n_el, 0);
+    for (size_t m = 0; m < n_el; ++m) in_cube[m] = inCubes(m);
+    assessCubeQuality(ctx.rays, f, mode, eye.origin, cube_near[e], cube_far[e], in_cube);
+    frames.push_back(std::move(f));
   }
   return second_layers ? drawSecondLayers(eye, target) : std::string();
 }

@@ -23,6 +23,8 @@ class CubePass : public ModePass {
 
   void prepare(RenderMode mode, FrameStages& stages, FrameCache* cache) override;
   std::string drawElements(RenderMode mode, const PassCamera& eye, const Framebuffer& target) override;
+  // Each element's frame with its quality (pvrr/method/cube_quality.h), as drawn.
+  std::vector<ElementFrame> takeElements() override { return std::move(frames); }
 
  private:
   // The elements drawn in other elements' cubes: the mirrors, and the lens if it is the only one.
@@ -72,6 +74,10 @@ class CubePass : public ModePass {
     std::vector<size_t> moved;
   };
   Staleness staleness(const FrameCache* cache, const CubeKey& key) const;
+  // Cube e's projection, with its near and far planes (cube_near, cube_far).
+  Mat4 cubeProjection(size_t e) const;
+  // Whether one of the moved meshes came within twice a cube's near plane of its centre.
+  bool movedNearCube(const std::vector<size_t>& moved) const;
 
   RenderContext ctx;
   ImpostorMaps maps;
@@ -91,6 +97,9 @@ class CubePass : public ModePass {
   bool second_layers = false;   // the second layers are to be drawn where needed (layers > 1)
   std::vector<size_t> cube_mesh;     // per element drawn in other cubes: its mesh's pool index
   std::vector<size_t> element_slot;  // per element: its second-pass mesh's pool index
+  // Per element: its cubes' near plane (cubeNearPlane, set when they are drawn) and far plane.
+  std::vector<double> cube_near, cube_far;
+  std::vector<ElementFrame> frames;  // this frame's elements with their quality (drawElements)
 };
 
 }  // namespace pvrr::gl

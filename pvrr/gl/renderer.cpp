@@ -19,6 +19,7 @@
 #include "pvrr/gl/cube_pass.h"
 #include "pvrr/gl/gl.h"
 #include "pvrr/gl/pvrr_pass.h"
+#include "pvrr/method/cube_quality.h"
 #include "pvrr/method/map_limits.h"
 #include "pvrr/gl/shadow_pass.h"
 
@@ -61,6 +62,19 @@ class RasterPass : public ModePass {
   RenderContext ctx;
 };
 
+// Impostor mode: the pixels of each element whose search ended off the distance maps (their seen point's w
+// raised by 2, shaders/impostor_search.glsl g_unresolved), into its quality.
+void countUnresolvedSearches(RasterFrame& out, const std::vector<float>& seen) {
+  std::vector<long> unresolved(out.elements.size(), 0), pixels(out.elements.size(), 0);
+  for (size_t i = 0; i < out.element.size(); ++i) {
+    const int e = out.element[i];
+    if (e < 0 || size_t(e) >= out.elements.size()) continue;
+    ++pixels[size_t(e)];
+    unresolved[size_t(e)] += seen[4 * i + 3] > 1.5f;
+  }
+  for (size_t e = 0; e < out.elements.size(); ++e) noteUnresolvedSearches(out.elements[e], unresolved[e], pixels[e]);
+}
+
 }  // namespace
 
 struct Renderer::Impl {
@@ -76,6 +90,7 @@ struct Renderer::Impl {
   ElementGridCache grid_cache;
   int max_texture_size = 0, max_texture_units = 0;
   GlLimits limits;                            // queryGlLimits, with the first context()
+  std::vector<double> limits_checked;         // mapLimitsKey of the last frame checkMapLimits passed
   std::unique_ptr<Framebuffer> frame_target;  // the second pass: colour, seen point, surface point
   // The passes of each mode (made with the renderer; each compiles its programs when a frame first needs them).
   RasterPass raster_pass;
@@ -116,7 +131,7 @@ struct Renderer::Impl {
 
   RasterFrame render(RenderMode mode, FrameCache* cache);
   std::string secondPass(RenderMode mode, ModePass& pass, CullCount* culled);
-  void readBack(RasterFrame& out) const;
+  void readBack(RasterFrame& out, RenderMode mode) const;
 };
 
 Renderer::Renderer(const Scene& scene, const RayScene& rays, RendererOptions options)
@@ -147,10 +162,15 @@ RasterFrame Renderer::Impl::render(RenderMode mode, FrameCache* cache) {
   RasterFrame out;
   out.width = ob.width;
   out.height = ob.height;
-  // Every texture and target of the frame against the GL's limits and memory before anything is drawn.
-  checkMapLimits(scene, mode,
-                 {options.map_size, options.seen_points, options.lens_height_map_size, options.surface_map_size},
-                 limits);
+  // Every texture and target of the frame against the GL's limits and memory before anything is drawn, once
+  // per change of what the check reads.
+  const MapSizeSettings sizes{options.map_size, options.seen_points, options.lens_height_map_size,
+                              options.surface_map_size};
+  std::vector<double> key = mapLimitsKey(scene, mode, sizes, limits);
+  if (key != limits_checked) {
+    checkMapLimits(scene, mode, sizes, limits);
+    limits_checked = std::move(key);
+  }
   meshes.rewind();
   ModePass& pass = passFor(mode);
   // Animated meshes that moved: their buffers rewritten in place (the ray scene is the caller's:
@@ -174,7 +194,7 @@ RasterFrame Renderer::Impl::render(RenderMode mode, FrameCache* cache) {
   const std::string layer_note = secondPass(mode, pass, &culled);
   noteSecondPass(out.stages, msSince(t0), cullNote(culled, options.cull_back_faces), layer_note, options.seen_points);
   out.elements = pass.takeElements();
-  readBack(out);
+  readBack(out, mode);
   out.frame_ms = msSince(frame_start);
   if (cache) cache->only_meshes_moved = false;
   return out;
@@ -214,7 +234,7 @@ std::string Renderer::Impl::secondPass(RenderMode mode, ModePass& pass, CullCoun
   return pass.finishedNote(note);
 }
 
-void Renderer::Impl::readBack(RasterFrame& out) const {
+void Renderer::Impl::readBack(RasterFrame& out, RenderMode mode) const {
   const Observer& ob = scene.observer;
   if (options.read_back && !options.seen_points) {
     const std::vector<float> color = frame_target->readFloat4(0);  // rows top-down
@@ -238,6 +258,7 @@ void Renderer::Impl::readBack(RasterFrame& out) const {
         out.element_point[dst] = ob.eye + Vec3(surf[src], surf[src + 1], surf[src + 2]);
       }
     }
+    if (mode == RenderMode::Impostor) countUnresolvedSearches(out, seen);
   }
 }
 

@@ -146,14 +146,18 @@ constexpr double kRefineTarget = 0.9;
 
 std::array<int, 2> refinedGridSize(const ElementFrame& f, int max_vertices, const FrameQualityLimits& limits) {
   const int u = f.grid.grid_u, v = f.grid.grid_v;
-  double spread = 0;
+  // Each spread over its limit (1: at the limit): the normals', and the traced directions' across a triangle
+  // with a totally reflected corner (a lens's TIR region, drawn from traced colours interpolated).
+  double ratio = 0;
   for (const PatchView& pv : f.views)
-    if (pv.in_view) spread = std::max(spread, pv.quality.max_normal_spread_deg);
-  if (u < 2 || v < 2 || !(spread > limits.max_normal_spread_deg)) return {u, v};
+    if (pv.in_view)
+      ratio = std::max({ratio, pv.quality.max_normal_spread_deg / limits.max_normal_spread_deg,
+                        pv.quality.max_traced_spread_deg / limits.max_traced_spread_deg});
+  if (u < 2 || v < 2 || !(ratio > 1.0)) return {u, v};
   // Aimed 10 % below the limit: the spread falls a little less than in proportion on a surface whose
   // curvature varies across a triangle (the toric mirror: 6.1 deg at 31 x 31 where 12.5 deg at 15 x 15
   // predicted 5.9).
-  double factor = spread / (kRefineTarget * limits.max_normal_spread_deg);
+  double factor = ratio / kRefineTarget;
   // Within the budget: (1 + (u - 1) k)(1 + (v - 1) k) <= max_vertices.
   const double a = double(u - 1) * double(v - 1), b = double(u - 1) + double(v - 1), c = 1.0 - double(max_vertices);
   const double k_max = (-b + std::sqrt(b * b - 4 * a * c)) / (2 * a);

@@ -80,9 +80,11 @@ struct FrameQualityLimits {
 };
 
 // Adaptive refinement (issue 26 item 2; the paper's future work "adaptive subdivision"), by whole grid: the
-// vertices per side that bring every seen triangle's normal spread below limits.max_normal_spread_deg,
-// assuming it falls in proportion to the grid spacing, with at most max_vertices in all (the grid keeps its
-// aspect). f's own size when no patch exceeds the limit or f is not a grid. {grid_u, grid_v}.
+// vertices per side that bring every seen triangle's normal spread below limits.max_normal_spread_deg, and
+// the spread of traced directions across a triangle with a totally reflected corner (a lens's TIR region)
+// below limits.max_traced_spread_deg, assuming each falls in proportion to the grid spacing, with at most
+// max_vertices in all (the grid keeps its aspect). f's own size when no patch exceeds a limit or f is not a
+// grid. {grid_u, grid_v}.
 std::array<int, 2> refinedGridSize(const ElementFrame& f, int max_vertices, const FrameQualityLimits& limits = {});
 
 // Sets each PatchView::quality and ElementFrame::quality of f (after fitPatchViews). A patch the viewer does

@@ -139,4 +139,21 @@ void checkMapLimits(const Scene& scene, RenderMode mode, const MapSizeSettings& 
               budget + advice());
 }
 
+std::vector<double> mapLimitsKey(const Scene& scene, RenderMode mode, const MapSizeSettings& s, const GlLimits& g) {
+  std::vector<double> k = {double(int(mode)),
+                           double(s.map_size),
+                           double(s.seen_points),
+                           double(s.lens_height_map_size),
+                           double(s.surface_map_size),
+                           double(scene.observer.width),
+                           double(scene.observer.height),
+                           double(g.max_texture_size),
+                           double(g.max_cube_map_size),
+                           double(g.max_renderbuffer_size),
+                           g.memory_bytes};
+  for (const Element& el : scene.elements)
+    k.insert(k.end(), {double(int(el.type)), double(el.patches_u), double(el.patches_v)});
+  return k;
+}
+
 }  // namespace pvrr

@@ -8,6 +8,7 @@
 #pragma once
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "pvrr/scene/scene.h"
 
@@ -40,5 +41,11 @@ double mapMemoryBytes(const Scene& scene, RenderMode mode, const MapSizeSettings
 // when a texture or target of a frame of `mode` exceeds a GL limit or mapMemoryBytes exceeds the budget, with
 // the largest map_size that fits where lowering it helps. Raster mode needs no maps (only its target counts).
 void checkMapLimits(const Scene& scene, RenderMode mode, const MapSizeSettings& settings, const GlLimits& limits);
+
+// Everything checkMapLimits reads of a frame (the mode, the settings, the image size, each element's type and
+// patch layout, and the limits themselves): a frame with the same key as the last one checked needs no second
+// check, so the renderer checks once per change of settings, not every frame.
+std::vector<double> mapLimitsKey(const Scene& scene, RenderMode mode, const MapSizeSettings& settings,
+                                 const GlLimits& limits);
 
 }  // namespace pvrr

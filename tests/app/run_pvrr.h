@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <sstream>
 #include <string>
 
@@ -17,13 +18,12 @@ struct CliResult {
   std::string out, err;
 };
 
-// Runs build/pvrr with the arguments (a shell fragment) from the source tree, capturing both streams.
-inline CliResult runPvrr(const std::string& args) {
+// Runs a shell command, capturing its exit code (-1 when it did not exit normally) and both streams.
+inline CliResult runCaptured(const std::string& command) {
   namespace fs = std::filesystem;
   static int counter = 0;
   const fs::path tmp = fs::temp_directory_path() / ("pvrr-cli-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
-  const std::string cmd = "cd '" PVRR_SOURCE_DIR "' && '" PVRR_BINARY "' " + args + " >'" + tmp.string() + ".out' 2>'" +
-                          tmp.string() + ".err'";
+  const std::string cmd = command + " >'" + tmp.string() + ".out' 2>'" + tmp.string() + ".err'";
   CliResult r;
   const int status = std::system(cmd.c_str());
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -40,6 +40,11 @@ inline CliResult runPvrr(const std::string& args) {
   return r;
 }
 
+// Runs build/pvrr with the arguments (a shell fragment) from the source tree, capturing both streams.
+inline CliResult runPvrr(const std::string& args) {
+  return runCaptured("cd '" PVRR_SOURCE_DIR "' && '" PVRR_BINARY "' " + args);
+}
+
 // The whole content of a file (empty when it cannot be read).
 inline std::string slurp(const std::filesystem::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -54,6 +59,15 @@ inline void expectOneLineError(const CliResult& r, const std::string& what) {
   EXPECT_EQ(r.code, 1) << r.err;
   EXPECT_NE(r.err.find(what), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << r.err;
+}
+
+// The same with several pieces of the line, and none of `outputs` written (all or nothing).
+inline void expectOneLineError(const CliResult& r, std::initializer_list<std::string> parts,
+                               std::initializer_list<std::string> outputs = {}) {
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "expected one line, got:\n" << r.err;
+  for (const std::string& p : parts) EXPECT_NE(r.err.find(p), std::string::npos) << "no \"" << p << "\" in: " << r.err;
+  for (const std::string& o : outputs) EXPECT_FALSE(std::filesystem::exists(o)) << o;
 }
 
 // A fresh temporary folder per test, removed afterwards.

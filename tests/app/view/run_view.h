@@ -6,11 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
-
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include "app/run_pvrr.h"
 
@@ -31,21 +27,8 @@ inline bool runView(const std::string& args, CliResult* r, std::string* why) {
   }
   // Parallel tests may race for a display number (xvfb-run -a): a few tries before giving up.
   for (int attempt = 0; attempt < 3; ++attempt) {  // the virtual screen is larger than any window the tests open
-    const std::string cmd =
-        "cd '" PVRR_SOURCE_DIR "' && xvfb-run -a -s '-screen 0 1600x1000x24' '" PVRR_BINARY "' view " + args;
-    static int n = 0;
-    const std::filesystem::path out = std::filesystem::temp_directory_path() /
-                                      ("pvrr-window-" + std::to_string(::getpid()) + "-" + std::to_string(n++));
-    const int status = std::system((cmd + " >'" + out.string() + ".out' 2>'" + out.string() + ".err'").c_str());
-    r->code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    std::ifstream o(out.string() + ".out"), e(out.string() + ".err");
-    std::stringstream so, se;
-    so << o.rdbuf();
-    se << e.rdbuf();
-    r->out = so.str();
-    r->err = se.str();
-    std::filesystem::remove(out.string() + ".out");
-    std::filesystem::remove(out.string() + ".err");
+    *r = runCaptured("cd '" PVRR_SOURCE_DIR "' && xvfb-run -a -s '-screen 0 1600x1000x24' '" PVRR_BINARY "' view " +
+                     args);
     if (r->err.find("Xvfb failed to start") == std::string::npos) return true;
   }
   *why = "xvfb-run could not start Xvfb (3 tries): " + r->err;

@@ -138,6 +138,15 @@ TEST(FrameQuality, RefinedGridSizeScalesWithTheSpreadWithinTheBudget) {
   f.views[0].quality.max_normal_spread_deg = 12.0;
   f.views[0].in_view = false;  // unseen patches ask for nothing
   EXPECT_EQ(refinedGridSize(f, 4096), (std::array<int, 2>{15, 15}));
+  // A lens's TIR region: its traced directions spread 4 deg across a triangle against the 2 deg limit, the same
+  // ratio as 12 deg of normals against 6: 33 x 33 (the thick TIR lens: 64' median at 24 x 24 -> 3.8' at 64 x 64,
+  // docs/robustness.md).
+  f.views[0].in_view = true;
+  f.views[0].quality.max_normal_spread_deg = 1.0;
+  f.views[0].quality.max_traced_spread_deg = 4.0;
+  EXPECT_EQ(refinedGridSize(f, 4096), (std::array<int, 2>{33, 33}));
+  f.views[0].quality.max_traced_spread_deg = 1.9;  // within its limit
+  EXPECT_EQ(refinedGridSize(f, 4096), (std::array<int, 2>{15, 15}));
 }
 
 // render.viewpoint_solver: parsed, refused when unknown, and each solver fits the stiff toric patches with an

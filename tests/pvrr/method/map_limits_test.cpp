@@ -135,5 +135,30 @@ TEST(MapLimits, ImpostorDataMapsAgainstTheTextureLimit) {
   EXPECT_EQ(refusal(mirror, RenderMode::Impostor, {256, true, 2048, 1024}, g), "");  // no lens: no height maps
 }
 
+// The renderer checks once per change of what checkMapLimits reads (mapLimitsKey): every input of the check
+// changes the key, and nothing else does.
+TEST(MapLimits, TheKeyChangesWithEveryInputOfTheCheck) {
+  const GlLimits g = roomyLimits();
+  const MapSizeSettings base{1024, true, 512, 512};
+  Scene s = test::shippedScene("plane-mirror");
+  const std::vector<double> k = mapLimitsKey(s, RenderMode::Pvrr, base, g);
+  EXPECT_EQ(mapLimitsKey(s, RenderMode::Pvrr, base, g), k);
+  s.observer.eye += Vec3(0.1, 0, 0);  // the eye is no input
+  EXPECT_EQ(mapLimitsKey(s, RenderMode::Pvrr, base, g), k);
+  EXPECT_NE(mapLimitsKey(s, RenderMode::Impostor, base, g), k);
+  for (MapSizeSettings m : {MapSizeSettings{2048, true, 512, 512}, MapSizeSettings{1024, false, 512, 512},
+                            MapSizeSettings{1024, true, 1024, 512}, MapSizeSettings{1024, true, 512, 1024}})
+    EXPECT_NE(mapLimitsKey(s, RenderMode::Pvrr, m, g), k);
+  GlLimits smaller = g;
+  smaller.memory_bytes /= 2;
+  EXPECT_NE(mapLimitsKey(s, RenderMode::Pvrr, base, smaller), k);
+  Scene wider = s;
+  wider.observer.width = 1024;
+  EXPECT_NE(mapLimitsKey(wider, RenderMode::Pvrr, base, g), k);
+  Scene split = s;
+  split.elements[0].patches_u = 2;
+  EXPECT_NE(mapLimitsKey(split, RenderMode::Pvrr, base, g), k);
+}
+
 }  // namespace
 }  // namespace pvrr
