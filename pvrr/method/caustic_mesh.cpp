@@ -298,4 +298,31 @@ CausticPlan planCaustics(const RayScene& rays, const CausticPlanOptions& o) {
   return plan;
 }
 
+std::optional<CausticLightField> referenceCaustics(const RayScene& rays, const CausticPlanOptions& plan_options,
+                                                   int photons_per_side, FrameStages& stages) {
+  if (causticLights(rays.scene()).empty()) {
+    stages.skipped(kReferenceCausticsStage, "no light has \"caustics\": true");
+    return std::nullopt;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const CausticPlan plan = planCaustics(rays, plan_options);
+  std::vector<CausticReceiverMap> windows;
+  for (const CausticReceiver& r : plan.receivers) windows.push_back({r.mesh, IrradianceGrid::zeros(r.window)});
+  CausticOptions o;
+  o.photons_per_side = photons_per_side;
+  o.max_depth = plan_options.max_depth;
+  o.dispersion = plan_options.dispersion;
+  o.spectral_samples = plan_options.spectral_samples;
+  CausticLightField field = causticLightField(rays, windows, o);
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  std::string note = std::to_string(field.emitted) + " photons (" + std::to_string(photons_per_side) + "^2 per light, element and " +
+                     "wavelength sample, " + std::to_string(field.samples_per_photon) + " sample(s)) on " +
+                     std::to_string(windows.size()) + " receiver window(s) of the raster plan; lenses block the caustic "
+                     "lights' shadow rays";
+  for (const std::string& n : plan.notes) note += "; " + n;
+  if (windows.empty()) note = "no caustic light lands on a planar receiver: none added; " + note;
+  stages.ran(kReferenceCausticsStage, ms, int(std::min<long long>(field.emitted, 2147483647LL)), note);
+  return field;
+}
+
 }  // namespace pvrr

@@ -16,8 +16,11 @@
 // times), at most kMaxCausticReceivers receivers, by landed power. Curved receivers get no caustic light; the
 // notes say so when photons land on one.
 #pragma once
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "pvrr/base/stats.h"
 
 #include "pvrr/scene/render_desc.h"
 #include "pvrr/trace/irradiance_grid.h"
@@ -76,5 +79,18 @@ std::vector<CausticReceiver> planarReceivers(const Scene& scene);
 // Traces the photon meshes of every light with caustics on and chooses the receivers' windows.
 // Throws pvrr::Error for options out of range.
 CausticPlan planCaustics(const RayScene& rays, const CausticPlanOptions& options);
+
+// The reference picture's caustic light (pvrr/trace/tracer.h TraceOptions::caustics): the light tracer's maps
+// (photons_per_side^2 photons per light, element and sample) on the receiver windows and cells the raster
+// plan chooses, so that both pictures add the same kind of map. `stages` gets the stage
+// kReferenceCausticsStage: its photon count and receivers, or why it was skipped (no light with caustics on:
+// then nullopt and the reference is what it was). Returns an empty field (lenses still block the caustic
+// lights) when no caustic light lands on a planar receiver.
+inline constexpr const char* kReferenceCausticsStage = "reference-caustics";
+// The reference's photons per side: the light tracer's default, within 0.1 % of 1024^2 inside the burning
+// lens's spot (docs/caustics.md "Convergence").
+inline constexpr int kReferenceCausticPhotons = 512;
+std::optional<CausticLightField> referenceCaustics(const RayScene& rays, const CausticPlanOptions& plan_options,
+                                                   int photons_per_side, FrameStages& stages);
 
 }  // namespace pvrr

@@ -232,6 +232,7 @@ PhotonBundle shootCausticPhotons(const RayScene& rays, const CausticOptions& o) 
   for (size_t li = 0; li < scene.lights.size(); ++li) {
     const Light& light = scene.lights[li];
     if (light.type == Light::Type::Ambient) continue;  // no direction: it makes no caustic
+    if (o.caustic_lights_only && !light.caustics) continue;
     for (size_t ei = 0; ei < scene.elements.size(); ++ei) {
       if (o.element >= 0 && int(ei) != o.element) continue;
       CausticAperture ap;
@@ -329,6 +330,47 @@ CausticResult depositPhotons(const PhotonBundle& bundle, const ReceiverRect& rec
     res.spot_rel_stderr = acc / wsum;
   }
   return res;
+}
+
+Vec3 CausticLightField::irradianceAt(const Vec3& p) const {
+  Vec3 e(0.0);
+  const double slab = DepositOptions{}.slab_m;
+  for (const CausticReceiverMap& m : receivers) {
+    const ReceiverRect& r = m.grid.rect;
+    if (std::abs(glm::dot(p - r.centre, r.normal())) > slab) continue;
+    const Vec2 uv = r.toReceiver(p);
+    if (!r.contains(uv)) continue;
+    // Cell coordinates with cell centres at integers; bilinear, clamped to the border cells.
+    const double x = (uv.x + 0.5 * r.width_m) / r.cellWidth() - 0.5;
+    const double y = (uv.y + 0.5 * r.height_m) / r.cellHeight() - 0.5;
+    const double fx = std::floor(x), fy = std::floor(y), ax = x - fx, ay = y - fy;
+    const auto cell = [&](int i, int j) {
+      return m.grid.irradiance[m.grid.index(std::clamp(i, 0, r.cells_u - 1), std::clamp(j, 0, r.cells_v - 1))];
+    };
+    const int i0 = int(fx), j0 = int(fy);
+    const Vec3 c0 = glm::mix(cell(i0, j0), cell(i0 + 1, j0), ax);
+    const Vec3 c1 = glm::mix(cell(i0, j0 + 1), cell(i0 + 1, j0 + 1), ax);
+    e += glm::mix(c0, c1, ay);
+  }
+  return e;
+}
+
+CausticLightField causticLightField(const RayScene& rays, const std::vector<CausticReceiverMap>& windows,
+                                    CausticOptions options) {
+  const auto start = std::chrono::steady_clock::now();
+  options.caustic_lights_only = true;
+  const PhotonBundle b = shootCausticPhotons(rays, options);
+  CausticLightField f;
+  f.emitted = b.emitted;
+  f.photons_per_side = options.photons_per_side;
+  f.samples_per_photon = b.samples_per_photon;
+  for (const CausticReceiverMap& w : windows) {
+    DepositOptions d;
+    d.mesh = w.mesh;
+    f.receivers.push_back({w.mesh, depositPhotons(b, w.grid.rect, d).grid});
+  }
+  f.elapsed_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return f;
 }
 
 }  // namespace pvrr

@@ -48,6 +48,7 @@ struct CausticOptions {
   int spectral_samples = 16;
   uint64_t seed = 1;
   int element = -1;  // only this element's photons (-1: every element)
+  bool caustic_lights_only = false;  // only the lights with Light::caustics on (the reference picture's)
 };
 
 // A photon after its last specular event: the ray it leaves on, its power, and where that ray meets the scene.
@@ -96,6 +97,29 @@ struct CausticResult {
 };
 
 CausticResult depositPhotons(const PhotonBundle& bundle, const ReceiverRect& receiver, const DepositOptions& options);
+
+// The caustic light of the reference picture (Tracer, TraceOptions::caustics; docs/caustics.md "In the
+// reference picture"): the light tracer's maps over receiver windows, computed once per render, looked up at
+// every diffuse hit as the raster modes look up theirs (shaders/caustic_lookup.glsl): a point within
+// DepositOptions::slab_m of a window's plane and inside it gets that map's irradiance, bilinear between cell
+// centres (clamped to the border cells, as GL_CLAMP_TO_EDGE), summed over the windows; the shading adds
+// albedo x that irradiance (pvrr/trace/shading.h).
+struct CausticReceiverMap {
+  int mesh = -1;  // Scene::meshes index: only photons landing on it are deposited
+  IrradianceGrid grid;
+};
+struct CausticLightField {
+  std::vector<CausticReceiverMap> receivers;
+  long long emitted = 0;        // photons shot (the sample count)
+  int photons_per_side = 0;     // strata per side of each aperture
+  int samples_per_photon = 1;   // wavelength samples
+  double elapsed_ms = 0;
+  Vec3 irradianceAt(const Vec3& p) const;
+};
+// Shoots the photons of the lights with caustics on (options.caustic_lights_only is forced) and deposits them
+// on each receiver's window, keeping the hits on its mesh.
+CausticLightField causticLightField(const RayScene& rays, const std::vector<CausticReceiverMap>& windows,
+                                    CausticOptions options);
 
 // The padding of an aperture rectangle, relative to its size (covers the sampling of curved rims).
 constexpr double kAperturePad = 0.02;

@@ -33,7 +33,7 @@ Vec3 sampleTexture(const Texture& t, Vec2 uv) {
 }
 
 Vec3 shadeDiffuse(const Scene& scene, const DiffuseMaterial& m, const Vec3& p, const Vec3& n, Vec2 uv,
-                  const ShadowRays* shadows, double ambient_visibility) {
+                  const ShadowRays* shadows, double ambient_visibility, const Vec3& caustic) {
   Vec3 albedo = m.color;
   if (m.texture >= 0) albedo *= sampleTexture(scene.textures[size_t(m.texture)], uv);
   Vec3 light(0.0);
@@ -56,7 +56,7 @@ Vec3 shadeDiffuse(const Scene& scene, const DiffuseMaterial& m, const Vec3& p, c
       }
     }
   }
-  return albedo * light;
+  return albedo * (light + caustic);
 }
 
 }  // namespace pvrr

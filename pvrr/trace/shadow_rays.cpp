@@ -36,7 +36,7 @@ Vec3 ShadowRays::transmittance(const Light& l, const Vec3& p) const {
     if (!hit.hit()) return Vec3(passed);
     if (hit.kind == HitKind::Environment) return Vec3(0.0);
     const Element& el = scene.elements[size_t(hit.element)];
-    if (el.type == ElementType::Mirror) return Vec3(0.0);
+    if (el.type == ElementType::Mirror || (caustic_lights_block_ && l.caustics)) return Vec3(0.0);
     passed *= std::sqrt(lensShadowTransmittance(el));  // one interface: 1 - R0
     t_min = hit.t + rays_.epsilon();
   }

@@ -11,6 +11,9 @@
 //   own angle: the raster path's shadow maps hold one transmittance per lens (shaders/shadow_lookup.glsl),
 //   and the two agree by construction. The segment is not bent by the lens (where the light it refracts
 //   lands is a caustic).
+// - with `caustic_lights_block` (the reference picture with the caustic light added, TraceOptions::caustics):
+//   for a light with caustics on (Light::caustics), a lens blocks fully too, as in the raster shadow maps: its
+//   light arrives refracted, as the caustic (pvrr/trace/light_tracer.h), not straight through.
 // The segment starts at the point itself (t > RayScene::epsilon()) and ends at a point light (t < its
 // distance) or never (a directional light).
 #pragma once
@@ -23,13 +26,15 @@ double lensShadowTransmittance(const Element& lens);
 
 class ShadowRays {
  public:
-  explicit ShadowRays(const RayScene& rays) : rays_(rays) {}
+  explicit ShadowRays(const RayScene& rays, bool caustic_lights_block = false)
+      : rays_(rays), caustic_lights_block_(caustic_lights_block) {}
   // The fraction of light `l` that reaches `p`, per channel (grey: lenses attenuate every channel alike);
   // 1 for a light with shadows off and for an ambient light.
   Vec3 transmittance(const Light& l, const Vec3& p) const;
 
  private:
   const RayScene& rays_;
+  bool caustic_lights_block_ = false;
 };
 
 }  // namespace pvrr

@@ -13,6 +13,7 @@
 #include "pvrr/base/error.h"
 #include "pvrr/optics/optics.h"
 #include "pvrr/trace/ambient_occlusion.h"
+#include "pvrr/trace/light_tracer.h"
 #include "pvrr/trace/shading.h"
 #include "pvrr/trace/specular.h"
 #include "pvrr/optics/spectrum.h"
@@ -80,13 +81,14 @@ TraceResult Tracer::traceImpl(const Vec3& o_in, const Vec3& d_in, double wavelen
     if (hit.kind == HitKind::Environment) {
       const EnvMesh& mesh = scene_.meshes[size_t(hit.mesh)];
       Vec3 n = glm::dot(hit.normal, d) > 0 ? -hit.normal : hit.normal;
-      const ShadowRays shadows(rays_);
+      const ShadowRays shadows(rays_, options_.caustics != nullptr);
+      const Vec3 caustic = options_.caustics ? options_.caustics->irradianceAt(hit.point) : Vec3(0.0);
       const AmbientOcclusionDesc& ao = scene_.render.ambient_occlusion;
       const double ambient =
           ao.on ? referenceAmbientVisibility(rays_, hit.point, n, occluderOfMesh(scene_, hit.mesh), ao.reference_samples)
                 : 1.0;
       r.color = throughput * shadeDiffuse(scene_, scene_.materials[size_t(mesh.material)], hit.point, n, hit.uv,
-                                          &shadows, ambient);
+                                          &shadows, ambient, caustic);
       r.seen = hit.point;
       seg.event = "diffuse";
       if (path) path->push_back(seg);

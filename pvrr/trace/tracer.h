@@ -17,6 +17,8 @@
 // per-channel (n, k) in the off and rgb modes, and in the spectral mode with its conductor Fresnel
 // reflectance at each sample's wavelength, Metal::index(lambda).
 //
+// Caustics: TraceOptions::caustics.
+//
 // Primary rays: render() intersects the primary rays of 4 x 4 pixel tiles as Embree packets
 // (RayScene::intersectPacket, the same exact hits as single rays); every secondary ray is a single ray.
 #pragma once
@@ -31,6 +33,8 @@
 #include "pvrr/scene/render_desc.h"
 
 namespace pvrr {
+
+struct CausticLightField;  // pvrr/trace/light_tracer.h
 
 // One segment of a traced path (pvrr trace prints these). The segment runs from `origin` along `direction`
 // to its event point.
@@ -60,6 +64,11 @@ struct TraceOptions {
   DispersionMode dispersion = DispersionMode::Off;
   int spectral_samples = 16;
   bool primary_packets = true;  // render(): primary rays of 4 x 4 tiles as packets (false: one ray each)
+  // The caustic light (docs/caustics.md "In the reference picture"), computed once by the caller and kept alive
+  // while the tracer runs: added at every diffuse hit (albedo x its irradiance), and for the lights with
+  // caustics on a lens blocks their shadow rays fully (ShadowRays' caustic_lights_block), since their light
+  // through it is the caustic. Null: no caustic light, lenses pass every light (Fresnel), as before.
+  const CausticLightField* caustics = nullptr;
 };
 
 class Tracer {

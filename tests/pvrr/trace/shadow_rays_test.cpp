@@ -95,6 +95,27 @@ TEST(ShadowRays, MirrorsBlockAndLensesTransmitByFresnel) {
   EXPECT_EQ(shadows.transmittance(up, Vec3(1.0, 3, 1.0)), Vec3(0.0));
 }
 
+// With the caustic light added (TraceOptions::caustics), a lens blocks a light with caustics on fully, as the
+// raster shadow maps do; a light with caustics off still passes (1 - R0)^2, and mirrors block either way.
+TEST(ShadowRays, LensesBlockCausticLightsWhenTheCausticIsAdded) {
+  const std::string lens = R"({"name": "l", "type": "lens", "pose": {"position": [-1.0, 1.5, 1.0],
+      "normal": [0, 1, 0], "up": [0, 0, -1]}, "outline": {"shape": "circle", "diameter": 0.3},
+      "front": {"type": "sphere", "radius": 1.0}, "back": {"type": "sphere", "radius": -1.0},
+      "centre_thickness": 0.03, "material": {"n_d": 1.5, "V_d": 60, "dispersion": false}})";
+  Scene s = test::shadowScene("quad", R"({"type": "directional", "direction": [0, -1, 0], "caustics": true})", lens);
+  RayScene rays(s);
+  const double r0 = (0.5 / 2.5) * (0.5 / 2.5);
+  const Vec3 under(-1.0, 0, 1.0), beside(-1.0, 0, 1.3);
+  Light on = s.lights[0], off = s.lights[0];
+  ASSERT_TRUE(on.caustics);
+  off.caustics = false;
+  const ShadowRays plain(rays), blocking(rays, true);
+  EXPECT_NEAR(plain.transmittance(on, under).x, (1 - r0) * (1 - r0), 1e-12);
+  EXPECT_EQ(blocking.transmittance(on, under), Vec3(0.0));
+  EXPECT_EQ(blocking.transmittance(on, beside), Vec3(1.0));
+  EXPECT_EQ(blocking.transmittance(off, under), plain.transmittance(off, under));
+}
+
 // The tracer shades a shadowed ground point with the ambient light only, a lit one with both lights.
 TEST(ShadowRays, TracerShadesShadowedPointsWithAmbientOnly) {
   Scene s = test::shadowScene("sphere", R"({"type": "directional", "direction": [0, -1, 0], "intensity": 0.8})");
