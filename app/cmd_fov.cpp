@@ -67,9 +67,8 @@ json unionJson(const std::vector<const EyeFootprint*>& feet) {
   if (u.empty())
     return {{"polygons", nullptr},
             {"note",
-             "the union is not one simple loop (footprint outlines fold where they reach the horizon, "
-             "or the union has a hole or parts): not represented; the zones' coverage uses every sample's "
-             "footprint (footprint.samples)"}};
+             "the union is not one simple loop (it has a hole or disjoint parts): not represented; the zones' "
+             "coverage uses every sample's footprint (footprint.samples)"}};
   return {{"polygons", json::array({polygonJson(u)})}};
 }
 
@@ -94,7 +93,8 @@ json ellipseFootprintJson(const std::vector<EyeFootprint>& feet, const VehicleFr
         sees_horizon = sees_horizon || f.sees_horizon;
         samples.push_back({{"eye", f.eye},
                            {"position", {f.eye_vehicle.x, f.eye_vehicle.y, f.eye_vehicle.z}},
-                           {"polygon", polygonJson(f.outline)}});
+                           {"polygon", polygonJson(f.outline)},
+                           {"outline_cut_area_m2", f.outline_cut_area_m2}});
       }
     if (mine.empty()) continue;
     json u = unionJson(mine);
@@ -128,6 +128,7 @@ json footprintJson(const std::vector<EyeFootprint>& feet, const VehicleFrame& fr
   json fp = json::object();
   for (const EyeFootprint& f : feet)
     fp[f.eye] = {{"polygon", polygonJson(f.outline)},
+                 {"outline_cut_area_m2", f.outline_cut_area_m2},
                  {"rays", f.fate.size()},
                  {"road", f.count(RayFate::Road)},
                  {"horizon", f.count(RayFate::Horizon)},

@@ -180,7 +180,60 @@ EyeFootprint traceFootprint(const RayScene& rays, int element, const VehicleFram
     refine(square(i0, j0), a, square(i1, j1), b, 0);
   }
   if (signedArea(f.outline) < 0) std::reverse(f.outline.begin(), f.outline.end());
+  f.outline_cut_area_m2 = makeSimple(f.outline);
   return f;
+}
+
+int firstSelfCrossing(const std::vector<Vec2>& p, size_t& i_out, size_t& j_out, Vec2& x_out) {
+  const size_t n = p.size();
+  if (n < 4) return 0;
+  // Bounding boxes of the edges, so that most pairs are rejected at once.
+  std::vector<Vec2> lo(n), hi(n);
+  for (size_t i = 0; i < n; ++i) {
+    lo[i] = glm::min(p[i], p[(i + 1) % n]);
+    hi[i] = glm::max(p[i], p[(i + 1) % n]);
+  }
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = i + 2; j < n; ++j) {
+      if (i == 0 && j == n - 1) continue;  // neighbours across the closing edge
+      if (hi[i].x < lo[j].x || hi[j].x < lo[i].x || hi[i].y < lo[j].y || hi[j].y < lo[i].y) continue;
+      const Vec2 a = p[i], d = p[(i + 1) % n] - a, b = p[j], e = p[(j + 1) % n] - b;
+      const double den = cross2(d, e);
+      if (den == 0) continue;
+      const double t = cross2(b - a, e) / den, u = cross2(b - a, d) / den;
+      if (t >= 0 && t <= 1 && u >= 0 && u <= 1) {
+        i_out = i;
+        j_out = j;
+        x_out = a + t * d;
+        return 1;
+      }
+    }
+  return 0;
+}
+
+double makeSimple(std::vector<Vec2>& p) {
+  double cut = 0;
+  size_t i = 0, j = 0;
+  Vec2 x(0);
+  // Each cut removes at least one vertex, so this ends.
+  while (firstSelfCrossing(p, i, j, x)) {
+    // The loop from the crossing through p[i + 1] .. p[j] back to the crossing, and the rest.
+    std::vector<Vec2> inner{x}, outer(p.begin(), p.begin() + std::ptrdiff_t(i) + 1);
+    inner.insert(inner.end(), p.begin() + std::ptrdiff_t(i) + 1, p.begin() + std::ptrdiff_t(j) + 1);
+    outer.push_back(x);
+    outer.insert(outer.end(), p.begin() + std::ptrdiff_t(j) + 1, p.end());
+    const double ai = std::abs(signedArea(inner)), ao = std::abs(signedArea(outer));
+    cut += std::min(ai, ao);
+    p = ai > ao ? inner : outer;
+    // Drop a repeated point (the crossing at a shared vertex).
+    std::vector<Vec2> q;
+    for (const Vec2& v : p)
+      if (q.empty() || v != q.back()) q.push_back(v);
+    while (q.size() > 1 && q.front() == q.back()) q.pop_back();
+    p = q;
+  }
+  if (signedArea(p) < 0) std::reverse(p.begin(), p.end());
+  return cut;
 }
 
 std::vector<Vec2> zoneInVehicle(const FovZone& z, const VehicleFrame& frame, double zone_horizon_m) {

@@ -71,7 +71,13 @@ struct EyeFootprint {
   // The image of the mirror's boundary, counter-clockwise in (x, y): one point per boundary sample, and between two
   // whose road points lie more than 1 m and 5 % of their distance apart, points of the edge between them (halving
   // it, at most 10 times), so that the outline follows the edge out to the horizon instead of a chord across it.
+  // The outline is then made simple (makeSimple): where the mirror's boundary runs above the horizon, its
+  // clamped image (CONVENTIONS) runs along the horizon's arc and back again wherever the boundary's horizontal
+  // direction turns back (near the corner where an edge meets the horizon, on the car mirror by about 2 m at
+  // 1 km); such a fold is a sliver of zero area, 1 km away, whose sides (arcs about slightly different mirror
+  // points) cross. outline_cut_area_m2 is the area of the loops cut off (0 when the traced outline was simple).
   std::vector<Vec2> outline;
+  double outline_cut_area_m2 = 0;
   int count(RayFate f) const;
   // The farthest road reach behind the ocular points (m) of the Road rays, and whether any ray reaches the
   // horizon.
@@ -133,6 +139,15 @@ SurfaceFigures surfaceFigures(const RayScene& rays, int element, const Vec3& eye
 // outer boundary: the edges of each split where they cross the other's, those outside the other kept and
 // chained. Overlapping collinear edges are not handled (two eyes' footprints never share an edge).
 std::vector<std::vector<Vec2>> polygonUnion(const std::vector<Vec2>& a, const std::vector<Vec2>& b);
+
+// Whether the closed polygon p crosses itself: the first pair of non-adjacent edges (p[i], p[i + 1]) and
+// (p[j], p[j + 1]), i < j, that meet (touching counts), and where; 0 when p is simple.
+int firstSelfCrossing(const std::vector<Vec2>& p, size_t& i, size_t& j, Vec2& x);
+
+// Makes a closed polygon simple: at each crossing (firstSelfCrossing) it splits into two loops and keeps the one of
+// larger area, until none is left; counter-clockwise after. Returns the area cut off (the sum of the smaller
+// loops' areas).
+double makeSimple(std::vector<Vec2>& p);
 
 // Inside test for a simple polygon (even-odd).
 bool insidePolygon(const std::vector<Vec2>& poly, Vec2 p);

@@ -140,6 +140,13 @@ TEST(FovCli, EyeEllipse) {
   EXPECT_EQ(je["eyes"], (nlohmann::json{"left", "right"}));
   EXPECT_EQ(je["footprint"]["samples"].size(), 30u);
   EXPECT_EQ(je["footprint"]["left"]["samples"], 15);
+  // The samples' outlines are simple (the horizon's fold cut off), so each eye's union and the union over all samples
+  // are one loop each, with no note.
+  for (const char* eye : {"left", "right"}) EXPECT_TRUE(je["footprint"][eye]["polygon"].is_array()) << eye;
+  ASSERT_TRUE(je["footprint"]["union"]["polygons"].is_array());
+  EXPECT_EQ(je["footprint"]["union"]["polygons"].size(), 1u);
+  EXPECT_FALSE(je["footprint"]["union"].contains("note"));
+  for (const nlohmann::json& s : je["footprint"]["samples"]) EXPECT_GE(s["outline_cut_area_m2"].get<double>(), 0);
   ASSERT_EQ(jp["zones"].size(), 2u);
   for (size_t i = 0; i < 2; ++i) {
     EXPECT_EQ(jz["zones"][i]["covered_fraction"], jp["zones"][i]["covered_fraction"]);
