@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -110,28 +111,15 @@ void chooseWindow(Receiver& r, const PhotonBundle& b, const Args& a, const std::
     c = Vec2(v[0], v[1]), w = v[2], h = v[3];
   } else {
     std::vector<std::pair<Vec2, double>> landed;
-    double total = 0;
-    Vec2 acc(0);
     for (const CausticPhoton& p : b.photons) {
       if (p.mesh != r.index || !std::isfinite(p.t_hit)) continue;
       const Vec2 uv = full.toReceiver(p.origin + p.t_hit * p.direction);
-      if (!full.contains(uv)) continue;
-      landed.push_back({uv, mean3(p.power)});
-      total += mean3(p.power);
-      acc += mean3(p.power) * uv;
+      if (full.contains(uv)) landed.push_back({uv, mean3(p.power)});
     }
-    if (!(total > 0)) throw Error(path + ": environment (" + r.name + "): no caustic light lands on this receiver");
-    c = acc / total;
-    std::vector<std::pair<double, double>> radii;  // (distance from the centroid, power)
-    for (const auto& [uv, pw] : landed) radii.push_back({std::max(std::abs(uv.x - c.x), std::abs(uv.y - c.y)), pw});
-    std::sort(radii.begin(), radii.end());
-    double sum = 0, radius = 0;
-    for (const auto& [d, pw] : radii) {
-      sum += pw;
-      radius = d;
-      if (sum >= kWindowQuantile * total) break;
-    }
-    w = h = std::max(kMinWindow_m, 2 * kWindowScale * radius);
+    const std::optional<PowerWindow> window = powerWindow(landed, kWindowQuantile, kWindowScale, kMinWindow_m);
+    if (!window) throw Error(path + ": environment (" + r.name + "): no caustic light lands on this receiver");
+    c = window->centre;
+    w = h = window->side_m;
   }
   // Clip to the receiver.
   const double u0 = std::max(c.x - 0.5 * w, -0.5 * full.width_m), u1 = std::min(c.x + 0.5 * w, 0.5 * full.width_m);

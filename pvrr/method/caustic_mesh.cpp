@@ -155,27 +155,17 @@ void chooseWindow(CausticReceiver& r, const std::vector<std::pair<Vec3, double>>
   const ReceiverRect& full = r.full;
   std::vector<std::pair<Vec2, double>> uv;
   double total = 0;
-  Vec2 acc(0);
   for (const auto& [x, w] : landed) {
     const Vec2 q = full.toReceiver(x);
     if (!full.contains(q) || !(w > 0)) continue;
     uv.push_back({q, w});
     total += w;
-    acc += w * q;
   }
   r.landed_power = total;
-  if (!(total > 0)) return;
-  const Vec2 c = acc / total;
-  std::vector<std::pair<double, double>> radii;
-  for (const auto& [q, w] : uv) radii.push_back({std::max(std::abs(q.x - c.x), std::abs(q.y - c.y)), w});
-  std::sort(radii.begin(), radii.end());
-  double sum = 0, radius = 0;
-  for (const auto& [d, w] : radii) {
-    sum += w;
-    radius = d;
-    if (sum >= kWindowQuantile * total) break;
-  }
-  const double side = std::max(kMinWindow_m, 2 * kWindowScale * radius);
+  const std::optional<PowerWindow> window = powerWindow(uv, kWindowQuantile, kWindowScale, kMinWindow_m);
+  if (!window) return;
+  const Vec2 c = window->centre;
+  const double side = window->side_m;
   const double u0 = std::max(c.x - 0.5 * side, -0.5 * full.width_m),
                u1 = std::min(c.x + 0.5 * side, 0.5 * full.width_m);
   const double v0 = std::max(c.y - 0.5 * side, -0.5 * full.height_m),

@@ -54,13 +54,12 @@ inline constexpr int kMaxRefineSteps = 16;
 
 // render.ambient_occlusion (pvrr/trace/ambient_occlusion.h): off by default. The raster path's displacement
 // fields (pvrr/method/ao_field.h) sample `positions`^2 points on each occluding object's bounding sphere
-// (octahedral map) and `directions`^2 rays from each (concentric map); each fragment casts `samples` rays per
-// occluder; the reference casts `reference_samples` rays per shaded point.
+// (octahedral map) and `directions`^2 rays from each (concentric map), turned at load into an occlusion
+// volume a fragment reads (pvrr/gl/ao_fields.h); the reference casts `reference_samples` rays per shaded point.
 struct AmbientOcclusionDesc {
   bool on = false;
   int positions = 64;
   int directions = 16;
-  int samples = 16;
   int reference_samples = 256;
 };
 

@@ -372,5 +372,7 @@ inline Mat3 readRotation(const Obj& o) {
 
 // The scene file's sections, read into the description (scene_json_sections.cpp).
 SceneDesc readScene(Ctx& c, const json& doc);
+// The `vehicle` section (scene_json_vehicle.cpp); `environment` for the obstructions' names.
+VehicleDesc readVehicle(const Ctx& c, const json* j, const std::vector<EnvObjectDesc>& environment);
 
 }  // namespace pvrr::scene_json_detail

@@ -373,4 +373,26 @@ CausticLightField causticLightField(const RayScene& rays, const std::vector<Caus
   return f;
 }
 
+std::optional<PowerWindow> powerWindow(const std::vector<std::pair<Vec2, double>>& landed, double quantile,
+                                       double scale, double min_side_m) {
+  double total = 0;
+  Vec2 acc(0);
+  for (const auto& [q, w] : landed) {
+    total += w;
+    acc += w * q;
+  }
+  if (!(total > 0)) return std::nullopt;
+  const Vec2 c = acc / total;
+  std::vector<std::pair<double, double>> radii;  // (Chebyshev distance from the centroid, power)
+  for (const auto& [q, w] : landed) radii.push_back({std::max(std::abs(q.x - c.x), std::abs(q.y - c.y)), w});
+  std::sort(radii.begin(), radii.end());
+  double sum = 0, radius = 0;
+  for (const auto& [d, w] : radii) {
+    sum += w;
+    radius = d;
+    if (sum >= quantile * total) break;
+  }
+  return PowerWindow{c, std::max(min_side_m, 2 * scale * radius)};
+}
+
 }  // namespace pvrr

@@ -31,6 +31,7 @@
 //   biased low; power is conserved except within half a cell of the border) and divided by the cell area.
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -151,5 +152,16 @@ enum class PhotonFate { Missed, Absorbed, Left };
 // and where it meets the environment. Missed: its first hit is not `element`.
 PhotonFate followPhoton(const RayScene& rays, int element, double wavelength_nm, bool spectral, int max_depth,
                         CausticPhoton& p);
+
+// The automatic window of the caustic light landed on a receiver (`landed`: receiver coordinates and power):
+// about the power's centroid, the square holding `quantile` of the power (its Chebyshev radius), enlarged
+// `scale` times, at least `min_side_m` across. Nothing when no power landed. The raster caustic maps
+// (pvrr/method/caustic_mesh.h) and `pvrr caustic` choose their windows with it.
+struct PowerWindow {
+  Vec2 centre{0.0};
+  double side_m = 0;
+};
+std::optional<PowerWindow> powerWindow(const std::vector<std::pair<Vec2, double>>& landed, double quantile,
+                                       double scale, double min_side_m);
 
 }  // namespace pvrr
