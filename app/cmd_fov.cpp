@@ -268,6 +268,8 @@ AimReport runAim(const std::string& scene_path, const std::vector<std::string>& 
   ao.range_deg = aim_range_deg;
   ao.left_eye = eyes_opt != "right";
   ao.right_eye = eyes_opt != "left";
+  // --eyes ellipse: aimed for every sample of the eye ellipse (an eye sees a point when any of its samples does).
+  if (eyes_opt == "ellipse") ao.eye_samples = eyeEllipseSamples(frame, *ls.desc.vehicle->eye_ellipse);
   const ElementDesc& ed = ls.desc.elements[size_t(index)];
   if (ed.pivot) {
     if (ed.attached_to_observer)
@@ -357,8 +359,6 @@ int cmdFov(const std::vector<std::string>& argv) {
   options.samples = a.getInt("samples", options.samples, 2);
   if (options.samples > 1001) usageError("fov", "--samples: expected at most 1001");
   const bool aim = a.has("aim");
-  if (aim && eyes_opt == "ellipse")
-    usageError("fov", "--aim aims for the ocular points; it does not take --eyes ellipse (not yet)");
   const double aim_range_deg = a.getDouble("aim-range", 10);
   if (!(aim_range_deg >= 1 && aim_range_deg <= 45)) usageError("fov", "--aim-range: expected degrees in [1, 45]");
   const std::string scene_path = a.positional()[0];

@@ -49,6 +49,7 @@ struct Searcher {
   Scene work;                        // the scene with the element turned
   std::unique_ptr<RayScene> tracer;  // on `work`: one Embree scene, the element moved in it per evaluation
   int evaluations = 0;
+  std::vector<EyeSample> eyes;  // aimEyes
 
   AimScore evaluate(AimAngles a) {
     ++evaluations;
@@ -61,9 +62,7 @@ struct Searcher {
       tracer->updateElementPoses();
     const RayScene& rays = *tracer;
     std::vector<EyeFootprint> feet;
-    const VehicleDesc& v = frame.desc();
-    if (options.left_eye) feet.push_back(traceFootprint(rays, element, frame, v.eye_left, "left", options.fov));
-    if (options.right_eye) feet.push_back(traceFootprint(rays, element, frame, v.eye_right, "right", options.fov));
+    for (const EyeSample& e : eyes) feet.push_back(traceFootprint(rays, element, frame, e.world, e.eye, options.fov));
     std::vector<const EyeFootprint*> eyes;
     for (const EyeFootprint& f : feet) eyes.push_back(&f);
     AimScore s;
@@ -124,8 +123,7 @@ AimMargins::AimMargins(const Scene& scene, int element, const VehicleFrame& fram
                        const Vec3& pitch_axis)
     : el_(scene.elements[size_t(element)]),
       frame_(frame),
-      left_eye_(options.left_eye),
-      right_eye_(options.right_eye),
+      eyes_(aimEyes(options, frame)),
       base_(base),
       pivot_(pivot),
       yaw_axis_(yaw_axis),
@@ -141,27 +139,30 @@ AimMargins::AimMargins(const Scene& scene, int element, const VehicleFrame& fram
     const double a0 = std::atan2(h, std::max(-hi.x, 1e-3)), a1 = std::atan2(h, -lo.x);
     for (int k = 0; k < kEdgePoints; ++k) {
       const double x = -h / std::tan(a0 + (a1 - a0) * k / (kEdgePoints - 1));
-      for (const double y : {lo.y, hi.y}) points_.push_back({frame.toWorld(Vec3(x, y, 0)), z.eyes, {}});
+      for (const double y : {lo.y, hi.y})
+        points_.push_back({frame.toWorld(Vec3(x, y, 0)), z.eyes, std::vector<Vec2>(eyes_.size(), Vec2(0))});
     }
   }
 }
 
 void AimMargins::seedAt(const double* angles_deg) {
   const Mat4 pose = aimedPose(base_, pivot_, yaw_axis_, pitch_axis_, {angles_deg[0] * kDeg, angles_deg[1] * kDeg});
-  const VehicleDesc& v = frame_.desc();
-  for (Point& p : points_) {
-    p.seed[0] = solve(pose, v.eye_left, p.q, p.seed[0]).s;
-    p.seed[1] = solve(pose, v.eye_right, p.q, p.seed[1]).s;
-  }
+  for (Point& p : points_)
+    for (size_t e = 0; e < eyes_.size(); ++e) p.seed[e] = solve(pose, eyes_[e].world, p.q, p.seed[e]).s;
 }
 
 std::vector<double> AimMargins::margins(const double* angles_deg) const {
   const Mat4 pose = aimedPose(base_, pivot_, yaw_axis_, pitch_axis_, {angles_deg[0] * kDeg, angles_deg[1] * kDeg});
-  const VehicleDesc& v = frame_.desc();
   std::vector<double> out;
   for (const Point& p : points_) {
-    const double ml = left_eye_ ? solve(pose, v.eye_left, p.q, p.seed[0]).margin : -1;
-    const double mr = right_eye_ ? solve(pose, v.eye_right, p.q, p.seed[1]).margin : -1;
+    double ml = -kInf, mr = -kInf;
+    for (size_t e = 0; e < eyes_.size(); ++e) {
+      double& m = eyes_[e].eye == "left" ? ml : mr;
+      m = std::max(m, solve(pose, eyes_[e].world, p.q, p.seed[e]).margin);
+    }
+    // An eye not searched for sees nothing (margin -1, a whole square's width outside).
+    if (ml == -kInf) ml = -1;
+    if (mr == -kInf) mr = -1;
     switch (p.eyes) {
       case FovZone::Eyes::Either:
         out.push_back(std::max(ml, mr));
@@ -240,6 +241,14 @@ struct SoftMinResidual {
 
 }  // namespace
 
+std::vector<EyeSample> aimEyes(const AimOptions& options, const VehicleFrame& frame) {
+  if (!options.eye_samples.empty()) return options.eye_samples;
+  std::vector<EyeSample> e;
+  if (options.left_eye) e.push_back({"left", frame.desc().eye_left, Vec3(0)});
+  if (options.right_eye) e.push_back({"right", frame.desc().eye_right, Vec3(0)});
+  return e;
+}
+
 Mat4 aimedPose(const Mat4& local_to_world, const Vec3& pivot, const Vec3& yaw_axis, const Vec3& pitch_axis,
                AimAngles a) {
   const Mat3 R = rotation(yaw_axis, a.yaw_rad) * rotation(pitch_axis, a.pitch_rad);
@@ -251,7 +260,8 @@ Mat4 aimedPose(const Mat4& local_to_world, const Vec3& pivot, const Vec3& yaw_ax
 AimResult aimMirror(const Scene& scene, int element, const VehicleFrame& frame, const std::vector<FovZone>& zones,
                     const AimOptions& options) {
   PVRR_CHECK(!zones.empty());
-  PVRR_CHECK(options.left_eye || options.right_eye);
+  const std::vector<EyeSample> eyes = aimEyes(options, frame);
+  PVRR_CHECK(!eyes.empty());
   PVRR_CHECK(options.coarse_step_deg > 0 && options.fine_step_deg > 0 && options.range_deg >= options.coarse_step_deg);
   const Element& el = scene.elements[size_t(element)];
   AimResult res;
@@ -263,7 +273,7 @@ AimResult aimMirror(const Scene& scene, int element, const VehicleFrame& frame, 
   res.pitch_axis = glm::normalize(h);
 
   Searcher s{scene,     element,      frame,          zones, options, el.local_to_world,
-             res.pivot, res.yaw_axis, res.pitch_axis, scene, nullptr};
+             res.pivot, res.yaw_axis, res.pitch_axis, scene, nullptr, 0, eyes};
   res.before = s.evaluate({});
   const int mc = int(std::floor(options.range_deg / options.coarse_step_deg + 1e-9));
   const Searcher::Cell coarse = s.grid({}, options.coarse_step_deg * kDeg, mc);

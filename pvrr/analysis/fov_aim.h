@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "pvrr/analysis/fov.h"
+#include "pvrr/analysis/fov_eyes.h"
 
 namespace pvrr {
 
@@ -32,7 +33,14 @@ struct AimOptions {
   bool polish = true;
   std::optional<Vec3> pivot;  // world; default the element's pose position (its vertex)
   bool left_eye = true, right_eye = true;
+  // The eye positions searched for, each seeing for its eye ("left" / "right") as evaluateZone counts them: an eye
+  // ellipse's samples (fov_eyes.h; a point is seen by an eye when any of its samples sees it). Empty: the ocular
+  // points chosen by left_eye / right_eye.
+  std::vector<EyeSample> eye_samples;
 };
+
+// The eye positions of a search: options.eye_samples, else the ocular points left_eye / right_eye choose.
+std::vector<EyeSample> aimEyes(const AimOptions& options, const VehicleFrame& frame);
 
 struct AimAngles {
   double yaw_rad = 0, pitch_rad = 0;
@@ -61,7 +69,8 @@ Mat4 aimedPose(const Mat4& local_to_world, const Vec3& pivot, const Vec3& yaw_ax
                AimAngles a);
 
 // The polish's smooth objective (METHOD 3), exposed for its tests: each zone edge point's margin on the mirror's
-// parameter square at angles (yaw, pitch) in degrees. Newton starts from seeds fixed by seedAt (once, before the
+// parameter square at angles (yaw, pitch) in degrees; an eye's margin is the largest over its eye positions
+// (aimEyes), a zone point's the eyes' combination its zone asks for (either: the larger, both: the smaller). Newton starts from seeds fixed by seedAt (once, before the
 // solver runs), so margins() is a pure function of the angles: the same angles give the same bits whatever was
 // evaluated before (Ceres' central differences compare two evaluations of one function).
 class AimMargins {
@@ -77,7 +86,7 @@ class AimMargins {
   struct Point {
     Vec3 q;  // world, on the road
     FovZone::Eyes eyes;
-    Vec2 seed[2];  // left, right eye
+    std::vector<Vec2> seed;  // per eye position (eyes_)
   };
   struct Solve {
     Vec2 s;
@@ -88,7 +97,7 @@ class AimMargins {
 
   const Element& el_;
   const VehicleFrame& frame_;
-  bool left_eye_, right_eye_;
+  std::vector<EyeSample> eyes_;
   Mat4 base_;
   Vec3 pivot_, yaw_axis_, pitch_axis_;
   std::vector<Point> points_;
