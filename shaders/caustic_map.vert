@@ -5,12 +5,15 @@ layout(location = 0) in vec2 a_ndc;       // the vertex's aperture coordinates, 
 layout(location = 1) in vec3 a_origin;    // where it leaves the element, relative to the mesh's anchor
 layout(location = 2) in vec3 a_direction;
 layout(location = 3) in vec3 a_power;     // W per unit aperture measure
+layout(location = 4) in float a_mesh;     // the environment mesh its exit ray meets first (-1: none)
 out vec3 v_origin;
 out vec3 v_direction;
 out vec3 v_power;
+flat out float v_mesh;
 void main() {
   v_origin = a_origin;
   v_direction = a_direction;
   v_power = a_power;
+  v_mesh = a_mesh;
   gl_Position = vec4(a_ndc, 0.0, 1.0);
 }

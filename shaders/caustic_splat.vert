@@ -1,7 +1,8 @@
 #version 330 core
 // Splats the caustic map's photons into one receiver's light map (pvrr/gl/caustic_pass.h): one point per
 // texel (gl_VertexID), drawn where its exit ray first meets a mapped receiver's plane inside that receiver's
-// rectangle, if that receiver is this map's. Positions are relative to the photon mesh's anchor.
+// rectangle, if that receiver is this map's and the mesh the photon's exit ray meets first (the caustic map's
+// direction w): light stopped by anything else lands on no map. Positions are relative to the photon mesh's anchor.
 #define CAUSTIC_RECEIVERS 4
 uniform sampler2D u_origin;
 uniform sampler2D u_direction;
@@ -14,6 +15,7 @@ uniform vec3 u_centre[CAUSTIC_RECEIVERS];          // each receiver's rectangle:
 uniform vec3 u_axis_u[CAUSTIC_RECEIVERS];
 uniform vec3 u_axis_v[CAUSTIC_RECEIVERS];
 uniform vec2 u_half[CAUSTIC_RECEIVERS];
+uniform int u_mesh[CAUSTIC_RECEIVERS];             // each receiver's Scene::meshes index
 uniform vec2 u_window_centre;                      // the drawn map's window, receiver coordinates (m)
 uniform vec2 u_window_size;
 uniform vec2 u_cells;
@@ -27,12 +29,15 @@ void main() {
   ivec2 t = ivec2(gl_VertexID % u_side, gl_VertexID / u_side);
   vec4 o = texelFetch(u_origin, t, 0);
   if (o.w < 0.5) return;
-  vec3 d = normalize(texelFetch(u_direction, t, 0).xyz);
+  vec4 dm = texelFetch(u_direction, t, 0);
+  vec3 d = normalize(dm.xyz);
+  int mesh = int(floor(dm.w + 0.5));
   float best = 3.0e38;
   int hit = -1;
   vec2 uv_hit = vec2(0.0);
   for (int r = 0; r < CAUSTIC_RECEIVERS; ++r) {
     if (r >= u_receivers) break;
+    if (u_mesh[r] != mesh) continue;
     vec3 n = cross(u_axis_u[r], u_axis_v[r]);
     float dn = dot(d, n);
     if (dn == 0.0) continue;

@@ -146,16 +146,16 @@ void CausticPass::render() {
 void CausticPass::splat(const CausticMesh& m) {
   const CausticAperture& ap = m.aperture;
   std::vector<float> data;
-  data.reserve(m.vertices.size() * 11);
+  data.reserve(m.vertices.size() * 12);
   for (const CausticVertex& v : m.vertices) {
     const Vec3 o = v.origin - m.anchor;
     data.insert(data.end(),
                 {float(2 * (v.xy.x - ap.x0) / (ap.x1 - ap.x0) - 1), float(2 * (v.xy.y - ap.y0) / (ap.y1 - ap.y0) - 1),
                  float(o.x), float(o.y), float(o.z), float(v.direction.x), float(v.direction.y), float(v.direction.z),
-                 float(v.power_density.x), float(v.power_density.y), float(v.power_density.z)});
+                 float(v.power_density.x), float(v.power_density.y), float(v.power_density.z), float(v.mesh)});
   }
   MeshBuffers mesh;
-  uploadMesh(mesh, data, {2, 3, 3, 3}, m.triangles);
+  uploadMesh(mesh, data, {2, 3, 3, 3, 1}, m.triangles);
   glBindFramebuffer(GL_FRAMEBUFFER, photon_fbo_);
   const GLenum buffers[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
   glDrawBuffers(3, buffers);
@@ -187,6 +187,7 @@ void CausticPass::splat(const CausticMesh& m) {
     p.set("u_axis_u" + k, glm::vec3(full.u_axis));
     p.set("u_axis_v" + k, glm::vec3(full.v_axis));
     p.set("u_half" + k, glm::vec2(0.5 * full.width_m, 0.5 * full.height_m));
+    p.set("u_mesh" + k, plan_.receivers[r].mesh);
   }
   glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
   glDrawBuffer(GL_COLOR_ATTACHMENT0);

@@ -85,6 +85,7 @@ CausticVertex vertexOf(const Traced& t, double x, double y) {
   v.origin = t.p.origin;
   v.direction = t.p.direction;
   v.power_density = t.p.power;
+  v.mesh = t.left ? t.p.mesh : -1;
   return v;
 }
 

@@ -46,6 +46,10 @@ struct CausticVertex {
   Vec2 xy{0};  // aperture coordinates
   Vec3 origin{0}, direction{0};
   Vec3 power_density{0};
+  // The environment mesh its exit ray meets first (Scene::meshes index; -1: none). A kept cell's corners share it,
+  // so the splat lands the cell's photons only on that mesh's light map: whatever stands between the element and
+  // a receiver (an occluder that is not itself a mapped receiver) keeps the light off it.
+  int mesh = -1;
 };
 
 struct CausticMesh {
