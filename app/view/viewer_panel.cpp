@@ -178,8 +178,10 @@ void Viewer::panel(const gl::RasterFrame& f, double frame_ms) {
   ImGui::Begin("pvrr view");
   {
     // Its rectangle less a pixel all round (the border's half pixels), while the window is drawn whole: not
-    // collapsed (a collapsed title bar is translucent).
-    const ImVec2 pos = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
+    // collapsed (a collapsed title bar is translucent). In framebuffer pixels (ImGui's are the screen's).
+    const ImVec2 scale = ImGui::GetIO().DisplayFramebufferScale, at = ImGui::GetWindowPos(),
+                 extent = ImGui::GetWindowSize();
+    const ImVec2 pos(at.x * scale.x, at.y * scale.y), size(extent.x * scale.x, extent.y * scale.y);
     panel_list_ = ImGui::IsWindowCollapsed() ? nullptr : ImGui::GetWindowDrawList();
     panel_rect_ = {int(std::ceil(pos.x)) + 1, int(std::ceil(pos.y)) + 1, int(std::floor(pos.x + size.x)) - 1,
                    int(std::floor(pos.y + size.y)) - 1};
