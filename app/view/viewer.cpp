@@ -226,7 +226,8 @@ void Viewer::frame() {
   const auto t_render = Clock::now();
   if (!wipe_drawn_) {
     // The wipe's first draw, where a software GL compiles its shaders' code: here, of the first frame, into the
-    // back buffer that the frame's present then overwrites, not at the first reference.
+    // back buffer that the frame's present (and the panel over the rest) then overwrites, not at the first
+    // reference.
     wipe_->present(renderer_->colorTexture(), ob.width, ob.height, 0.5 * ob.width, true);
     wipe_drawn_ = true;
   }
