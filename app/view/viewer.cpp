@@ -226,23 +226,38 @@ void Viewer::frame() {
   const auto t_render = Clock::now();
   if (!wipe_drawn_) {
     // The wipe's first draw, where a software GL compiles its shaders' code: here, of the first frame, into the
-    // back buffer that the frame's present then overwrites, not at the first reference.
+    // back buffer that the frame's present (and the panel over the rest) then overwrites, not at the first
+    // reference.
     wipe_->present(renderer_->colorTexture(), ob.width, ob.height, 0.5 * ob.width, true);
     wipe_drawn_ = true;
   }
+  // The panel first made (no GL), then the frame presented around its opaque rectangle, then the panel drawn.
+  window_.beginPanel();
+  fov_overlay_.draw(ls_.scene, ls_.desc, *rays_, selected_, scene_builds_, ob);  // under the panel, in panel shots
+  const double shown_ms = recent_ms_.empty() ? f.frame_ms : recent_ms_.back();
+  panel_list_ = nullptr;
+  if (show_panel_) panel(f, shown_ms);
+  window_.endPanel();
+  const auto t_panel_made = Clock::now();
   presentFrame(ob);
   const auto t_present = Clock::now();
   if (!pending_screenshots_.empty()) {
-    // Screenshots show the frame alone: taken before the panel is drawn over it.
+    // Screenshots show the frame alone: taken before the panel is drawn over it (that frame presented whole).
     const ImageRGB8 img = window_.readBackBuffer(ob.width, ob.height);
     for (const std::string& file : pending_screenshots_) writePngAtomic(file, img, MissingFolder::Create);
     pending_screenshots_.clear();
   }
-  window_.beginPanel();
-  fov_overlay_.draw(ls_.scene, ls_.desc, *rays_, selected_, scene_builds_, ob);  // under the panel, in panel shots
-  const double shown_ms = recent_ms_.empty() ? f.frame_ms : recent_ms_.back();
-  if (show_panel_) panel(f, shown_ms);
-  window_.endPanel();
+  {
+    // The panel from its picture (panel_cache.h) unless it is being worked (a screenshot with the panel shows
+    // what the window shows).
+    const ImGuiIO& io = ImGui::GetIO();
+    const bool worked = io.WantCaptureMouse || io.WantCaptureKeyboard || ImGui::IsAnyItemActive() ||
+                        ImGui::IsPopupOpen("", ImGuiPopupFlags_AnyPopupId);
+    if (panelDrawn() && !worked)
+      window_.drawPanel(panel_list_, panel_outer_);
+    else
+      window_.drawPanel();
+  }
   if (!panel_screenshots_.empty()) {
     const ImageRGB8 img = window_.readBackBuffer(ob.width, ob.height);
     for (const std::string& file : panel_screenshots_) writePngAtomic(file, img, MissingFolder::Create);
@@ -275,8 +290,8 @@ void Viewer::frame() {
     return std::chrono::duration<double, std::milli>(b - a).count();
   };
   render_ms_.push_back(span(t0, t_render));
-  present_ms_.push_back(span(t_render, t_present));
-  panel_ms_.push_back(span(t_present, t_panel));
+  present_ms_.push_back(span(t_panel_made, t_present));
+  panel_ms_.push_back(span(t_render, t_panel_made) + span(t_present, t_panel));
   swap_ms_.push_back(span(t_panel, Clock::now()));
   if (tracing) {
     ++frames_while_tracing_;
@@ -378,9 +393,28 @@ void Viewer::discardReference(const std::string& why) {
   waiting_reference_ = false;
 }
 
+bool Viewer::panelDrawn() const {
+  // Not while the panel is hidden, collapsed or not drawn this frame (ImGui hides a window the frame it first
+  // sizes itself).
+  if (!show_panel_ || !panel_list_) return false;
+  const ImDrawData* dd = ImGui::GetDrawData();
+  if (!dd || !dd->Valid) return false;
+  for (int i = 0; i < dd->CmdListsCount; ++i)
+    if (dd->CmdLists[i] == panel_list_ && dd->CmdLists[i]->VtxBuffer.Size > 0) return true;
+  return false;
+}
+
+std::optional<PixelRect> Viewer::panelHole() const {
+  // Not under a screenshot of the frame alone.
+  if (!pending_screenshots_.empty() || !panelDrawn()) return std::nullopt;
+  return panel_rect_;
+}
+
 void Viewer::presentFrame(const Observer& ob) {
   if (!reference_) {
-    window_.present(renderer_->colorTexture(), ob.width, ob.height);
+    const std::optional<PixelRect> hole = panelHole();
+    panel_hole_frames_ += hole ? 1 : 0;
+    window_.present(renderer_->colorTexture(), ob.width, ob.height, hole);
     return;
   }
   const bool finished = reference_->finished();  // first: every tile is queued once it says so
@@ -527,6 +561,12 @@ json Viewer::stats() const {
             {"present", t.empty() ? 0.0 : median(present_ms_)},
             {"panel", t.empty() ? 0.0 : median(panel_ms_)},
             {"swap", t.empty() ? 0.0 : median(swap_ms_)}}},
+          // Frames presented around the panel's opaque rectangle (the last frame's, window pixels, rows
+          // top-down, [x0, x1) x [y0, y1)): the frame under it is not drawn.
+          {"present", {{"panel_hole_frames", panel_hole_frames_},
+                       {"panel_rect", {panel_rect_.x0, panel_rect_.y0, panel_rect_.x1, panel_rect_.y1}}}},
+          // The panel drawn from its picture (app/view/panel_cache.h): pictures made, frames copied from one.
+          {"panel", {{"pictures", window_.panelCache().pictures()}, {"copies", window_.panelCache().copies()}}},
           {"size", {design_.width, design_.height}},
           {"reference", referenceStats()},
           {"lens_probe", probeStats()},

@@ -159,6 +159,13 @@ class Viewer {
   gl::FrameCache cache_;
 
   bool quit_ = false, show_panel_ = true;
+  // The panel as this frame drew it (panel()): its opaque rectangle, and its draw list (null when collapsed);
+  // the present pass leaves that rectangle out when the list is in the frame's draw data (panelHole).
+  PixelRect panel_rect_, panel_outer_;  // less a pixel all round; and all its pixels
+  const ImDrawList* panel_list_ = nullptr;
+  int panel_hole_frames_ = 0;  // frames presented around the panel
+  bool panelDrawn() const;     // the panel is in this frame's draw data
+  std::optional<PixelRect> panelHole() const;
   std::vector<std::string> pending_screenshots_, panel_screenshots_;
   int frames_ = 0, saved_ = 0;
   std::vector<double> frame_ms_;  // every frame, for --stats

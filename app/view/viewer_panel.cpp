@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <tuple>
 
@@ -173,8 +174,20 @@ void Viewer::referencePanel() {
 void Viewer::panel(const gl::RasterFrame& f, double frame_ms) {
   ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(460, 0), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowBgAlpha(0.85f);
+  ImGui::SetNextWindowBgAlpha(1.0f);  // opaque: the frame under it is not presented (panelHole)
   ImGui::Begin("pvrr view");
+  {
+    // Its rectangle less a pixel all round (the border's half pixels), while the window is drawn whole: not
+    // collapsed (a collapsed title bar is translucent). In framebuffer pixels (ImGui's are the screen's).
+    const ImVec2 scale = ImGui::GetIO().DisplayFramebufferScale, at = ImGui::GetWindowPos(),
+                 extent = ImGui::GetWindowSize();
+    const ImVec2 pos(at.x * scale.x, at.y * scale.y), size(extent.x * scale.x, extent.y * scale.y);
+    panel_list_ = ImGui::IsWindowCollapsed() ? nullptr : ImGui::GetWindowDrawList();
+    panel_rect_ = {int(std::ceil(pos.x)) + 1, int(std::ceil(pos.y)) + 1, int(std::floor(pos.x + size.x)) - 1,
+                   int(std::floor(pos.y + size.y)) - 1};
+    panel_outer_ = {int(std::floor(pos.x)), int(std::floor(pos.y)), int(std::ceil(pos.x + size.x)),
+                    int(std::ceil(pos.y + size.y))};
+  }
   const double med = median(std::vector<double>(recent_ms_.begin(), recent_ms_.end()));
   ImGui::Text("frame %.2f ms, %.1f fps (median of the last %zu: %.2f ms)", frame_ms, med > 0 ? 1000.0 / med : 0.0,
               recent_ms_.size(), med);

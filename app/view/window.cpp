@@ -20,23 +20,6 @@ namespace {
 std::string g_glfw_error;  // the last GLFW error, for the messages
 void onGlfwError(int code, const char* text) { g_glfw_error = std::string(text) + " (GLFW error " + std::to_string(code) + ")"; }
 
-// A full-screen triangle; each fragment copies its texel, encoded to sRGB through a table of linearToSrgb8
-// (pvrr/base/image.h) over the 65536 values of the renderer's 16-bit target (a float target is rounded to them
-// first: at most 1/131070 off, under 0.03 of a code). The table is exact where pow() in the shader was not, and
-// cheaper on llvmpipe (docs/method.md "Measurements behind the design").
-constexpr const char* kPresentFs = R"(#version 330 core
-uniform sampler2D u_frame;
-uniform sampler2D u_srgb;  // 256 x 256 R8: texel (k & 255, k >> 8) holds the code of k / 65535
-out vec4 out_color;
-float encode(float c) {
-  int k = int(clamp(c, 0.0, 1.0) * 65535.0 + 0.5);
-  return texelFetch(u_srgb, ivec2(k & 255, k >> 8), 0).r;
-}
-void main() {
-  vec3 c = texelFetch(u_frame, ivec2(gl_FragCoord.xy), 0).rgb;
-  out_color = vec4(encode(c.r), encode(c.g), encode(c.b), 1.0);
-})";
-
 GLuint compile(GLenum kind, const char* source, const std::string& what) {
   const GLuint s = glCreateShader(kind);
   glShaderSource(s, 1, &source, nullptr);
@@ -137,23 +120,15 @@ Window::Window(int width, int height, WindowGl api, bool vsync, const std::strin
   fc.get_proc_address = glfwGetProcAddress;
   context_ = gl::GlContext::adopt(std::move(fc));
 
-  program_ = buildProgram(kFullScreenVs, kPresentFs, "present");
   glGenVertexArrays(1, &vao_);
-  std::vector<std::uint8_t> table(65536);
-  for (size_t k = 0; k < table.size(); ++k) table[k] = linearToSrgb8(double(float(k) / 65535.0f));
-  glGenTextures(1, &srgb_table_);
-  glBindTexture(GL_TEXTURE_2D, srgb_table_);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_R8, 256, 256, 0, GL_RED, GL_UNSIGNED_BYTE, table.data());
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-  glBindTexture(GL_TEXTURE_2D, 0);
-  gl::checkGlError("creating the present program");
+  present_ = std::make_unique<PresentPass>(vao_);
+  panel_cache_ = std::make_unique<PanelCache>();
 
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
   ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini: a run writes only the files it is asked for
   ImGui::StyleColorsDark();
+  ImGui::GetStyle().WindowRounding = 0;  // the panel's rectangle is all opaque (the present pass skips it)
   ImGui_ImplGlfw_InitForOpenGL(window_, true);  // chains the callbacks installed before it
   ImGui_ImplOpenGL3_Init("#version 330 core");
   imgui_ = true;
@@ -167,9 +142,9 @@ Window::~Window() {
   }
   if (context_) {
     context_->makeCurrent();
-    if (program_) glDeleteProgram(program_);
+    present_.reset();
+    panel_cache_.reset();
     if (vao_) glDeleteVertexArrays(1, &vao_);
-    if (srgb_table_) glDeleteTextures(1, &srgb_table_);
     context_.reset();
   }
   if (window_) glfwDestroyWindow(window_);
@@ -210,20 +185,8 @@ void beginPresentPass(int width, int height) {
   glDisable(GL_FRAMEBUFFER_SRGB);
 }
 
-void Window::present(unsigned texture, int width, int height) {
-  beginPresentPass(width, height);
-  glUseProgram(program_);
-  glActiveTexture(GL_TEXTURE0);
-  glBindTexture(GL_TEXTURE_2D, texture);
-  glUniform1i(glGetUniformLocation(program_, "u_frame"), 0);
-  glActiveTexture(GL_TEXTURE1);
-  glBindTexture(GL_TEXTURE_2D, srgb_table_);
-  glUniform1i(glGetUniformLocation(program_, "u_srgb"), 1);
-  glActiveTexture(GL_TEXTURE0);
-  glBindVertexArray(vao_);
-  glDrawArrays(GL_TRIANGLES, 0, 3);
-  glBindVertexArray(0);
-  gl::checkGlError("presenting the frame");
+void Window::present(unsigned texture, int width, int height, const std::optional<PixelRect>& hole) {
+  present_->present(texture, width, height, hole);
 }
 
 void Window::beginPanel() {
@@ -232,9 +195,17 @@ void Window::beginPanel() {
   ImGui::NewFrame();
 }
 
-void Window::endPanel() {
-  ImGui::Render();
-  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+void Window::endPanel() { ImGui::Render(); }
+
+void Window::drawPanel(const ImDrawList* panel, const PixelRect& rect) {
+  if (!panel) {
+    panel_cache_->invalidate();  // the panel may have changed since its picture
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    return;
+  }
+  int width = 0, height = 0;
+  framebufferSize(&width, &height);
+  panel_cache_->draw(*ImGui::GetDrawData(), panel, rect, width, height);
 }
 
 ImageRGB8 Window::readBackBuffer(int width, int height) const {

@@ -6,6 +6,10 @@
 #include <memory>
 #include <string>
 
+#include <optional>
+
+#include "app/view/panel_cache.h"
+#include "app/view/present_pass.h"
 #include "pvrr/base/image.h"
 #include "pvrr/gl/context.h"
 
@@ -27,7 +31,7 @@ unsigned buildProgram(const char* vertex_source, const char* fragment_source, co
 extern const char* const kFullScreenVs;
 
 // The GL state of a present pass: the window's framebuffer, the full viewport, no depth test, blending,
-// culling, scissor or sRGB conversion (the present shaders encode sRGB themselves). Used by Window::present
+// culling, scissor or sRGB conversion (the present shaders encode sRGB themselves). Used by PresentPass::present
 // and Wipe::present.
 void beginPresentPass(int width, int height);
 
@@ -64,17 +68,23 @@ class Window {
   bool closeRequested() const;
   void framebufferSize(int* width, int* height) const;
   // Draws `texture` (a linear colour texture of the framebuffer's size, Renderer::colorTexture) into the default
-  // framebuffer, encoded to sRGB as pvrr::srgbPicture encodes a picture.
-  void present(unsigned texture, int width, int height);
-  // ImGui frame: begin before building the panel, end to draw it over the presented frame.
+  // framebuffer, encoded to sRGB as pvrr::srgbPicture encodes a picture, but for the pixels of `hole` (where an
+  // opaque panel will be drawn over it).
+  void present(unsigned texture, int width, int height, const std::optional<PixelRect>& hole = std::nullopt);
+  // ImGui frame: begin before building the panel, end after it (ImGui::Render: the draw lists made, nothing
+  // drawn), then draw it over the presented frame.
   void beginPanel();
   void endPanel();
+  // Draws ImGui's frame over the presented one: all of it anew (`panel` null), or with the panel's draw list
+  // `panel` (its pixels in `rect`) copied from its picture (panel_cache.h).
+  void drawPanel(const ImDrawList* panel = nullptr, const PixelRect& rect = {});
+  const PanelCache& panelCache() const { return *panel_cache_; }
   // The back buffer's pixels (after present and before swap), rows top-down.
   ImageRGB8 readBackBuffer(int width, int height) const;
   void swapAndPoll();
-  // The present pass's sRGB table (256 x 256 R8: texel (k & 255, k >> 8) holds linearToSrgb8(k / 65535)), for
-  // passes that present the frame as present() does.
-  unsigned srgbTable() const { return srgb_table_; }
+  // The present pass, whose sRGB table passes that present the frame as present() does bind
+  // (shaders/srgb_encode.glsl).
+  const PresentPass& presentPass() const { return *present_; }
   // An empty vertex array object of this context, for full-screen passes.
   unsigned emptyVertexArray() const { return vao_; }
 
@@ -83,7 +93,9 @@ class Window {
   GLFWwindow* window_ = nullptr;
   int api_hint_ = 0;  // the GLFW context creation API that opened it
   std::unique_ptr<gl::GlContext> context_;
-  unsigned program_ = 0, vao_ = 0, srgb_table_ = 0;
+  unsigned vao_ = 0;
+  std::unique_ptr<PresentPass> present_;
+  std::unique_ptr<PanelCache> panel_cache_;
   bool imgui_ = false;
 };
 

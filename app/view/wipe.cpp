@@ -2,16 +2,17 @@
 
 #include "pvrr/gl/gl.h"  // glad first
 
+#include "app/view/present_pass.h"
 #include "app/view/window.h"
 
 namespace pvrr::app::view {
 namespace {
 
-// The mode's frame encoded as Window::present encodes it (its sRGB table); the reference and heat map are
-// 8-bit codes already, stored top-down (flipped here: GL's rows are bottom-up).
+// The mode's frame encoded as the present pass encodes it (shaders/srgb_encode.glsl); the reference and heat map
+// are 8-bit codes already, stored top-down (flipped here: GL's rows are bottom-up).
 constexpr const char* kWipeFs = R"(#version 330 core
+#include "srgb_encode.glsl"
 uniform sampler2D u_frame;
-uniform sampler2D u_srgb;
 uniform sampler2D u_reference;
 uniform sampler2D u_heat;
 uniform int u_split;
@@ -19,15 +20,11 @@ uniform int u_overlay;
 uniform int u_height;
 out vec4 out_color;
 const float kOverlayDim = 0.4;  // the frame under the overlay where there is no error to show
-float encode(float c) {
-  int k = int(clamp(c, 0.0, 1.0) * 65535.0 + 0.5);
-  return texelFetch(u_srgb, ivec2(k & 255, k >> 8), 0).r;
-}
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
   ivec2 q = ivec2(p.x, u_height - 1 - p.y);
   vec3 c = texelFetch(u_frame, p, 0).rgb;
-  vec3 mode = vec3(encode(c.r), encode(c.g), encode(c.b));
+  vec3 mode = srgbEncode(c);
   vec3 outc;
   if (p.x >= u_split) {
     vec4 r = texelFetch(u_reference, q, 0);
@@ -65,13 +62,23 @@ void clearTexture(unsigned framebuffer, unsigned texture) {
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
+// The wipe's program: its fragment shader here, the encode it includes from the embedded shaders.
+gl::Program wipeProgram() {
+  const gl::ShaderFileLookup lookup = [](const std::string& name) {
+    return name == "wipe.frag" ? std::string(kWipeFs) : gl::shaderSource(name);
+  };
+  gl::Program p = gl::Program::fromSources({"full-screen triangle (app/view/window.cpp)", kFullScreenVs},
+                                           gl::shaderWithIncludes("wipe.frag", lookup));
+  PresentPass::bindBlockOf(p.id());
+  return p;
+}
+
 }  // namespace
 
-Wipe::Wipe(Window& window) : window_(window) { program_ = buildProgram(kFullScreenVs, kWipeFs, "wipe"); }
+Wipe::Wipe(Window& window) : window_(window), program_(wipeProgram()) {}
 
 Wipe::~Wipe() {
   window_.context().makeCurrent();
-  glDeleteProgram(program_);
   if (reference_) glDeleteTextures(1, &reference_);
   if (heat_) glDeleteTextures(1, &heat_);
   if (framebuffer_) glDeleteFramebuffers(1, &framebuffer_);
@@ -119,18 +126,19 @@ void Wipe::uploadHeat(const std::vector<std::uint8_t>& rgba) {
 
 void Wipe::present(unsigned frame, int width, int height, double split_px, bool overlay) {
   beginPresentPass(width, height);
-  glUseProgram(program_);
-  const unsigned textures[4] = {frame, window_.srgbTable(), reference_, heat_};
-  const char* names[4] = {"u_frame", "u_srgb", "u_reference", "u_heat"};
-  for (int k = 0; k < 4; ++k) {
+  program_.use();
+  const unsigned textures[3] = {frame, reference_, heat_};
+  const char* names[3] = {"u_frame", "u_reference", "u_heat"};
+  for (int k = 0; k < 3; ++k) {
     glActiveTexture(GLenum(GL_TEXTURE0 + k));
     glBindTexture(GL_TEXTURE_2D, textures[k]);
-    glUniform1i(glGetUniformLocation(program_, names[k]), k);
+    program_.set(names[k], k);
   }
   glActiveTexture(GL_TEXTURE0);
-  glUniform1i(glGetUniformLocation(program_, "u_split"), int(split_px + 0.5));
-  glUniform1i(glGetUniformLocation(program_, "u_overlay"), overlay ? 1 : 0);
-  glUniform1i(glGetUniformLocation(program_, "u_height"), height);
+  window_.presentPass().bindTable();
+  program_.set("u_split", int(split_px + 0.5));
+  program_.set("u_overlay", overlay ? 1 : 0);
+  program_.set("u_height", height);
   glBindVertexArray(window_.emptyVertexArray());
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glBindVertexArray(0);

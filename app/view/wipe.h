@@ -3,7 +3,7 @@
 // heat map. Used only while a reference exists; the window's plain present (window.h) draws every other frame.
 //
 // The reference and the heat map are uploaded as 8-bit sRGB codes (computed on the CPU as pvrr compare writes
-// its pictures) and shown unchanged; the mode's frame is encoded as Window::present encodes it. Reference
+// its pictures) and shown unchanged; the mode's frame is encoded as the present pass encodes it. Reference
 // pixels not traced yet show the mode's frame at half brightness; with the overlay, pixels without an error
 // (no element, or a non-finite one) show it at kOverlayDim.
 #pragma once
@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "app/view/reference_tiles.h"
+#include "pvrr/gl/program.h"
 
 namespace pvrr::app::view {
 
@@ -37,7 +38,8 @@ class Wipe {
 
  private:
   Window& window_;
-  unsigned program_ = 0, reference_ = 0, heat_ = 0, framebuffer_ = 0;  // framebuffer_: for clearing them
+  gl::Program program_;
+  unsigned reference_ = 0, heat_ = 0, framebuffer_ = 0;  // framebuffer_: for clearing them
   int width_ = 0, height_ = 0;
 };
 
