@@ -111,6 +111,26 @@ TEST_P(AmbientOcclusionTest, TheFieldMovesWithTheCar) {
   EXPECT_LT(d.mad, kGroundMad);
 }
 
+// A car lifted off the ground (a jump): its ground maps no longer lie on the road's plane, so the road reads the
+// occlusion volumes instead (pvrr/gl/ao_fields.h), and agrees all the same.
+TEST_P(AmbientOcclusionTest, ALiftedCarsGroundReadsTheVolumes) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  const SceneDesc desc = carDesc(R"({"keys": [{"time_s": 0}, {"time_s": 1, "offset": [0.5, 0.4, 0], "rotation_deg": [0, 20, 0]}]})",
+                                 "", "true");
+  Scene s = buildScene(desc);
+  applyAnimation(s, desc, 1.0);
+  RayScene rays(s);
+  const Frame ref = Tracer(rays, TraceOptions{}).render();
+  gl::Renderer renderer(s, rays, gl::RendererOptions{});
+  const Difference d = groundDifference(ref, renderer.render(RenderMode::Raster), 0, 1.0, Vec3(0.5, 0, 0));
+  std::printf("[ ambient occlusion ] lifted car: %d pixels, mean |A_raster - A_ref| %.4f, darkest %.3f\n", d.pixels,
+              d.mad, d.darkest);
+  EXPECT_GT(d.pixels, 5000);
+  EXPECT_LT(d.darkest, 0.6);
+  EXPECT_LT(d.mad, kGroundMad);
+}
+
 TEST_P(AmbientOcclusionTest, TheGroundInAMirrorAgreesInPvrrMode) {
   const auto ctx = test::glContextOrFail(GetParam());
   if (!ctx) return;
