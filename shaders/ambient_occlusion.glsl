@@ -10,6 +10,15 @@
 uniform vec3 u_ao_centre[AO_FIELDS];    // the bounding sphere's centre, relative to the camera origin
 uniform mat3 u_ao_rotation[AO_FIELDS];  // the field's frame to the world (its object's motion)
 uniform float u_ao_radius[AO_FIELDS];
+#if defined(AO_VERTEX)
+// The vertex shader (env.vert): each field's offset from its centre in its own frame, affine in the position,
+// so interpolated exactly; the fragments do not transform it.
+out vec3 v_ao_p[AO_FIELDS];
+void aoVertex(vec3 x) {
+  for (int f = 0; f < AO_FIELDS; ++f) v_ao_p[f] = transpose(u_ao_rotation[f]) * (x - u_ao_centre[f]);
+}
+#else
+in vec3 v_ao_p[AO_FIELDS];
 uniform float u_ao_reaches[AO_FIELDS];  // 1: field f reaches this draw (AoField::reach; not its own), else 0
 #if defined(AO_GROUND)
 // Per field AO_HEIGHTS layers of kAoGroundSize^2: O(+y) at warped (x, z), the fade included. It shares the
@@ -21,7 +30,7 @@ uniform int u_ao_height;                // the layer of this draw's plane within
 float ambientOcclusion(vec3 x, vec3 n) {
   float o = 0.0;
   for (int f = 0; f < AO_FIELDS; ++f) {
-    vec2 p = (transpose(u_ao_rotation[f]) * (x - u_ao_centre[f])).xz;
+    vec2 p = v_ao_p[f].xz;
     vec2 uv = p / (abs(p) + u_ao_radius[f]) * 0.5 + 0.5;
     o += u_ao_reaches[f] * texture(u_ao_ground, vec3(uv, float(f * AO_HEIGHTS + u_ao_height))).r;
   }
@@ -38,9 +47,8 @@ const float AO_MIN_CONE = 0.01;
 // The occlusion field f casts at x with unit normal n: its volume read trilinearly at the warped coordinates
 // x / (|x| + r), an ambient cube of the six axis normals (sum n_i^2 O(sign(n_i) axis_i)).
 float aoFieldOcclusion(int f, vec3 x, vec3 n_world) {
-  mat3 to_field = transpose(u_ao_rotation[f]);
-  vec3 p = to_field * (x - u_ao_centre[f]);
-  vec3 n = to_field * n_world;
+  vec3 p = v_ao_p[f];
+  vec3 n = transpose(u_ao_rotation[f]) * n_world;
   float radius = u_ao_radius[f];
   float fade = clamp(radius * radius / (AO_MIN_CONE * dot(p, p)) - 1.0, 0.0, 1.0);
   const float size = float(AO_VOLUME);
@@ -59,4 +67,5 @@ float ambientOcclusion(vec3 x, vec3 n) {
   return min(o, 1.0);
 }
 #endif
+#endif  // AO_VERTEX
 #endif
