@@ -17,8 +17,18 @@ out vec3 v_ao_p[AO_FIELDS];
 void aoVertex(vec3 x) {
   for (int f = 0; f < AO_FIELDS; ++f) v_ao_p[f] = transpose(u_ao_rotation[f]) * (x - u_ao_centre[f]);
 }
+#if defined(FACETED) && !defined(AO_GROUND)
+// A faceted mesh's face normal (facing the viewer) in each field's frame, once per vertex.
+flat out vec3 v_ao_n[AO_FIELDS];
+void aoVertexNormal(vec3 n) {
+  for (int f = 0; f < AO_FIELDS; ++f) v_ao_n[f] = transpose(u_ao_rotation[f]) * n;
+}
+#endif
 #else
 in vec3 v_ao_p[AO_FIELDS];
+#if defined(FACETED) && !defined(AO_GROUND)
+flat in vec3 v_ao_n[AO_FIELDS];
+#endif
 uniform float u_ao_reaches[AO_FIELDS];  // 1: field f reaches this draw (AoField::reach; not its own), else 0
 #if defined(AO_GROUND)
 // Per field AO_HEIGHTS layers of kAoGroundSize^2: O(+y) at warped (x, z), the fade included. It shares the
@@ -48,7 +58,11 @@ const float AO_MIN_CONE = 0.01;
 // x / (|x| + r), an ambient cube of the six axis normals (sum n_i^2 O(sign(n_i) axis_i)).
 float aoFieldOcclusion(int f, vec3 x, vec3 n_world) {
   vec3 p = v_ao_p[f];
+#if defined(FACETED)
+  vec3 n = v_ao_n[f];  // n_world is the face normal it was computed from
+#else
   vec3 n = transpose(u_ao_rotation[f]) * n_world;
+#endif
   float radius = u_ao_radius[f];
   float fade = clamp(radius * radius / (AO_MIN_CONE * dot(p, p)) - 1.0, 0.0, 1.0);
   const float size = float(AO_VOLUME);

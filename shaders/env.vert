@@ -30,6 +30,9 @@ void main() {
   if (dot(n, v_pos - u_view_origin) > 0.0) n = -n;  // two-sided, as env.frag
   v_face_normal = n;
   v_face_light = ambientAndDirectional(n);
+#if defined(AMBIENT_OCCLUSION) && !defined(AO_GROUND)
+  aoVertexNormal(n);
+#endif
 #endif
 #if defined(AMBIENT_OCCLUSION)
   aoVertex(v_pos);
