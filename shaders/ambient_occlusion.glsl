@@ -1,16 +1,17 @@
 // Ambient occlusion from displacement fields: pvrr/method/ao_field.cpp's volumeOcclusion and
 // groundMapOcclusion in GLSL (keep them in step; the definition is pvrr/trace/ambient_occlusion.h's). Defines
 // from pvrr/gl/ao_fields.cpp: AO_FIELDS (occluders), AO_VOLUME (each occlusion volume's grid points per axis,
-// kAoVolumeSize); the ground variant (a horizontal plane facing up, every occluder turning about the vertical:
-// AoReceiver::Ground) also AO_GROUND and AO_HEIGHTS (the ground maps' heights per field), and reads only the
-// ground maps. A mesh no field reaches is drawn without AMBIENT_OCCLUSION at all. llvmpipe shades both sides
-// of a per-fragment branch, so nothing here branches per fragment; the loop runs over the fields that reach
-// the draw (a uniform count: the same for every fragment).
+// kAoVolumeSize), AO_PER_VERTEX (few enough occluders for their varyings: the transforms per vertex); the
+// ground variant (a horizontal plane facing up, every occluder turning about the vertical: AoReceiver::Ground)
+// also AO_GROUND and AO_HEIGHTS (the ground maps' heights per field), and reads only the ground maps. A mesh no
+// field reaches is drawn without AMBIENT_OCCLUSION at all. llvmpipe shades both sides of a per-fragment branch,
+// so nothing here branches per fragment; a field that does not reach the draw is weighted by 0 (a loop over
+// a uniform list of them, dynamically indexed, measured slower).
 #if defined(AMBIENT_OCCLUSION)
 uniform vec3 u_ao_centre[AO_FIELDS];    // the bounding sphere's centre, relative to the camera origin
 uniform mat3 u_ao_rotation[AO_FIELDS];  // the field's frame to the world (its object's motion)
 uniform float u_ao_radius[AO_FIELDS];
-#if defined(AO_VERTEX)
+#if defined(AO_VERTEX) && defined(AO_PER_VERTEX)
 // The vertex shader (env.vert): each field's offset from its centre in its own frame, affine in the position,
 // so interpolated exactly; the fragments do not transform it.
 out vec3 v_ao_p[AO_FIELDS];
@@ -24,10 +25,19 @@ void aoVertexNormal(vec3 n) {
   for (int f = 0; f < AO_FIELDS; ++f) v_ao_n[f] = transpose(u_ao_rotation[f]) * n;
 }
 #endif
-#else
+#elif !defined(AO_VERTEX)
+// The offset of x (relative to the camera origin) from field f's centre in its frame, and normal n there.
+#if defined(AO_PER_VERTEX)
 in vec3 v_ao_p[AO_FIELDS];
-#if defined(FACETED) && !defined(AO_GROUND)
+#define AO_OFFSET(f, x) v_ao_p[f]
+#else
+#define AO_OFFSET(f, x) (transpose(u_ao_rotation[f]) * ((x) - u_ao_centre[f]))
+#endif
+#if defined(AO_PER_VERTEX) && defined(FACETED) && !defined(AO_GROUND)
 flat in vec3 v_ao_n[AO_FIELDS];
+#define AO_NORMAL(f, n) v_ao_n[f]  // the face normal it was computed from
+#else
+#define AO_NORMAL(f, n) (transpose(u_ao_rotation[f]) * (n))
 #endif
 uniform float u_ao_reaches[AO_FIELDS];  // 1: field f reaches this draw (AoField::reach; not its own), else 0
 #if defined(AO_GROUND)
@@ -40,7 +50,7 @@ uniform int u_ao_height;                // the layer of this draw's plane within
 float ambientOcclusion(vec3 x, vec3 n) {
   float o = 0.0;
   for (int f = 0; f < AO_FIELDS; ++f) {
-    vec2 p = v_ao_p[f].xz;
+    vec2 p = AO_OFFSET(f, x).xz;
     vec2 uv = p / (abs(p) + u_ao_radius[f]) * 0.5 + 0.5;
     o += u_ao_reaches[f] * texture(u_ao_ground, vec3(uv, float(f * AO_HEIGHTS + u_ao_height))).r;
   }
@@ -57,12 +67,8 @@ const float AO_MIN_CONE = 0.01;
 // The occlusion field f casts at x with unit normal n: its volume read trilinearly at the warped coordinates
 // x / (|x| + r), an ambient cube of the six axis normals (sum n_i^2 O(sign(n_i) axis_i)).
 float aoFieldOcclusion(int f, vec3 x, vec3 n_world) {
-  vec3 p = v_ao_p[f];
-#if defined(FACETED)
-  vec3 n = v_ao_n[f];  // n_world is the face normal it was computed from
-#else
-  vec3 n = transpose(u_ao_rotation[f]) * n_world;
-#endif
+  vec3 p = AO_OFFSET(f, x);
+  vec3 n = AO_NORMAL(f, n_world);
   float radius = u_ao_radius[f];
   float fade = clamp(radius * radius / (AO_MIN_CONE * dot(p, p)) - 1.0, 0.0, 1.0);
   const float size = float(AO_VOLUME);

@@ -30,11 +30,11 @@ void main() {
   if (dot(n, v_pos - u_view_origin) > 0.0) n = -n;  // two-sided, as env.frag
   v_face_normal = n;
   v_face_light = ambientAndDirectional(n);
-#if defined(AMBIENT_OCCLUSION) && !defined(AO_GROUND)
+#if defined(AO_PER_VERTEX) && !defined(AO_GROUND)
   aoVertexNormal(n);
 #endif
 #endif
-#if defined(AMBIENT_OCCLUSION)
+#if defined(AO_PER_VERTEX)
   aoVertex(v_pos);
 #endif
   gl_Position = u_view_proj * vec4(v_pos, 1.0);

@@ -19,6 +19,8 @@ bool anyAmbientLight(const Scene& scene) {
   return false;
 }
 
+// At most this many occluders are transformed per vertex (AO_PER_VERTEX, shaders/ambient_occlusion.glsl).
+constexpr int kAoPerVertexFields = 7;
 // At most this many heights of horizontal planes get ground maps (the others read the volumes).
 constexpr size_t kMaxGroundHeights = 8;
 // Two heights closer than this (m) are one; a plane's vertices and normals are this level and vertical.
@@ -67,6 +69,9 @@ std::vector<std::string> aoDefines(const Scene& scene, AoReceiver receiver) {
   if (receiver == AoReceiver::None || !ambientOcclusionSkipReason(scene).empty()) return {};
   std::vector<std::string> d = {"#define AMBIENT_OCCLUSION", "#define AO_FIELDS " + std::to_string(occluderCount(scene)),
                                 "#define AO_VOLUME " + std::to_string(kAoVolumeSize)};
+  // 6 varying components per occluder (offset and face normal): with the environment's own 14, within the 64
+  // vertex outputs GL 4.x guarantees up to kAoPerVertexFields occluders; more are transformed per fragment.
+  if (occluderCount(scene) <= kAoPerVertexFields) d.push_back("#define AO_PER_VERTEX");
   if (receiver == AoReceiver::Ground) {
     d.push_back("#define AO_GROUND");
     d.push_back("#define AO_HEIGHTS " + std::to_string(std::max<size_t>(1, horizontalPlanes(scene).heights.size())));

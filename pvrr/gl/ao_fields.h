@@ -29,8 +29,8 @@ inline constexpr const char* kAmbientOcclusionStage = "ambient-occlusion";
 // Why the scene's shading has no ambient occlusion, or empty when it has: off, no occluding object, or no
 // ambient light to occlude.
 std::string ambientOcclusionSkipReason(const Scene& scene);
-// The defines of an environment program that reads the fields (AMBIENT_OCCLUSION, AO_FIELDS, AO_VOLUME;
-// Ground: AO_GROUND, AO_HEIGHTS); none when the scene has no ambient occlusion or for AoReceiver::None.
+// The defines of an environment program that reads the fields (AMBIENT_OCCLUSION, AO_FIELDS, AO_VOLUME,
+// AO_PER_VERTEX; Ground: AO_GROUND, AO_HEIGHTS); none when the scene has no ambient occlusion or for AoReceiver::None.
 std::vector<std::string> aoDefines(const Scene& scene, AoReceiver receiver = AoReceiver::Volume);
 
 class AoFields {
