@@ -27,7 +27,8 @@
 // t = x / (|x| + r) per axis (x from the sphere's centre: fine near the object, the whole space within
 // (-1, 1)), each holding the occlusion for the six axis normals +-x, +-y, +-z (an "ambient cube": a normal n
 // reads sum n_i^2 O(sign(n_i) axis_i), exact for axis normals, such as a ground under a car that turns about
-// the vertical). A fragment reads it trilinearly: two texture lookups per occluder.
+// the vertical). A fragment reads it trilinearly: one texture lookup per occluder (the GPU copy holds, per
+// octant of normals, the three axis occlusions of its signs: pvrr/gl/ao_fields.cpp).
 //
 // The ground maps (what most fragments read): on a horizontal plane y = h (a ground, a pavement) facing up,
 // with the occluder turning about the vertical only, the occlusion depends on the two horizontal offsets from
