@@ -1,46 +1,91 @@
-// Ambient occlusion from displacement fields: pvrr/method/ao_field.cpp's volumeVisibility in GLSL (keep them
-// in step; the definition is pvrr/trace/ambient_occlusion.h's). Defines from pvrr/gl/ao_fields.cpp:
-// AO_FIELDS (occluders), AO_VOLUME (each occlusion volume's grid points per axis, kAoVolumeSize).
+// Ambient occlusion from displacement fields: pvrr/method/ao_field.cpp's volumeOcclusion and
+// groundMapOcclusion in GLSL (keep them in step; the definition is pvrr/trace/ambient_occlusion.h's). Defines
+// from pvrr/gl/ao_fields.cpp: AO_FIELDS (occluders), AO_VOLUME (each occlusion volume's grid points per axis,
+// kAoVolumeSize), AO_PER_VERTEX (few enough occluders for their varyings: the transforms per vertex); the
+// ground variant (a horizontal plane facing up, every occluder turning about the vertical: AoReceiver::Ground)
+// also AO_GROUND and AO_HEIGHTS (the ground maps' heights per field), and reads only the ground maps. A mesh no
+// field reaches is drawn without AMBIENT_OCCLUSION at all. llvmpipe shades both sides of a per-fragment branch,
+// so nothing here branches per fragment; a field that does not reach the draw is weighted by 0 (a loop over
+// a uniform list of them, dynamically indexed, measured slower).
 #if defined(AMBIENT_OCCLUSION)
-uniform sampler3D u_ao_volume;          // per field two blocks of AO_VOLUME slices: O(+x, -x, +y, -y), O(+z, -z)
 uniform vec3 u_ao_centre[AO_FIELDS];    // the bounding sphere's centre, relative to the camera origin
 uniform mat3 u_ao_rotation[AO_FIELDS];  // the field's frame to the world (its object's motion)
 uniform float u_ao_radius[AO_FIELDS];
-uniform int u_ao_self;                  // the field of the object being drawn (it does not occlude itself)
+#if defined(AO_VERTEX) && defined(AO_PER_VERTEX)
+// The vertex shader (env.vert): each field's offset from its centre in its own frame, affine in the position,
+// so interpolated exactly; the fragments do not transform it.
+out vec3 v_ao_p[AO_FIELDS];
+void aoVertex(vec3 x) {
+  for (int f = 0; f < AO_FIELDS; ++f) v_ao_p[f] = transpose(u_ao_rotation[f]) * (x - u_ao_centre[f]);
+}
+#if defined(FACETED) && !defined(AO_GROUND)
+// A faceted mesh's face normal (facing the viewer) in each field's frame, once per vertex.
+flat out vec3 v_ao_n[AO_FIELDS];
+void aoVertexNormal(vec3 n) {
+  for (int f = 0; f < AO_FIELDS; ++f) v_ao_n[f] = transpose(u_ao_rotation[f]) * n;
+}
+#endif
+#elif !defined(AO_VERTEX)
+// The offset of x (relative to the camera origin) from field f's centre in its frame, and normal n there.
+#if defined(AO_PER_VERTEX)
+in vec3 v_ao_p[AO_FIELDS];
+#define AO_OFFSET(f, x) v_ao_p[f]
+#else
+#define AO_OFFSET(f, x) (transpose(u_ao_rotation[f]) * ((x) - u_ao_centre[f]))
+#endif
+#if defined(AO_PER_VERTEX) && defined(FACETED) && !defined(AO_GROUND)
+flat in vec3 v_ao_n[AO_FIELDS];
+#define AO_NORMAL(f, n) v_ao_n[f]  // the face normal it was computed from
+#else
+#define AO_NORMAL(f, n) (transpose(u_ao_rotation[f]) * (n))
+#endif
+uniform float u_ao_reaches[AO_FIELDS];  // 1: field f reaches this draw (AoField::reach; not its own), else 0
+#if defined(AO_GROUND)
+// Per field AO_HEIGHTS layers of kAoGroundSize^2: O(+y) at warped (x, z), the fade included. It shares the
+// volume's texture unit (another target; no program reads both).
+uniform sampler2DArray u_ao_ground;
+uniform int u_ao_height;                // the layer of this draw's plane within each field's
+
+// The occluded fraction (0..1) of the ambient light at x (relative to the camera origin) with normal n.
+float ambientOcclusion(vec3 x, vec3 n) {
+  float o = 0.0;
+  for (int f = 0; f < AO_FIELDS; ++f) {
+    vec2 p = AO_OFFSET(f, x).xz;
+    vec2 uv = p / (abs(p) + u_ao_radius[f]) * 0.5 + 0.5;
+    o += u_ao_reaches[f] * texture(u_ao_ground, vec3(uv, float(f * AO_HEIGHTS + u_ao_height))).r;
+  }
+  return n.y > 0.0 ? min(o, 1.0) : 0.0;  // facing down, the plane sees none of an occluder standing on it
+}
+#else
+// Per field (along z) eight blocks of AO_VOLUME^3 side by side along x, one per octant of normals: the
+// occlusion for the axis normals of its signs (pvrr/gl/ao_fields.cpp).
+uniform sampler3D u_ao_volume;
 // A sphere seen within a cone narrower than this (sin^2 of its half angle) is left out, faded out from twice
 // it (ao_field.h's kAoMinCone, aoFade).
 const float AO_MIN_CONE = 0.01;
 
-// The occlusion field f casts at x (relative to the camera origin) with unit normal n: its volume read
-// trilinearly at the warped coordinates x / (|x| + r), an ambient cube of the six axis normals.
+// The occlusion field f casts at x with unit normal n: its volume read trilinearly at the warped coordinates
+// x / (|x| + r), an ambient cube of the six axis normals (sum n_i^2 O(sign(n_i) axis_i)).
 float aoFieldOcclusion(int f, vec3 x, vec3 n_world) {
-  mat3 to_field = transpose(u_ao_rotation[f]);
-  vec3 p = to_field * (x - u_ao_centre[f]);
+  vec3 p = AO_OFFSET(f, x);
+  vec3 n = AO_NORMAL(f, n_world);
   float radius = u_ao_radius[f];
   float fade = clamp(radius * radius / (AO_MIN_CONE * dot(p, p)) - 1.0, 0.0, 1.0);
-  if (fade <= 0.0) return 0.0;
-  vec3 n = to_field * n_world;
-  vec3 uvw = p / (abs(p) + radius) * 0.5 + 0.5;
-  // Within the field's block of slices: clamped to its outermost slices' centres, then offset to the block.
   const float size = float(AO_VOLUME);
-  float z = clamp(uvw.z * size, 0.5, size - 0.5);
-  const float depth = float(2 * AO_FIELDS * AO_VOLUME);
-  vec3 n2 = n * n;
-  vec4 a = texture(u_ao_volume, vec3(uvw.xy, (z + float(2 * f) * size) / depth));
-  float o = n2.x * (n.x >= 0.0 ? a.r : a.g) + n2.y * (n.y >= 0.0 ? a.b : a.a);
-  // The +-z block only where the normal has a z part (not for a ground under a car turning about y).
-  if (n2.z > 1e-4) {
-    vec2 b = texture(u_ao_volume, vec3(uvw.xy, (z + float(2 * f + 1) * size) / depth)).rg;
-    o += n2.z * (n.z >= 0.0 ? b.r : b.g);
-  }
-  return fade * o;
+  // Grid coordinates within the block, clamped to its outermost texels' centres (GL_CLAMP_TO_EDGE of one).
+  vec3 g = clamp((p / (abs(p) + radius) * 0.5 + 0.5) * size, 0.5, size - 0.5);
+  float block = dot(vec3(lessThan(n, vec3(0.0))), vec3(1.0, 2.0, 4.0));
+  vec3 a = texture(u_ao_volume, vec3((g.x + block * size) / (8.0 * size), g.y / size,
+                                     (g.z + float(f) * size) / (size * float(AO_FIELDS)))).rgb;
+  return fade * dot(n * n, a);
 }
 
-// The occluded fraction (0..1) of the ambient light at x with normal n.
+// The occluded fraction (0..1) of the ambient light at x (relative to the camera origin) with normal n.
 float ambientOcclusion(vec3 x, vec3 n) {
   float o = 0.0;
-  for (int f = 0; f < AO_FIELDS; ++f)
-    if (f != u_ao_self) o += aoFieldOcclusion(f, x, n);
+  for (int f = 0; f < AO_FIELDS; ++f) o += u_ao_reaches[f] * aoFieldOcclusion(f, x, n);
   return min(o, 1.0);
 }
+#endif
+#endif  // AO_VERTEX
 #endif

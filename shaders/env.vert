@@ -14,6 +14,8 @@ out vec3 v_pos;            // relative to the camera origin
 out vec3 v_normal;
 out vec2 v_uv;
 #include "shading.glsl"
+#define AO_VERTEX  // the vertex half of ambient_occlusion.glsl (nothing without AMBIENT_OCCLUSION)
+#include "ambient_occlusion.glsl"
 #if defined(FACETED)
 uniform vec3 u_view_origin;
 flat out vec3 v_face_normal;  // facing the viewer
@@ -28,6 +30,12 @@ void main() {
   if (dot(n, v_pos - u_view_origin) > 0.0) n = -n;  // two-sided, as env.frag
   v_face_normal = n;
   v_face_light = ambientAndDirectional(n);
+#if defined(AO_PER_VERTEX) && !defined(AO_GROUND)
+  aoVertexNormal(n);
+#endif
+#endif
+#if defined(AO_PER_VERTEX)
+  aoVertex(v_pos);
 #endif
   gl_Position = u_view_proj * vec4(v_pos, 1.0);
 }

@@ -1,5 +1,7 @@
 #include "pvrr/gl/ao_fields.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "pvrr/gl/gl.h"
@@ -17,6 +19,43 @@ bool anyAmbientLight(const Scene& scene) {
   return false;
 }
 
+// At most this many occluders are transformed per vertex (AO_PER_VERTEX, shaders/ambient_occlusion.glsl).
+constexpr int kAoPerVertexFields = 7;
+// At most this many heights of horizontal planes get ground maps (the others read the volumes).
+constexpr size_t kMaxGroundHeights = 8;
+// Two heights closer than this (m) are one; a plane's vertices and normals are this level and vertical.
+constexpr double kLevelTolerance = 1e-6;
+
+// The heights of the static horizontal planes that are no occluder's (the ground maps'), and per mesh the
+// index of its height (-1: not such a plane).
+struct Planes {
+  std::vector<double> heights;
+  std::vector<int> mesh_height;
+};
+Planes horizontalPlanes(const Scene& scene) {
+  Planes out;
+  out.mesh_height.assign(scene.meshes.size(), -1);
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    const EnvMesh& mesh = scene.meshes[m];
+    if (mesh.occluder >= 0 || scene.meshAnimated(m) || mesh.positions.empty()) continue;
+    const double y0 = mesh.anchor.y + double(mesh.positions[0].y);
+    const bool level = std::all_of(mesh.positions.begin(), mesh.positions.end(), [&](const glm::vec3& p) {
+      return std::abs(mesh.anchor.y + double(p.y) - y0) < kLevelTolerance;
+    });
+    const bool vertical = std::all_of(mesh.normals.begin(), mesh.normals.end(),
+                                      [](const glm::vec3& n) { return std::abs(std::abs(double(n.y)) - 1) < kLevelTolerance; });
+    if (!level || !vertical || mesh.normals.empty()) continue;
+    size_t h = 0;
+    while (h < out.heights.size() && std::abs(out.heights[h] - y0) >= kLevelTolerance) ++h;
+    if (h == out.heights.size()) {
+      if (h == kMaxGroundHeights) continue;
+      out.heights.push_back(y0);
+    }
+    out.mesh_height[m] = int(h);
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string ambientOcclusionSkipReason(const Scene& scene) {
@@ -26,10 +65,18 @@ std::string ambientOcclusionSkipReason(const Scene& scene) {
   return "";
 }
 
-std::vector<std::string> aoDefines(const Scene& scene) {
-  if (!ambientOcclusionSkipReason(scene).empty()) return {};
-  return {"#define AMBIENT_OCCLUSION", "#define AO_FIELDS " + std::to_string(occluderCount(scene)),
-          "#define AO_VOLUME " + std::to_string(kAoVolumeSize)};
+std::vector<std::string> aoDefines(const Scene& scene, AoReceiver receiver) {
+  if (receiver == AoReceiver::None || !ambientOcclusionSkipReason(scene).empty()) return {};
+  std::vector<std::string> d = {"#define AMBIENT_OCCLUSION", "#define AO_FIELDS " + std::to_string(occluderCount(scene)),
+                                "#define AO_VOLUME " + std::to_string(kAoVolumeSize)};
+  // 6 varying components per occluder (offset and face normal): with the environment's own 14, within the 64
+  // vertex outputs GL 4.x guarantees up to kAoPerVertexFields occluders; more are transformed per fragment.
+  if (occluderCount(scene) <= kAoPerVertexFields) d.push_back("#define AO_PER_VERTEX");
+  if (receiver == AoReceiver::Ground) {
+    d.push_back("#define AO_GROUND");
+    d.push_back("#define AO_HEIGHTS " + std::to_string(std::max<size_t>(1, horizontalPlanes(scene).heights.size())));
+  }
+  return d;
 }
 
 AoFields::AoFields(const Scene& scene, int max_texture_units) : scene_(scene), unit_(units::aoVolume(max_texture_units)) {
@@ -38,19 +85,28 @@ AoFields::AoFields(const Scene& scene, int max_texture_units) : scene_(scene), u
   fields_ = buildAoFields(scene);
   build_ms_ = msSince(t0);
   if (fields_.empty()) return;
-  // One RGBA8 3D texture: per field two blocks of n slices (O for +x, -x, +y, -y; then +z, -z), filtered
-  // linearly, clamped at the edges (the shader keeps z inside its block).
-  const size_t n = kAoVolumeSize, slice = n * n;
-  std::vector<uint8_t> texels(slice * n * 2 * fields_.size() * 4, 0);
-  for (size_t f = 0; f < fields_.size(); ++f)
-    for (size_t point = 0; point < slice * n && !fields_[f].volume.empty(); ++point)
-      for (size_t half = 0; half < 2; ++half)
-        for (size_t c = 0; c < 4; ++c)
-          texels[(((2 * f + half) * n * slice) + point) * 4 + c] = fields_[f].volume[point * 8 + half * 4 + c];
+  // One RGBA8 3D texture: per field (along z) eight blocks of n^3 texels side by side along x, one per octant
+  // of normals (block b: x negative when b & 1, y when b & 2, z when b & 4), holding the occlusion for the
+  // three axis normals of its signs (O(+-x), O(+-y), O(+-z), 0): a normal reads the block of its signs, one
+  // trilinear lookup for the ambient cube. Filtered linearly; the shader keeps x and z inside the block.
+  const size_t n = kAoVolumeSize, row = 8 * n;
+  std::vector<uint8_t> texels(row * n * n * fields_.size() * 4, 0);
+  for (size_t f = 0; f < fields_.size(); ++f) {
+    if (fields_[f].volume.empty()) continue;
+    for (size_t k = 0; k < n; ++k)
+      for (size_t j = 0; j < n; ++j)
+        for (size_t i = 0; i < n; ++i) {
+          const uint8_t* o = &fields_[f].volume[((k * n + j) * n + i) * 8];
+          for (size_t b = 0; b < 8; ++b) {
+            uint8_t* t = &texels[(((f * n + k) * n + j) * row + b * n + i) * 4];
+            for (size_t a = 0; a < 3; ++a) t[a] = o[2 * a + ((b >> a) & 1)];
+          }
+        }
+  }
   glGenTextures(1, &texture_);
   glBindTexture(GL_TEXTURE_3D, texture_);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexImage3D(GL_TEXTURE_3D, 0, GL_RGBA8, GLsizei(n), GLsizei(n), GLsizei(2 * n * fields_.size()), 0, GL_RGBA,
+  glTexImage3D(GL_TEXTURE_3D, 0, GL_RGBA8, GLsizei(row), GLsizei(n), GLsizei(n * fields_.size()), 0, GL_RGBA,
                GL_UNSIGNED_BYTE, texels.data());
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
@@ -61,19 +117,50 @@ AoFields::AoFields(const Scene& scene, int max_texture_units) : scene_(scene), u
   glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAX_LEVEL, 0);
   glBindTexture(GL_TEXTURE_3D, 0);
   volume_bytes_ = texels.size();
+  // The ground maps: one R8 2D array, per field one layer per height.
+  const Planes planes = horizontalPlanes(scene);
+  heights_ = planes.heights;
+  mesh_height_ = planes.mesh_height;
+  if (!heights_.empty()) {
+    const auto t1 = Clock::now();
+    const size_t g = kAoGroundSize, layer = g * g;
+    std::vector<uint8_t> maps(layer * heights_.size() * fields_.size(), 0);
+    for (size_t f = 0; f < fields_.size(); ++f)
+      for (size_t h = 0; h < heights_.size(); ++h) {
+        const std::vector<uint8_t> map = groundMap(fields_[f], heights_[h]);
+        std::copy(map.begin(), map.end(), maps.begin() + std::ptrdiff_t((f * heights_.size() + h) * layer));
+      }
+    build_ms_ += msSince(t1);
+    glGenTextures(1, &ground_texture_);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, ground_texture_);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_R8, GLsizei(g), GLsizei(g), GLsizei(heights_.size() * fields_.size()), 0,
+                 GL_RED, GL_UNSIGNED_BYTE, maps.data());
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAX_LEVEL, 0);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
+    ground_bytes_ = maps.size();
+  }
   checkGlError("uploading the ambient occlusion fields");
 }
 
 AoFields::~AoFields() {
   if (texture_) glDeleteTextures(1, &texture_);
+  if (ground_texture_) glDeleteTextures(1, &ground_texture_);
 }
 
 void AoFields::bind(const Program& p, const Vec3& origin) const {
   if (!active()) return;
   glActiveTexture(GLenum(GL_TEXTURE0 + unit_));
   glBindTexture(GL_TEXTURE_3D, texture_);
+  if (ground_texture_) glBindTexture(GL_TEXTURE_2D_ARRAY, ground_texture_);  // the same unit, another target
   glActiveTexture(GL_TEXTURE0);
   p.set("u_ao_volume", unit_);
+  p.set("u_ao_ground", unit_);
   for (size_t i = 0; i < fields_.size(); ++i) {
     const AoField& f = fields_[i];
     const Mat4 motion = occluderMotion(scene_, f.occluder);
@@ -84,11 +171,39 @@ void AoFields::bind(const Program& p, const Vec3& origin) const {
     p.set("u_ao_rotation" + k, glm::mat3(Mat3(motion)));
     p.set("u_ao_radius" + k, float(f.radius));
   }
-  p.set("u_ao_self", -1);
 }
 
-void AoFields::setReceiver(const Program& p, int occluder) const {
-  if (active()) p.set("u_ao_self", occluder);
+std::vector<int> AoFields::reaching(size_t m, const std::array<Vec3, 2>& box) const {
+  std::vector<int> out;
+  const int self = scene_.meshes[m].occluder;
+  for (size_t i = 0; i < fields_.size(); ++i) {
+    const AoField& f = fields_[i];
+    if (f.occluder == self || f.volume.empty()) continue;
+    const Mat4 motion = occluderMotion(scene_, f.occluder);
+    const Vec3 c(motion * Vec4(f.centre, 1.0));
+    const Vec3 nearest = glm::clamp(c, box[0], box[1]);
+    if (glm::dot(nearest - c, nearest - c) < f.reach * f.reach) out.push_back(int(i));
+  }
+  return out;
+}
+
+AoReceiver AoFields::receiver(size_t m, const std::array<Vec3, 2>& box) const {
+  if (!active() || reaching(m, box).empty()) return AoReceiver::None;
+  // Every occluder turning about the vertical only, not lifted: the ground maps' planes stay at their heights.
+  bool upright = true;
+  for (const AoField& f : fields_) {
+    const Mat4 motion = occluderMotion(scene_, f.occluder);
+    upright = upright && std::abs(motion[1][1] - 1) < kLevelTolerance && std::abs(motion[3][1]) < kLevelTolerance;
+  }
+  return upright && m < mesh_height_.size() && mesh_height_[m] >= 0 ? AoReceiver::Ground : AoReceiver::Volume;
+}
+
+void AoFields::setReceiver(const Program& p, size_t m, const std::array<Vec3, 2>& box) const {
+  if (!active()) return;
+  const std::vector<int> list = reaching(m, box);
+  for (size_t f = 0; f < fields_.size(); ++f)
+    p.set("u_ao_reaches[" + std::to_string(f) + "]", std::find(list.begin(), list.end(), int(f)) != list.end() ? 1.0f : 0.0f);
+  p.set("u_ao_height", m < mesh_height_.size() ? std::max(0, mesh_height_[m]) : 0);
 }
 
 void AoFields::note(FrameStages& stages) const {
@@ -100,13 +215,21 @@ void AoFields::note(FrameStages& stages) const {
   size_t bytes = 0;
   for (const AoField& f : fields_) bytes += f.bytes();
   const AmbientOcclusionDesc& a = scene_.render.ambient_occlusion;
-  char text[256];
+  char text[384];
   std::snprintf(text, sizeof text,
                 "%s %zu field%s, %d^2 positions x %d^2 directions, %.1f MB (8 bit); occlusion volumes %d^3, %.1f MB; "
-                "built in %.0f ms",
+                "ground maps %d^2 at %zu height%s, %.2f MB; built in %.0f ms",
                 noted_ ? "reused" : "built", fields_.size(), fields_.size() == 1 ? "" : "s", a.positions, a.directions,
-                double(bytes) / (1 << 20), kAoVolumeSize, double(volume_bytes_) / (1 << 20), build_ms_);
-  stages.ran(kAmbientOcclusionStage, noted_ ? 0 : build_ms_, int(fields_.size()), text);
+                double(bytes) / (1 << 20), kAoVolumeSize, double(volume_bytes_) / (1 << 20), kAoGroundSize,
+                heights_.size(), heights_.size() == 1 ? "" : "s", double(ground_bytes_) / (1 << 20), build_ms_);
+  std::string note = text;
+  note += "; reach";  // AoField::reach: the meshes beyond it are drawn without the field
+  for (const AoField& f : fields_) {
+    std::snprintf(text, sizeof text, " %.1f", f.reach);
+    note += text;
+  }
+  note += " m";
+  stages.ran(kAmbientOcclusionStage, noted_ ? 0 : build_ms_, int(fields_.size()), note);
   noted_ = true;
 }
 

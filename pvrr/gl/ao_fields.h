@@ -6,7 +6,14 @@
 // cubes), so that a car's ground shadow seen in a mirror is the one seen directly
 // (shaders/ambient_occlusion.glsl). Each field follows its object's current rigid motion (EnvMesh::motion),
 // uploaded per pass, so an animated car keeps its occlusion.
+//
+// What a draw pays (llvmpipe shades both sides of every per-fragment branch, so the choice is made per draw,
+// by program variant: AoReceiver): a mesh whose box lies outside every other occluder's reach (where the fade
+// is 0) is drawn without ambient occlusion; a horizontal plane facing up (grounds, pavements: static, not an
+// occluder, every normal vertical, one height) reads the ground maps (pvrr/method/ao_field.h groundMap: one
+// bilinear lookup per occluder) while every occluder turns about the vertical only; the rest read the volumes.
 #pragma once
+#include <array>
 #include <string>
 #include <vector>
 
@@ -22,9 +29,9 @@ inline constexpr const char* kAmbientOcclusionStage = "ambient-occlusion";
 // Why the scene's shading has no ambient occlusion, or empty when it has: off, no occluding object, or no
 // ambient light to occlude.
 std::string ambientOcclusionSkipReason(const Scene& scene);
-// The defines of an environment program that reads the fields (AMBIENT_OCCLUSION, AO_FIELDS,
-// AO_POSITIONS, AO_DIRECTIONS, AO_SIDE); none when the scene has no ambient occlusion.
-std::vector<std::string> aoDefines(const Scene& scene);
+// The defines of an environment program that reads the fields (AMBIENT_OCCLUSION, AO_FIELDS, AO_VOLUME,
+// AO_PER_VERTEX; Ground: AO_GROUND, AO_HEIGHTS); none when the scene has no ambient occlusion or for AoReceiver::None.
+std::vector<std::string> aoDefines(const Scene& scene, AoReceiver receiver = AoReceiver::Volume);
 
 class AoFields {
  public:
@@ -38,19 +45,30 @@ class AoFields {
   bool active() const { return texture_ != 0; }
   // Binds the fields and sets program p's uniforms for a pass whose camera origin is `origin`.
   void bind(const Program& p, const Vec3& origin) const;
-  // The occluder the next draw belongs to (EnvMesh::occluder; it does not occlude itself), or -1.
-  void setReceiver(const Program& p, int occluder) const;
+  // How environment mesh m, whose box in world coordinates is `world_box`, is occluded now (the occluders'
+  // current motion): None when no other occluder's field reaches it (AoField::reach) or the fields are not
+  // active.
+  AoReceiver receiver(size_t m, const std::array<Vec3, 2>& world_box) const;
+  // Sets program p's uniforms for drawing environment mesh m, whose box in world coordinates is `world_box`:
+  // the fields that reach it (not its own occluder's), its ground maps' height.
+  void setReceiver(const Program& p, size_t m, const std::array<Vec3, 2>& world_box) const;
   // Notes the stage: the fields' count, size and precomputation time (once: "built"; later frames: "reused").
   void note(FrameStages& stages) const;
   const std::vector<AoField>& fields() const { return fields_; }
 
  private:
+  // The indices of the fields that reach mesh m (box: world), its own occluder's left out.
+  std::vector<int> reaching(size_t m, const std::array<Vec3, 2>& box) const;
+
   const Scene& scene_;
   std::vector<AoField> fields_;
   int unit_ = 0;
   unsigned texture_ = 0;
+  unsigned ground_texture_ = 0;      // GL_TEXTURE_2D_ARRAY, R8: per field one layer per height
+  std::vector<double> heights_;      // the horizontal planes' heights (world y), AO_HEIGHTS of them
+  std::vector<int> mesh_height_;     // per environment mesh: its index in heights_, or -1 (not such a plane)
   double build_ms_ = 0;
-  size_t volume_bytes_ = 0;
+  size_t volume_bytes_ = 0, ground_bytes_ = 0;
   mutable bool noted_ = false;
 };
 

@@ -170,13 +170,16 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
   glEnable(GL_DEPTH_TEST);
   glDepthMask(GL_TRUE);
   glDepthFunc(reversed_depth ? GL_GREATER : GL_LESS);
-  // The programs of the kinds of mesh the scene has, [faceted][textured], set up for this pass.
-  const Program* kinds[2][2] = {};
+  // The programs of the kinds of mesh the scene has, [ambient occlusion][faceted][textured], set up for this
+  // pass; a mesh's ambient occlusion variant is chosen per draw (AoFields::receiver).
+  const Program* kinds[3][2][2] = {};
+  std::vector<AoReceiver> ao_kind(scene.meshes.size(), AoReceiver::None);
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
     const bool faceted = env_faceted[m], textured = env_textured[m];
-    const Program*& p = kinds[faceted][textured];
+    if (ao_) ao_kind[m] = ao_->receiver(m, worldBox(m));
+    const Program*& p = kinds[int(ao_kind[m])][faceted][textured];
     if (p) continue;
-    p = &programs.env(faceted, textured, planes, with_seen, peel);
+    p = &programs.env(faceted, textured, planes, with_seen, peel, ao_kind[m]);
     p->use();
     if (peel) p->set("u_peel", kPeelUnit);
     p->set("u_view_proj", toFloat(vp));
@@ -205,7 +208,7 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
   for (const size_t m : drawOrder(relative, reversed_depth)) {
     const EnvMesh& mesh = scene.meshes[m];
     const DiffuseMaterial& mat = scene.materials[size_t(mesh.material)];
-    const Program& p = *kinds[env_faceted[m]][env_textured[m]];
+    const Program& p = *kinds[int(ao_kind[m])][env_faceted[m]][env_textured[m]];
     const bool cull = may_cull && mesh.closed_convex && near_clip.cannotOpen(relative[m][0], relative[m][1]);
     count.drawn += mesh.closed_convex;
     count.culled += cull;
@@ -216,7 +219,7 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
     p.use();
     p.set("u_offset", glm::vec3(mesh.anchor - origin));
     p.set("u_albedo", glm::vec3(mat.color));
-    if (ao_) ao_->setReceiver(p, mesh.occluder);
+    if (ao_) ao_->setReceiver(p, m, worldBox(m));
     if (env_textured[m]) glBindTexture(GL_TEXTURE_2D, textures[size_t(mat.texture)].name());
     gl::draw(env_meshes[m]);
   }

@@ -35,7 +35,7 @@ const Program& Programs::planesVariant(const std::string& vert, const std::strin
   return built(vert, frag, d);
 }
 
-const Program& Programs::env(bool faceted, bool textured, bool planes, bool with_seen, bool peel) const {
+const Program& Programs::env(bool faceted, bool textured, bool planes, bool with_seen, bool peel, AoReceiver ao) const {
   std::vector<std::string> d;
   if (with_seen) d.push_back(kWithSeenPoints);
   if (peel) d.push_back("#define PEEL");
@@ -44,7 +44,7 @@ const Program& Programs::env(bool faceted, bool textured, bool planes, bool with
   if (planes) d.push_back("#define PLANES");
   for (const std::string& s : shadowDefines(scene_)) d.push_back(s);
   for (const std::string& s : causticDefines(scene_)) d.push_back(s);
-  for (const std::string& s : aoDefines(scene_)) d.push_back(s);
+  for (const std::string& s : aoDefines(scene_, ao)) d.push_back(s);
   return built("env.vert", "env.frag", d);
 }
 

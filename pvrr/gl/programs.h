@@ -13,6 +13,10 @@
 
 namespace pvrr::gl {
 
+// How an environment draw's fragments are ambient-occluded (the program variant; pvrr/gl/ao_fields.h): not at
+// all, from the ground maps (a horizontal plane facing up), from the occlusion volumes.
+enum class AoReceiver { None, Ground, Volume };
+
 class Programs {
  public:
   Programs(const Scene& scene, bool seen_points) : scene_(scene), seen_points_(seen_points) {}
@@ -30,8 +34,10 @@ class Programs {
   // Environment meshes (shaders/env.frag), with the shadow maps' defines when a light casts shadows
   // (shadowDefines, pvrr/gl/shadow_pass.h): FACETED (one normal per triangle), TEXTURED (a material with a
   // texture; without, no texture is sampled: llvmpipe samples inside a uniform branch all the same).
-  // PEEL: the second layer of an impostor's distance map (shaders/outputs.glsl).
-  const Program& env(bool faceted, bool textured, bool planes, bool with_seen = false, bool peel = false) const;
+  // PEEL: the second layer of an impostor's distance map (shaders/outputs.glsl). ao: its ambient occlusion
+  // variant (aoDefines; nothing without render.ambient_occlusion).
+  const Program& env(bool faceted, bool textured, bool planes, bool with_seen = false, bool peel = false,
+                     AoReceiver ao = AoReceiver::Volume) const;
   // first_layer: an impostor cube's second layer, where nothing lies beyond the first (shaders/sky.frag).
   const Program& sky(bool planes, bool with_seen = false, bool first_layer = false) const;
   // Elements as plain surfaces (raster mode, and elements drawn dark at the depth limit).

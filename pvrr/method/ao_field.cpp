@@ -195,9 +195,64 @@ void buildVolume(AoField& f) {
       for (int a = 0; a < 6; ++a) texel[a] = uint8_t(std::lround(o[size_t(a)] * 255));
     }
   });
+  // The reach: past every grid point whose occlusion (fade included) is not negligible, by one cell outward on
+  // each axis (trilinear reads mix it into the cells around it).
+  f.reach = 0;
+  auto outward = [&](int i) {  // the offset of grid index i moved one cell away from the centre
+    const int o = std::clamp(2 * i + 1 < n ? i - 1 : i + 1, 0, n - 1);
+    return std::max(std::abs(aoUnwarp(2 * (i + 0.5) / n - 1, f.radius)), std::abs(aoUnwarp(2 * (o + 0.5) / n - 1, f.radius)));
+  };
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const uint8_t* texel = &f.volume[(size_t(k) * size_t(n) * size_t(n) + size_t(j) * size_t(n) + size_t(i)) * 8];
+        const Vec3 p(aoUnwarp(2 * (i + 0.5) / n - 1, f.radius), aoUnwarp(2 * (j + 0.5) / n - 1, f.radius),
+                     aoUnwarp(2 * (k + 0.5) / n - 1, f.radius));
+        const double fade = aoFade(f.radius * f.radius / std::max(glm::dot(p, p), 1e-300));
+        const uint8_t most = *std::max_element(texel, texel + 6);
+        if (fade * most / 255.0 < kAoNegligible) continue;
+        f.reach = std::max(f.reach, glm::length(Vec3(outward(i), outward(j), outward(k))));
+      }
 }
 
 }  // namespace
+
+std::vector<uint8_t> groundMap(const AoField& f, double height) {
+  const int n = kAoGroundSize;
+  std::vector<uint8_t> map(size_t(n) * size_t(n), 0);
+  if (f.volume.empty()) return map;
+  const double y = height - f.centre.y;
+  tbb::parallel_for(0, n, [&](int k) {
+    for (int i = 0; i < n; ++i) {
+      const Vec3 p(aoUnwarp(2 * (i + 0.5) / n - 1, f.radius), y, aoUnwarp(2 * (k + 0.5) / n - 1, f.radius));
+      const double fade = aoFade(f.radius * f.radius / std::max(glm::dot(p, p), 1e-300));
+      if (fade <= 0) continue;
+      map[size_t(k) * size_t(n) + size_t(i)] = uint8_t(std::lround(fade * axisOcclusion(f, p)[2] * 255));
+    }
+  });
+  return map;
+}
+
+double groundMapOcclusion(const AoField& f, const std::vector<uint8_t>& map, const Mat4& motion, const Vec3& x) {
+  if (map.empty()) return 0;
+  const Vec3 p = glm::transpose(Mat3(motion)) * (x - Vec3(motion[3])) - f.centre;
+  const int n = kAoGroundSize;
+  double g[2], fr[2];
+  int i0[2];
+  const double offsets[2] = {p.x, p.z};
+  for (int a = 0; a < 2; ++a) {
+    g[a] = std::clamp((aoWarp(offsets[a], f.radius) + 1) / 2 * n - 0.5, 0.0, double(n - 1));
+    i0[a] = std::min(int(std::floor(g[a])), n - 2);
+    fr[a] = g[a] - i0[a];
+  }
+  double o = 0;
+  for (int c = 0; c < 4; ++c) {
+    const int dx = c & 1, dz = c >> 1;
+    o += (dx ? fr[0] : 1 - fr[0]) * (dz ? fr[1] : 1 - fr[1]) *
+         map[size_t(i0[1] + dz) * size_t(n) + size_t(i0[0] + dx)] / 255.0;
+  }
+  return o;
+}
 
 double volumeOcclusion(const AoField& f, const Mat4& motion, const Vec3& x_world, const Vec3& n_world) {
   if (f.volume.empty()) return 0;

@@ -27,7 +27,14 @@
 // t = x / (|x| + r) per axis (x from the sphere's centre: fine near the object, the whole space within
 // (-1, 1)), each holding the occlusion for the six axis normals +-x, +-y, +-z (an "ambient cube": a normal n
 // reads sum n_i^2 O(sign(n_i) axis_i), exact for axis normals, such as a ground under a car that turns about
-// the vertical). A fragment reads it trilinearly: two texture lookups per occluder.
+// the vertical). A fragment reads it trilinearly: one texture lookup per occluder (the GPU copy holds, per
+// octant of normals, the three axis occlusions of its signs: pvrr/gl/ao_fields.cpp).
+//
+// The ground maps (what most fragments read): on a horizontal plane y = h (a ground, a pavement) facing up,
+// with the occluder turning about the vertical only, the occlusion depends on the two horizontal offsets from
+// the centre alone. Per occluder and per such height a kAoGroundSize^2 map of O(+y) at the warped coordinates
+// (x, z) of the volume, the fade (aoFade) included: one bilinear lookup of one channel per occluder, not two
+// trilinear ones of four.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -47,6 +54,9 @@ inline constexpr uint8_t kAoMiss = 255;          // a field ray that meets nothi
 inline constexpr double kAoMinCone = 0.01;
 // The fade: 1 at sin^2 >= 2 kAoMinCone, 0 at kAoMinCone.
 inline double aoFade(double sin2) { return std::clamp(sin2 / kAoMinCone - 1, 0.0, 1.0); }
+// Occlusion below this is left out where a whole mesh lies beyond it (AoField::reach): it darkens a pixel by
+// at most albedo * ambient * 2/255, under one 8-bit step of the picture for albedo * ambient <= 0.5.
+inline constexpr double kAoNegligible = 2.0 / 255;
 
 struct AoField {
   int occluder = -1;        // EnvMesh::occluder
@@ -59,6 +69,9 @@ struct AoField {
   // The occlusion volume: kAoVolumeSize^3 grid points (x fastest), per point 8 bytes: O for +x, -x, +y, -y,
   // +z, -z in 255ths, then two zeros.
   std::vector<uint8_t> volume;
+  // Beyond this distance from the centre (m, the field's frame) the volume's occlusion, fade included, is below
+  // kAoNegligible for every normal: the raster modes draw a mesh wholly beyond it without this field.
+  double reach = 0;
   double build_ms = 0;      // its precomputation (wall clock): field and volume
   int width() const { return positions * directions; }
   size_t bytes() const { return data.size(); }
@@ -67,6 +80,7 @@ struct AoField {
 inline constexpr int kAoVolumeSize = 40;       // grid points per axis
 inline constexpr int kAoVolumeRays = 64;        // rays per grid point outside the sphere (its cone)
 inline constexpr int kAoVolumeInsideSide = 12;  // inside: the whole sphere, kAoVolumeInsideSide^2 rays
+inline constexpr int kAoGroundSize = 64;        // ground map texels per side (finer than the volume's 40)
 
 // The warped coordinate t in (-1, 1) of offset x from the centre (radius r), and back.
 inline double aoWarp(double x, double r) { return x / (std::abs(x) + r); }
@@ -98,6 +112,13 @@ double volumeOcclusion(const AoField& f, const Mat4& motion, const Vec3& x, cons
 // The visibility from the volumes of every occluder but `receiver`.
 double volumeVisibility(const std::vector<AoField>& fields, const Scene& scene, const Vec3& x, const Vec3& n,
                         int receiver);
+// The ground map of field f on the plane y = height (the field's frame, world metres): kAoGroundSize^2 bytes
+// (x fastest), O(+y) in 255ths with the fade, texel (i, k) at the warped offsets (2 (i + 0.5) / n - 1,
+// 2 (k + 0.5) / n - 1) in x and z from the centre.
+std::vector<uint8_t> groundMap(const AoField& f, double height);
+// The occlusion the ground map casts at world x on a horizontal plane facing up (what the shader's ground
+// variant shades): bilinear, clamped at the outermost texels; the occluder's motion turns about the vertical.
+double groundMapOcclusion(const AoField& f, const std::vector<uint8_t>& map, const Mat4& motion, const Vec3& x);
 // The current motion of occluder `occluder` (its first mesh's; a group's objects move together).
 Mat4 occluderMotion(const Scene& scene, int occluder);
 

@@ -133,13 +133,16 @@ Scene carScene(const Mat4& motion) {
 }
 
 // Mean |A_field - A_reference| over ground points within 7 m of the car's centre (a 0.5 m grid, points under
-// the body included, points inside a wheel's footprint left out), and the largest.
-void groundDifference(const Mat4& motion, double& mad, double& worst, double& darkest, double& volume_mad) {
+// the body included, points inside a wheel's footprint left out), and the largest; likewise for the occlusion
+// volume (volume_mad) and the ground map at the ground's height (ground_mad, what the raster modes shade).
+void groundDifference(const Mat4& motion, double& mad, double& worst, double& darkest, double& volume_mad,
+                      double& ground_mad) {
   const Scene s = carScene(motion);
   const RayScene rays(s);
   const std::vector<AoField> fields = buildAoFields(s);
   ASSERT_EQ(fields.size(), 1u);
-  double sum = 0, volume_sum = 0;
+  const std::vector<uint8_t> ground = groundMap(fields[0], 0.0);
+  double sum = 0, volume_sum = 0, ground_sum = 0;
   int count = 0;
   worst = 0;
   darkest = 1;
@@ -156,6 +159,7 @@ void groundDifference(const Mat4& motion, double& mad, double& worst, double& da
       const double a_ref = referenceAmbientVisibility(rays, x, n, -1, 256);
       const double a_field = fieldVisibility(fields, s, x, n, -1, 16);
       volume_sum += std::abs(volumeVisibility(fields, s, x, n, -1) - a_ref);
+      ground_sum += std::abs(std::max(0.0, 1 - groundMapOcclusion(fields[0], ground, motion, x)) - a_ref);
       sum += std::abs(a_field - a_ref);
       worst = std::max(worst, std::abs(a_field - a_ref));
       darkest = std::min(darkest, a_ref);
@@ -163,27 +167,31 @@ void groundDifference(const Mat4& motion, double& mad, double& worst, double& da
     }
   mad = sum / count;
   volume_mad = volume_sum / count;
+  ground_mad = ground_sum / count;
 }
 
 TEST(AoFieldTest, GroundAroundACarAgreesWithTheReference) {
-  double mad = 0, worst = 0, darkest = 1, volume_mad = 0;
-  groundDifference(Mat4(1.0), mad, worst, darkest, volume_mad);
+  double mad = 0, worst = 0, darkest = 1, volume_mad = 0, ground_mad = 0;
+  groundDifference(Mat4(1.0), mad, worst, darkest, volume_mad, ground_mad);
   EXPECT_LT(darkest, 0.3);  // the test means something: under the car the ground is dark
   EXPECT_LT(mad, kGroundMad) << "worst " << worst;
   EXPECT_LT(volume_mad, kGroundMad);
-  std::printf("ground around a car: mean |A_field - A_ref| %.4f (worst %.4f), |A_volume - A_ref| %.4f\n", mad, worst,
-              volume_mad);
+  EXPECT_LT(ground_mad, kGroundMad);
+  std::printf("ground around a car: mean |A_field - A_ref| %.4f (worst %.4f), |A_volume - A_ref| %.4f, "
+              "|A_ground_map - A_ref| %.4f\n", mad, worst, volume_mad, ground_mad);
 }
 
 TEST(AoFieldTest, TheFieldMovesWithItsObject) {
   // Turned 35 degrees about y and moved 12 m: the field, built in the placed pose, follows.
   const Mat4 motion = glm::rotate(glm::translate(Mat4(1.0), Vec3(12, 0, -5)), radians(35), Vec3(0, 1, 0));
-  double mad = 0, worst = 0, darkest = 1, volume_mad = 0;
-  groundDifference(motion, mad, worst, darkest, volume_mad);
+  double mad = 0, worst = 0, darkest = 1, volume_mad = 0, ground_mad = 0;
+  groundDifference(motion, mad, worst, darkest, volume_mad, ground_mad);
   EXPECT_LT(darkest, 0.3);
   EXPECT_LT(mad, kGroundMad) << "worst " << worst;
   EXPECT_LT(volume_mad, kGroundMad);
-  std::printf("moved car: mean |A_field - A_ref| %.4f, |A_volume - A_ref| %.4f\n", mad, volume_mad);
+  EXPECT_LT(ground_mad, kGroundMad);
+  std::printf("moved car: mean |A_field - A_ref| %.4f, |A_volume - A_ref| %.4f, |A_ground_map - A_ref| %.4f\n", mad,
+              volume_mad, ground_mad);
 }
 
 }  // namespace
