@@ -20,12 +20,19 @@ void checkResolved(samplerCube seen, vec3 l) {
 // undershooting (in front of the surface) and overshooting parameters, 0 while there is none (the direction
 // R itself, at infinity, stands in for a missing overshoot, as in the paper).
 // falsePosition: that search from parameter dl, with the last undershooting (dun, ratio |l| / distance pun) and
-// overshooting (dov, pov) parameters so far (0: none); r1 the distance the impostor holds along R.
-vec3 falsePosition(samplerCube seen, vec3 x, vec3 R, float r1, float dl, float dun, float pun, float dov, float pov) {
+// overshooting (dov, pov) parameters so far (0: none); r1 the distance the impostor holds along R. d_at: the
+// distance the impostor holds at the point returned where the search read it there (it stopped on a ratio
+// within 1e-6 of 1), else -1: onSurface then need not read it again.
+vec3 falsePosition(samplerCube seen, vec3 x, vec3 R, float r1, float dl, float dun, float pun, float dov, float pov,
+                   out float d_at) {
   vec3 l = x + R * dl;
+  d_at = -1.0;
   for (int i = 0; i < IMPOSTOR_ITERATIONS; ++i) {
-    float llp = length(l) / envDistance(seen, l);
-    if (abs(1.0 - llp) < 1e-6) break;  // as close as float distances resolve
+    float d = envDistance(seen, l), llp = length(l) / d;
+    if (abs(1.0 - llp) < 1e-6) {  // as close as float distances resolve
+      d_at = d;
+      break;
+    }
     float ddl;
     if (llp < 1.0) {  // undershooting
       dun = dl, pun = llp;
@@ -37,17 +44,24 @@ vec3 falsePosition(samplerCube seen, vec3 x, vec3 R, float r1, float dl, float d
     dl = max(dl + ddl, 0.0);
     l = x + R * dl;
   }
-  return dot(l, l) > 0.0 ? l : R;  // x at the cube's origin and d = 0: the direction itself
+  if (dot(l, l) > 0.0) return l;
+  d_at = -1.0;
+  return R;  // x at the cube's origin and d = 0: the direction itself
 }
-vec3 impostorHit(samplerCube seen, vec3 x, vec3 R) {
-  float r1 = envDistance(seen, R);
+// r1: the distance the impostor holds along R; d_at as falsePosition's.
+vec3 impostorHit(samplerCube seen, vec3 x, vec3 R, out float r1, out float d_at) {
+  r1 = envDistance(seen, R);
   float dp = r1 - dot(x, R);
   vec3 p = x + R * dp;
   float ppp = length(p) / envDistance(seen, p);
   float dun = 0.0, dov = 0.0, pun = ppp, pov = ppp;
   if (ppp < 1.0) dun = dp; else dov = dp;
   float dl = max(dp + r1 * (1.0 - ppp), 0.0);
-  return falsePosition(seen, x, R, r1, dl, dun, pun, dov, pov);
+  return falsePosition(seen, x, R, r1, dl, dun, pun, dov, pov, d_at);
+}
+vec3 impostorHit(samplerCube seen, vec3 x, vec3 R) {
+  float r1, d_at;
+  return impostorHit(seen, x, R, r1, d_at);
 }
 
 #if IMPOSTOR_LAYERS > 1
@@ -60,8 +74,10 @@ vec3 impostorHit(samplerCube seen, vec3 x, vec3 R) {
 // distance jumps (1.5 texels to either side, across the ray's sweep, the farther more than 1.5 x the nearer),
 // the filtered distance blends the two surfaces, and the search ends between them, at a point on neither:
 // more than 1.25 x the nearer's distance and less than 0.8 x the farther's.
-bool onSurface(samplerCube seen, vec3 l, vec3 R) {
-  float len = length(l), d = envDistance(seen, l);
+// d_at: the distance the layer holds at l if the search read it there, else -1.
+bool onSurface(samplerCube seen, vec3 l, vec3 R, float d_at) {
+  float len = length(l), d = d_at;
+  if (d < 0.0) d = envDistance(seen, l);
   if (!(abs(len - d) <= 1e-3 * d)) return false;
   vec3 u = l / len, t = R - dot(R, u) * u;
   float tl = length(t);
@@ -79,13 +95,14 @@ float rayRatio(samplerCube seen, vec3 p) {
 }
 
 // A crossing of a layer between the march's parameters d0 (ratio r0 < 1) and d1 (ratio r1 >= 1; at_end: the
-// ray's end at infinity), refined by false position; whether it lies on the layer's surface.
-bool layerCrossing(samplerCube seen, vec3 x, vec3 R, float d0, float r0, float d1, float r1, bool at_end,
+// ray's end at infinity), refined by false position; whether it lies on the layer's surface. rR: the distance
+// the layer holds along R.
+bool layerCrossing(samplerCube seen, vec3 x, vec3 R, float rR, float d0, float r0, float d1, float r1, bool at_end,
                    out vec3 l) {
-  float rR = envDistance(seen, R);
   float dl = at_end ? max(d0 + rR * (1.0 - r0), d0) : d0 + (d1 - d0) * (1.0 - r0) / (r1 - r0);
-  l = falsePosition(seen, x, R, rR, dl, d0, r0, at_end ? 0.0 : d1, r1);
-  return onSurface(seen, l, R);
+  float d_at;
+  l = falsePosition(seen, x, R, rR, dl, d0, r0, at_end ? 0.0 : d1, r1, d_at);
+  return onSurface(seen, l, R, d_at);
 }
 
 // The first hit of the ray x + d R (x relative to the cube's origin, R unit) in the two layers; `layer`: which
@@ -98,8 +115,9 @@ bool layerCrossing(samplerCube seen, vec3 x, vec3 R, float d0, float r0, float d
 const int LAYER_STEPS = 16;
 vec3 layeredHit(samplerCube seen0, samplerCube seen1, vec3 x, vec3 R, out int layer) {
   layer = 0;
-  vec3 l0 = impostorHit(seen0, x, R);
-  if (onSurface(seen0, l0, R)) return l0;
+  float rR0, d_at;
+  vec3 l0 = impostorHit(seen0, x, R, rR0, d_at);
+  if (onSurface(seen0, l0, R, d_at)) return l0;
 #if !defined(LAYER_MARCH)
   discard;  // the second draw, LAYER_MARCH, shades this pixel (pvrr/gl/cube_pass.cpp)
   return l0;
@@ -107,6 +125,7 @@ vec3 layeredHit(samplerCube seen0, samplerCube seen1, vec3 x, vec3 R, out int la
   float a = length(x), t0 = 0.25 / float(LAYER_STEPS), d_prev = a * t0 / (1.0 - t0);
   vec3 p0 = x + R * d_prev;
   vec2 r_prev = vec2(rayRatio(seen0, p0), rayRatio(seen1, p0));
+  float rR1 = envDistance(seen1, R);
   for (int i = 1; i <= LAYER_STEPS; ++i) {
     bool at_end = i == LAYER_STEPS;
     float t = float(i) / float(LAYER_STEPS), d = at_end ? 0.0 : a * t / (1.0 - t);
@@ -114,9 +133,9 @@ vec3 layeredHit(samplerCube seen0, samplerCube seen1, vec3 x, vec3 R, out int la
     vec2 r = at_end ? vec2(2.0) : vec2(rayRatio(seen0, p), rayRatio(seen1, p));
     vec3 l, best = l0;
     float d_best = -1.0;
-    if (r_prev.x < 1.0 && r.x >= 1.0 && layerCrossing(seen0, x, R, d_prev, r_prev.x, d, r.x, at_end, l))
+    if (r_prev.x < 1.0 && r.x >= 1.0 && layerCrossing(seen0, x, R, rR0, d_prev, r_prev.x, d, r.x, at_end, l))
       best = l, d_best = dot(l - x, R);
-    if (r_prev.y < 1.0 && r.y >= 1.0 && layerCrossing(seen1, x, R, d_prev, r_prev.y, d, r.y, at_end, l) &&
+    if (r_prev.y < 1.0 && r.y >= 1.0 && layerCrossing(seen1, x, R, rR1, d_prev, r_prev.y, d, r.y, at_end, l) &&
         (d_best < 0.0 || dot(l - x, R) < d_best)) {
       layer = 1;
       return l;
