@@ -195,15 +195,75 @@ bool refine_tir = false;        // some channel's exact path is totally reflecte
 vec3 refine_seen;               // the seen channel's ray point where its search ended (relative to the map's
 bool refine_seen_ok = false;    // viewpoint), where it succeeded
 
+// Where the ray p + t d inside the glass (p on the front surface, d downward: -z) meets the back surface:
+// secant steps on its height above the back surface from p (the glass's thickness there) and the plane step
+// that drops the ray by that height, to 10 nm as glassExit (a smooth surface's root in two to four steps, where
+// glassExit's general march, which must find the first of two surfaces, costs several times more reads).
+// -1: the ray does not run down, or the steps did not converge; the caller tests that the root lies inside the
+// glass (below the front surface), else the ray meets the front first.
+float backCrossing(vec3 p, vec3 d) {
+  if (d.z > -1e-4) return -1.0;
+  float ta = 0.0, ga = p.z - lensTexel(true, p.xy).x;
+  float tb = ga / -d.z;
+  vec3 q = p + tb * d;
+  float gb = q.z - lensTexel(true, q.xy).x;
+  for (int i = 0; i < 6 && abs(gb) > 1e-8 && gb != ga; ++i) {
+    float tc = tb - gb * (tb - ta) / (gb - ga);
+    ta = tb, ga = gb, tb = tc;
+    q = p + tb * d;
+    gb = q.z - lensTexel(true, q.xy).x;
+  }
+  return abs(gb) <= 1e-7 && tb > 0.0 ? tb : -1.0;
+}
+
+// SPHERE_FRONT, SPHERE_BACK: that surface is a sphere or a plane (cad::SagSurface::sphereCurvature), met in closed
+// form with no texture read; the other surfaces in the height maps.
+#if defined(SPHERE_FRONT) || defined(SPHERE_BACK)
+uniform vec4 u_spheres;  // the front's curvature c = 1/R and vertex z, the back's (lens frame, metres)
+#endif
+// Where the ray o + t d meets the sphere (or plane, c = 0) of curvature c with its vertex at (0, 0, z0):
+// c (x^2 + y^2 + Z^2) = 2 Z with Z = z0 - z, the sag graph's root (the one that stays finite as c -> 0, in the
+// form without cancellation); its +z-side unit normal (c x, c y, 1 - c Z) / |.| in n. False where the ray
+// misses it or meets its far half.
+bool sphereHit(vec3 o, vec3 d, float c, float z0, out float t, out vec3 n) {
+  float Z0 = z0 - o.z;
+  float b = c * (dot(o.xy, d.xy) - Z0 * d.z) + d.z, q = c * (dot(o.xy, o.xy) + Z0 * Z0) - 2.0 * Z0;
+  float disc = b * b - c * q;
+  float den = -b - (b < 0.0 ? -1.0 : 1.0) * sqrt(max(disc, 0.0));
+  t = q / den;
+  vec3 p = o + t * d;
+  float w = 1.0 - c * (z0 - p.z);
+  n = normalize(vec3(c * p.xy, w));
+  return disc >= 0.0 && den != 0.0 && w > 0.0;
+}
+
+// The front surface's height at local xy.
+float frontHeight(vec2 xy) {
+#if defined(SPHERE_FRONT)
+  float c = u_spheres.x, r2 = dot(xy, xy);
+  return u_spheres.y - c * r2 / (1.0 + sqrt(max(1.0 - c * c * r2, 0.0)));
+#else
+  return lensTexel(false, xy).x;
+#endif
+}
+
 // The fragment's entry into the glass; its state for refinedLensST (called once, before the channels).
 void refineLensEntry(vec3 view) {
   if (!u_refine) return;
   refine_state = 2;
   if (dot(view, v_normal) >= 0.0) return;  // seen from behind
   vec3 x = u_to_local * (v_pos - u_offset), v = u_to_local * view;
+#if defined(SPHERE_FRONT)
+  float t;
+  vec3 n;
+  if (!sphereHit(x, v, u_spheres.x, u_spheres.y, t, n)) return;
+  vec3 e = x + t * v;
+  if (!inOutline(e.xy)) return;
+#else
   vec3 e = entryPoint(x, v, false);
   if (!inOutline(e.xy)) return;
   vec3 n = normalize(lensTexel(false, e.xy).yzw);
+#endif
   if (dot(v, n) >= 0.0) return;
   refine_entry = e;
   refine_dir = v;
@@ -217,22 +277,30 @@ vec2 refinedLensST(int k, vec2 st_interpolated) {
   if (refine_state != 1) return st_interpolated;
   float eta = u_channel_index[k];
   vec3 d = refract(refine_dir, refine_n, 1.0 / eta);
-  bool back;
-  float t = glassExit(refine_entry, d, back);
-  if (t < 0.0) {  // no crossing within the maps' reach
+#if defined(SPHERE_BACK)
+  float t;
+  vec3 nout;
+  if (!sphereHit(refine_entry, d, u_spheres.z, u_spheres.w, t, nout) || !(t > 0.0)) t = -1.0;
+  nout = -nout;  // out of the glass: the -z side
+#else
+  float t = backCrossing(refine_entry, d);
+#endif
+  if (t < 0.0) {  // no crossing found
     refine_fell_back = true;
     return st_interpolated;
   }
-  if (!back) {  // the front surface again: the ray inside runs up, not the vertex rays' path
+  vec3 p = refine_entry + t * d;
+  if (frontHeight(p.xy) < p.z) {  // above the front surface: the ray inside meets the front first
     refine_tir = true;
     return st_interpolated;
   }
-  vec3 p = refine_entry + t * d;
   if (!inOutline(p.xy)) {  // through the rim: absorbed in the tracer
     refine_fell_back = true;
     return st_interpolated;
   }
+#if !defined(SPHERE_BACK)
   vec3 nout = normalize(lensTexel(true, p.xy).yzw);
+#endif
   vec3 out_dir = dot(d, nout) > 0.0 ? refract(d, -nout, eta) : vec3(0.0);
   if (out_dir == vec3(0.0)) {
     refine_tir = true;

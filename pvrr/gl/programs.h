@@ -42,7 +42,9 @@ class Programs {
   // RGB dispersion (RGB_CHANNELS: its maps are planes); planes: drawn into a planes map. refine > 0: an element
   // whose fragments search their exact rays in its maps with that many secant steps (REFINE,
   // shaders/pvrr_refine.glsl): a mirror's reflected ray, or each of a lens's channels' exit rays.
-  const Program& pvrr(bool lens, size_t channels, bool rgb, bool planes, int refine = 0) const;
+  // spheres (a refined lens): bit 0 its front, bit 1 its back is a sphere or plane, met in closed form
+  // (SPHERE_FRONT, SPHERE_BACK).
+  const Program& pvrr(bool lens, size_t channels, bool rgb, bool planes, int refine = 0, int spheres = 0) const;
   // Distance-impostor elements (shaders/element_impostor.frag): a mirror, or a lens with one or three
   // wavelengths; cube_elements > 0: searches that meet a mirror in a cube go on in its cubes (CUBE_ELEMENTS).
   // lens_in_cubes: the scene's one lens is drawn in the other elements' cubes and refracted through there.

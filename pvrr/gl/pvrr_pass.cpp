@@ -41,6 +41,24 @@ bool usesTraced(const PatchView& pv, const VertexRay& r) {
   return r.traced && (r.status == VertexStatus::Tir || pv.draw_traced);
 }
 
+// A refined lens's surfaces that are spheres or planes (bit 0 the front, bit 1 the back), met in closed form in
+// the shader (SPHERE_FRONT, SPHERE_BACK); *u: their curvatures and vertex heights (u_spheres).
+int refineSpheres(const Element& el, glm::vec4* u) {
+  int bits = 0;
+  double c = 0;
+  if (el.lens.front->sphereCurvature(&c)) {
+    bits |= 1;
+    (*u)[0] = float(c);
+    (*u)[1] = float(el.lens.front->zVertex());
+  }
+  if (el.lens.back->sphereCurvature(&c)) {
+    bits |= 2;
+    (*u)[2] = float(c);
+    (*u)[3] = float(el.lens.back->zVertex());
+  }
+  return bits;
+}
+
 }  // namespace
 
 PvrrPass::~PvrrPass() {
@@ -363,7 +381,10 @@ void PvrrPass::drawPvrrElement(const ElementFrame& f, size_t first_slot, const P
   // scenes have them: never more than three channels), the planes variant.
   const bool rgb = rgbLens(el, f);
   const bool refined = refine_skip.size() > size_t(f.element) && refine_skip[size_t(f.element)].empty();
-  const Program& p = ctx.programs.pvrr(lens, channels, rgb, cam.planes, refined ? ctx.scene.render.refine : 0);
+  glm::vec4 spheres_uniform(0.0f);
+  const int spheres = refined && lens ? refineSpheres(el, &spheres_uniform) : 0;
+  const Program& p =
+      ctx.programs.pvrr(lens, channels, rgb, cam.planes, refined ? ctx.scene.render.refine : 0, spheres);
   p.use();
   p.set("u_view_proj", toFloat(cam.view_proj));
   p.set("u_offset", glm::vec3(anchor - cam.origin));
@@ -389,6 +410,7 @@ void PvrrPass::drawPvrrElement(const ElementFrame& f, size_t first_slot, const P
   }
   const size_t sets = channels > 1 ? (channels + 2) / 3 : 1;
   if (refined) setRefinement(p, f, seen_c);
+  if (spheres) p.set("u_spheres", spheres_uniform);
   for (size_t v = 0; v < f.views.size(); ++v) {
     const PatchView& pv = f.views[v];
     const Framebuffer& map = *maps[first_slot + v];
