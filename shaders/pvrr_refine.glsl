@@ -167,19 +167,20 @@ vec2 refinedST(vec3 view, vec2 st_interpolated) {
   return mapTexST(st);
 }
 #else  // LENS
-// Lenses: the fragment's exact path through the glass, per channel, from the lens's refractor height maps
-// (lens_march.glsl, pvrr/impostor/lens_height_map.h; the impostor mode's, whose exact exit rays measure
-// 0.0003' to 0.003' median against the reference): the view ray's entry point on the front surface, near the
-// rasterised triangle's point (secant steps on the heights: entryPoint), refraction in with the channel's
-// index, the march to where the ray meets the glass's surface again (glassExit), refraction out. The exit ray
-// is then searched in the patch's map as a mirror's reflected ray is, starting at the depth the map shows at
-// the channel's interpolated coordinate (every channel set is in use: no vertex attribute is left for the
-// exact hits' depth, and the map's own depth there lies next to the answer). The maps hold a sag surface's
-// height and normal exactly up to bilinear filtering, and the path depends on the eye, so nothing is baked per
-// frame. A fragment whose exact path is not the vertex rays' kind keeps the interpolated coordinates: a view
-// ray that meets the lens from behind or outside its outline, or whose path leaves through the front surface or
-// the rim (missed), or is totally reflected inside (u_count_tir); the totally reflected vertices' traced
-// colours and seen points are added as without REFINE.
+// Lenses: the fragment's exact path through the glass, per channel (docs/method.md "Per-fragment refinement"):
+// the view ray's entry point on the front surface, refraction in with the channel's index, the internal ray's
+// crossing of the back surface, refraction out. A surface that is a sphere or a plane is met in closed form
+// (SPHERE_FRONT, SPHERE_BACK); any other in the lens's refractor height maps (lens_march.glsl,
+// pvrr/impostor/lens_height_map.h; impostor mode's, eye-independent, baked once), by secant steps on the ray's
+// height above it: from the rasterised triangle's point for the front (entryPoint), from the entry point and the
+// plane step for the back (backCrossing). The exit ray is then searched in the patch's map as a mirror's
+// reflected ray is, starting at the depth the map shows at the channel's interpolated coordinate (every channel
+// set is in use: no vertex attribute is left for the exact hits' depth, and the map's own depth there lies next
+// to the answer); the seen channel's seen point is the search's ray point. A fragment whose exact path is not
+// the vertex rays' kind keeps the interpolated coordinates: a view ray that meets the lens from behind, misses
+// a surface or crosses outside the outline (missed, or failed at the rim), or whose internal ray meets the front
+// first or is totally reflected at the back (u_count_tir); the totally reflected vertices' traced colours and
+// seen points are added as without REFINE.
 uniform vec3 u_offset;           // element.vert's: the lens's anchor (its local frame's origin) - camera origin
 uniform mat3 u_to_local;         // world directions -> the lens's local frame (the height maps')
 uniform vec3 u_channel_index;    // the glass's index at the wavelengths of this draw's channels 0, 1, 2
@@ -201,17 +202,21 @@ bool refine_seen_ok = false;    // viewpoint), where it succeeded
 // glassExit's general march, which must find the first of two surfaces, costs several times more reads).
 // -1: the ray does not run down, or the steps did not converge; the caller tests that the root lies inside the
 // glass (below the front surface), else the ray meets the front first.
-float backCrossing(vec3 p, vec3 d) {
+// texel: the back map's texel at the root (its height and outward normal).
+float backCrossing(vec3 p, vec3 d, out vec4 texel) {
+  texel = vec4(0.0);
   if (d.z > -1e-4) return -1.0;
   float ta = 0.0, ga = p.z - lensTexel(true, p.xy).x;
   float tb = ga / -d.z;
   vec3 q = p + tb * d;
-  float gb = q.z - lensTexel(true, q.xy).x;
+  texel = lensTexel(true, q.xy);
+  float gb = q.z - texel.x;
   for (int i = 0; i < 6 && abs(gb) > 1e-8 && gb != ga; ++i) {
     float tc = tb - gb * (tb - ta) / (gb - ga);
     ta = tb, ga = gb, tb = tc;
     q = p + tb * d;
-    gb = q.z - lensTexel(true, q.xy).x;
+    texel = lensTexel(true, q.xy);
+    gb = q.z - texel.x;
   }
   return abs(gb) <= 1e-7 && tb > 0.0 ? tb : -1.0;
 }
@@ -283,7 +288,8 @@ vec2 refinedLensST(int k, vec2 st_interpolated) {
   if (!sphereHit(refine_entry, d, u_spheres.z, u_spheres.w, t, nout) || !(t > 0.0)) t = -1.0;
   nout = -nout;  // out of the glass: the -z side
 #else
-  float t = backCrossing(refine_entry, d);
+  vec4 back_texel;
+  float t = backCrossing(refine_entry, d, back_texel);
 #endif
   if (t < 0.0) {  // no crossing found
     refine_fell_back = true;
@@ -299,7 +305,7 @@ vec2 refinedLensST(int k, vec2 st_interpolated) {
     return st_interpolated;
   }
 #if !defined(SPHERE_BACK)
-  vec3 nout = normalize(lensTexel(true, p.xy).yzw);
+  vec3 nout = normalize(back_texel.yzw);
 #endif
   vec3 out_dir = dot(d, nout) > 0.0 ? refract(d, -nout, eta) : vec3(0.0);
   if (out_dir == vec3(0.0)) {
