@@ -86,7 +86,7 @@ void main() {
 #if defined(REFINE) && defined(LENS)
   // Where the seen channel's search succeeded on a surface (not the sky), its ray point there: it lies on the
   // map's depth surface within the search's tolerance, where the seen map's bilinear sample errs between texels
-  // (positions are not affine across a perspective image: arcminutes in the burning lens's 130-150 deg maps).
+  // (positions are not affine across a perspective image: up to ~0.4' in the burning lens's 130-150 deg maps).
   vec4 seen = texture(u_seen_map, st_seen);
   if (refine_seen_ok && seen.w > 0.999) seen.xyz = refine_seen;
 #elif defined(REFINE)
