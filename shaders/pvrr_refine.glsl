@@ -242,6 +242,19 @@ bool sphereHit(vec3 o, vec3 d, float c, float z0, out float t, out vec3 n) {
   return disc >= 0.0 && den != 0.0 && w > 0.0;
 }
 
+// OUTLINE_ELLIPSE: the lens's outline is an ellipse or a circle, tested in closed form (as cad::Outline::contains)
+// in place of the outline mask's bilinear read (two a fragment; the mask's threshold also rounds the outline to
+// its texels).
+#if defined(OUTLINE_ELLIPSE)
+uniform vec4 u_ellipse;  // the outline's centre (lens frame xy, metres) and 1 / its half width and half height
+bool inLensOutline(vec2 xy) {
+  vec2 q = (xy - u_ellipse.xy) * u_ellipse.zw;
+  return dot(q, q) <= 1.0;
+}
+#else
+bool inLensOutline(vec2 xy) { return inOutline(xy); }
+#endif
+
 // The front surface's height at local xy.
 float frontHeight(vec2 xy) {
 #if defined(SPHERE_FRONT)
@@ -263,10 +276,10 @@ void refineLensEntry(vec3 view) {
   vec3 n;
   if (!sphereHit(x, v, u_spheres.x, u_spheres.y, t, n)) return;
   vec3 e = x + t * v;
-  if (!inOutline(e.xy)) return;
+  if (!inLensOutline(e.xy)) return;
 #else
   vec3 e = entryPoint(x, v, false);
-  if (!inOutline(e.xy)) return;
+  if (!inLensOutline(e.xy)) return;
   vec3 n = normalize(lensTexel(false, e.xy).yzw);
 #endif
   if (dot(v, n) >= 0.0) return;
@@ -300,7 +313,7 @@ vec2 refinedLensST(int k, vec2 st_interpolated) {
     refine_tir = true;
     return st_interpolated;
   }
-  if (!inOutline(p.xy)) {  // through the rim: absorbed in the tracer
+  if (!inLensOutline(p.xy)) {  // through the rim: absorbed in the tracer
     refine_fell_back = true;
     return st_interpolated;
   }

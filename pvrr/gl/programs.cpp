@@ -75,6 +75,7 @@ const Program& Programs::pvrr(bool lens, size_t channels, bool rgb, bool planes,
     d.push_back("#define REFINE " + std::to_string(refine));
     if (spheres & 1) d.push_back("#define SPHERE_FRONT");
     if (spheres & 2) d.push_back("#define SPHERE_BACK");
+    if (spheres & 4) d.push_back("#define OUTLINE_ELLIPSE");
   }
   return planes ? planesVariant("element.vert", "element_pvrr.frag", d) : built("element.vert", "element_pvrr.frag", d);
 }

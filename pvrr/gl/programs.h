@@ -43,7 +43,8 @@ class Programs {
   // whose fragments search their exact rays in its maps with that many secant steps (REFINE,
   // shaders/pvrr_refine.glsl): a mirror's reflected ray, or each of a lens's channels' exit rays.
   // spheres (a refined lens): bit 0 its front, bit 1 its back is a sphere or plane, met in closed form
-  // (SPHERE_FRONT, SPHERE_BACK).
+  // (SPHERE_FRONT, SPHERE_BACK); bit 2 its outline is an ellipse or circle, tested in closed form
+  // (OUTLINE_ELLIPSE).
   const Program& pvrr(bool lens, size_t channels, bool rgb, bool planes, int refine = 0, int spheres = 0) const;
   // Distance-impostor elements (shaders/element_impostor.frag): a mirror, or a lens with one or three
   // wavelengths; cube_elements > 0: searches that meet a mirror in a cube go on in its cubes (CUBE_ELEMENTS).

@@ -42,8 +42,9 @@ bool usesTraced(const PatchView& pv, const VertexRay& r) {
 }
 
 // A refined lens's surfaces that are spheres or planes (bit 0 the front, bit 1 the back), met in closed form in
-// the shader (SPHERE_FRONT, SPHERE_BACK); *u: their curvatures and vertex heights (u_spheres).
-int refineSpheres(const Element& el, glm::vec4* u) {
+// the shader (SPHERE_FRONT, SPHERE_BACK); *u: their curvatures and vertex heights (u_spheres). Bit 2: its
+// outline is an ellipse or a circle (OUTLINE_ELLIPSE), *ellipse its centre and inverse half axes (u_ellipse).
+int refineSpheres(const Element& el, glm::vec4* u, glm::vec4* ellipse) {
   int bits = 0;
   double c = 0;
   if (el.lens.front->sphereCurvature(&c)) {
@@ -55,6 +56,12 @@ int refineSpheres(const Element& el, glm::vec4* u) {
     bits |= 2;
     (*u)[2] = float(c);
     (*u)[3] = float(el.lens.back->zVertex());
+  }
+  const cad::Outline& o = el.lens.outline;
+  if (o.shape() == cad::Outline::Shape::Ellipse || o.shape() == cad::Outline::Shape::Circle) {
+    bits |= 4;
+    const double a = 0.5 * o.width(), b = o.shape() == cad::Outline::Shape::Circle ? a : 0.5 * o.height();
+    *ellipse = glm::vec4(float(o.centre().x), float(o.centre().y), float(1.0 / a), float(1.0 / b));
   }
   return bits;
 }
@@ -381,8 +388,8 @@ void PvrrPass::drawPvrrElement(const ElementFrame& f, size_t first_slot, const P
   // scenes have them: never more than three channels), the planes variant.
   const bool rgb = rgbLens(el, f);
   const bool refined = refine_skip.size() > size_t(f.element) && refine_skip[size_t(f.element)].empty();
-  glm::vec4 spheres_uniform(0.0f);
-  const int spheres = refined && lens ? refineSpheres(el, &spheres_uniform) : 0;
+  glm::vec4 spheres_uniform(0.0f), ellipse_uniform(0.0f);
+  const int spheres = refined && lens ? refineSpheres(el, &spheres_uniform, &ellipse_uniform) : 0;
   const Program& p =
       ctx.programs.pvrr(lens, channels, rgb, cam.planes, refined ? ctx.scene.render.refine : 0, spheres);
   p.use();
@@ -410,7 +417,8 @@ void PvrrPass::drawPvrrElement(const ElementFrame& f, size_t first_slot, const P
   }
   const size_t sets = channels > 1 ? (channels + 2) / 3 : 1;
   if (refined) setRefinement(p, f, seen_c);
-  if (spheres) p.set("u_spheres", spheres_uniform);
+  if (spheres & 3) p.set("u_spheres", spheres_uniform);
+  if (spheres & 4) p.set("u_ellipse", ellipse_uniform);
   for (size_t v = 0; v < f.views.size(); ++v) {
     const PatchView& pv = f.views[v];
     const Framebuffer& map = *maps[first_slot + v];

@@ -227,7 +227,8 @@ TEST_P(RefineTest, ShippedMirrorsFromTheirFiles) {
 // searched in the lens's map: the spectacle lens (one channel, the whole picture), the reading lens (RGB
 // dispersion: three exit rays a fragment, the seen point the d line's), the progressive lens (a NURBS back
 // surface), the burning lens (RGB, 5 x 5 patches with 130-150 deg maps, some drawn traced) and the spectacle
-// lens with an aspheric front (the entry found in the height map rather than in closed form) at 160 x 120,
+// lens with an aspheric front and a rectangular outline (the entry found in the height map, the outline in
+// its mask, rather than in closed form) at 160 x 120,
 // against the reference: at least as close as unrefined in median and p95 and far closer in median; each lens
 // fragment counted once, refined or fallen back; off draws the unrefined pixels.
 TEST_P(RefineTest, ShippedLensesMatchTheReference) {
@@ -238,14 +239,17 @@ TEST_P(RefineTest, ShippedLensesMatchTheReference) {
     const char* file;
     std::vector<std::string> set;
   };
-  // The shipped lenses' fronts are spheres (met in closed form); the aspheric variant's front is met in its
-  // height map (as the progressive lens's NURBS back).
+  // The shipped lenses' fronts are spheres (met in closed form) and their outlines ellipses or circles (tested in
+  // closed form); the variant's aspheric front is met in its height map (as the progressive lens's NURBS back)
+  // and its rounded rectangle tested in the outline mask.
   const Case cases[] = {{"spectacle-lens", "spectacle-lens", {}},
                         {"reading-lens", "reading-lens", {}},
                         {"progressive-lens", "progressive-lens", {}},
                         {"burning-lens", "burning-lens", {}},
-                        {"spectacle-lens, aspheric front", "spectacle-lens",
-                         {"elements[0].front.type=\"asphere\"", "elements[0].front.conic=-0.5"}}};
+                        {"spectacle-lens, aspheric front, rectangle", "spectacle-lens",
+                         {"elements[0].front.type=\"asphere\"", "elements[0].front.conic=-0.5",
+                          "elements[0].outline={\"shape\": \"rectangle\", \"width\": 0.05, \"height\": 0.04, "
+                          "\"corner_radius\": 0.008}"}}};
   for (const Case& c : cases) {
     const std::string name = c.name;
     const std::string path = std::string(PVRR_SOURCE_DIR) + "/models/" + c.file + ".json";
