@@ -2,6 +2,7 @@
 // derivatives in numerically stable forms (no R - sqrt(R^2 - r^2) cancellation).
 #include "cad/sag.h"
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -38,6 +39,10 @@ class PlaneSag final : public SagSurface {
     return std::make_shared<PlaneSag>(outline(), z);
   }
   std::string describe() const override { return "plane"; }
+  bool sphereCurvature(double* c) const override {
+    *c = 0;
+    return true;
+  }
 };
 
 // Z = f(r^2) with f(rho) = c rho / (1 + sqrt(1 - K rho)) + sum_i a_i rho^(i+2), K = (1 + k) c^2.
@@ -82,6 +87,12 @@ class ConicSag final : public SagSurface {
 
   std::shared_ptr<const SagSurface> withVertex(double z) const override {
     return std::make_shared<ConicSag>(outline(), z, c_, k_, a_, sphere_);
+  }
+
+  bool sphereCurvature(double* c) const override {
+    if (k_ != 0 || std::any_of(a_.begin(), a_.end(), [](double x) { return x != 0; })) return false;
+    *c = c_;
+    return true;
   }
 
   std::string describe() const override {

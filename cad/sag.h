@@ -31,6 +31,9 @@ class SagSurface : public Surface {
 
   // The same shape with its vertex moved to z_vertex (lens back surfaces are built this way).
   virtual std::shared_ptr<const SagSurface> withVertex(double z_vertex) const = 0;
+  // A sphere's (or a plane's) curvature c = 1/R (0: a plane), for ray intersections in closed form:
+  // c (x^2 + y^2 + Z^2) = 2 Z; false for any other shape.
+  virtual bool sphereCurvature(double* c) const { return false; }
 
   const Outline& outline() const { return outline_; }
   double zVertex() const { return z_vertex_; }

@@ -9,8 +9,8 @@
 //                More than three channels: one additive draw per set of three (pvrr/gl/pvrr_pass.cpp).
 //   LENS         the element is a lens (transmission) rather than a mirror (reflection)
 //   NO_SEEN_POINTS  colour only: the seen-point maps are not read (RendererOptions::seen_points off)
-//   REFINE n     a mirror (CHANNELS 1) whose fragments search their exact reflected ray in the map, n secant
-//                steps (render.refine; pvrr_refine.glsl)
+//   REFINE n     fragments that search their exact ray in the map, n secant steps (render.refine;
+//                pvrr_refine.glsl): a mirror's reflected ray (CHANNELS 1), or a lens's exit ray per channel (LENS)
 #include "element_inputs.glsl"
 uniform sampler2D u_map;         // first pass colour (linear)
 uniform sampler2D u_seen_map;    // first pass seen points, relative to the map's camera origin (LINEAR)
@@ -25,10 +25,11 @@ vec2 mapST(vec3 stq) { return min(stq.xy / stq.z * u_st_scale, u_st_max); }
 #include "outputs.glsl"
 #include "shading.glsl"
 #include "optics.glsl"
+#include "lens_march.glsl"
 #include "pvrr_refine.glsl"
 
 void main() {
-#if defined(REFINE)
+#if defined(REFINE) && !defined(LENS)
   refineDerivatives();
 #endif
   vec3 n = normalize(v_normal);
@@ -47,7 +48,24 @@ void main() {
     weight = vec3(fresnelConductor(cos_i, u_metal_n.r, u_metal_k.r), fresnelConductor(cos_i, u_metal_n.g, u_metal_k.g),
                   fresnelConductor(cos_i, u_metal_n.b, u_metal_k.b));
 #endif
-#if CHANNELS == 3 && defined(RGB_CHANNELS)
+#if defined(REFINE) && defined(LENS)
+  // Each channel's exact exit ray searched in the map (pvrr_refine.glsl); the seen point follows u_seen_channel's.
+  refineLensEntry(view);
+  vec2 st0 = refinedLensST(0, mapST(v_st0));
+#if CHANNELS == 3
+  vec2 st1 = refinedLensST(1, mapST(v_st1)), st2 = refinedLensST(2, mapST(v_st2));
+  vec2 st_seen = u_seen_channel == 0 ? st0 : u_seen_channel == 1 ? st1 : st2;
+#if defined(RGB_CHANNELS)
+  vec3 c = vec3(v_w0.r * texture(u_map, st0).r, v_w1.g * texture(u_map_g, st1).r, v_w2.b * texture(u_map_b, st2).r);
+#else
+  vec3 c = v_w0 * texture(u_map, st0).rgb + v_w1 * texture(u_map, st1).rgb + v_w2 * texture(u_map, st2).rgb;
+#endif
+#else
+  vec2 st_seen = st0;
+  vec3 c = v_w0 * texture(u_map, st0).rgb;
+#endif
+  refineLensCount();
+#elif CHANNELS == 3 && defined(RGB_CHANNELS)
   vec3 c = vec3(v_w0.r * texture(u_map, mapST(v_st0)).r, v_w1.g * texture(u_map_g, mapST(v_st1)).r,
                 v_w2.b * texture(u_map_b, mapST(v_st2)).r);
 #else
@@ -65,7 +83,13 @@ void main() {
 #if defined(NO_SEEN_POINTS)
   vec4 seen = vec4(0.0);
 #else
-#if defined(REFINE)
+#if defined(REFINE) && defined(LENS)
+  // Where the seen channel's search succeeded on a surface (not the sky), its ray point there: it lies on the
+  // map's depth surface within the search's tolerance, where the seen map's bilinear sample errs between texels
+  // (positions are not affine across a perspective image: up to ~0.4' in the burning lens's 130-150 deg maps).
+  vec4 seen = texture(u_seen_map, st_seen);
+  if (refine_seen_ok && seen.w > 0.999) seen.xyz = refine_seen;
+#elif defined(REFINE)
   vec4 seen = texture(u_seen_map, st0);
 #else
   vec4 seen = texture(u_seen_map, mapST(v_st_seen));

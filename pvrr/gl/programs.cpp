@@ -63,7 +63,7 @@ const Program& Programs::envmap(bool lens) const {
               : built("element.vert", "element_envmap.frag", {});
 }
 
-const Program& Programs::pvrr(bool lens, size_t channels, bool rgb, bool planes, int refine) const {
+const Program& Programs::pvrr(bool lens, size_t channels, bool rgb, bool planes, int refine, int spheres) const {
   std::vector<std::string> d = {channels > 1 ? "#define CHANNELS 3" : "#define CHANNELS 1"};
   if (lens) d.push_back("#define LENS");
   if (rgb) d.push_back("#define RGB_CHANNELS");
@@ -73,6 +73,9 @@ const Program& Programs::pvrr(bool lens, size_t channels, bool rgb, bool planes,
     d.push_back("#extension GL_ARB_shader_atomic_counters : require");
     d.push_back("#extension GL_ARB_texture_gather : require");
     d.push_back("#define REFINE " + std::to_string(refine));
+    if (spheres & 1) d.push_back("#define SPHERE_FRONT");
+    if (spheres & 2) d.push_back("#define SPHERE_BACK");
+    if (spheres & 4) d.push_back("#define OUTLINE_ELLIPSE");
   }
   return planes ? planesVariant("element.vert", "element_pvrr.frag", d) : built("element.vert", "element_pvrr.frag", d);
 }

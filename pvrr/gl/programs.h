@@ -45,10 +45,13 @@ class Programs {
   // Elements in envmap mode: a mirror, or a lens (LENS, the "refraction vectors" baseline).
   const Program& envmap(bool lens) const;
   // A pvrr element: its channels in one draw (1) or in sets of three (more: CHANNELS 3), a lens (LENS), with
-  // RGB dispersion (RGB_CHANNELS: its maps are planes); planes: drawn into a planes map. refine > 0: a mirror
+  // RGB dispersion (RGB_CHANNELS: its maps are planes); planes: drawn into a planes map. refine > 0: an element
   // whose fragments search their exact rays in its maps with that many secant steps (REFINE,
-  // shaders/pvrr_refine.glsl).
-  const Program& pvrr(bool lens, size_t channels, bool rgb, bool planes, int refine = 0) const;
+  // shaders/pvrr_refine.glsl): a mirror's reflected ray, or each of a lens's channels' exit rays.
+  // spheres (a refined lens): bit 0 its front, bit 1 its back is a sphere or plane, met in closed form
+  // (SPHERE_FRONT, SPHERE_BACK); bit 2 its outline is an ellipse or circle, tested in closed form
+  // (OUTLINE_ELLIPSE).
+  const Program& pvrr(bool lens, size_t channels, bool rgb, bool planes, int refine = 0, int spheres = 0) const;
   // Distance-impostor elements (shaders/element_impostor.frag): a mirror, or a lens with one or three
   // wavelengths; cube_elements > 0: searches that meet a mirror in a cube go on in its cubes (CUBE_ELEMENTS).
   // lens_in_cubes: the scene's one lens is drawn in the other elements' cubes and refracted through there.

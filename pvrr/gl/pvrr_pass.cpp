@@ -16,8 +16,10 @@ namespace {
 
 // The texture units of an element's pvrr draw: its patch's map, the map's seen points, and the G and B planes of
 // an RGB map (R on kMapUnit). A refined mirror (never an RGB element: pvrr_refine.glsl) reads its surface maps
-// and its map's depth on impostor_maps.h's units.
+// and its map's depth on impostor_maps.h's units; a refined lens its map's depth there too, and its refractor
+// height maps after it (kRefineLensUnit: the planes take kPlaneUnitG and the next).
 constexpr int kMapUnit = 0, kSeenMapUnit = 1, kPlaneUnitG = 2;
+constexpr int kRefineLensUnit = kRefineDepthUnit + 1;
 
 // A serial number for every first pass rendered in the process (FrameCache::maps_serial).
 uint64_t nextFirstPassSerial() {
@@ -37,6 +39,31 @@ bool sameChannels(const std::vector<ChannelSpec>& a, const std::vector<ChannelSp
 // ray only in a patch drawn traced (a neighbouring patch that shares the vertex draws it from its map).
 bool usesTraced(const PatchView& pv, const VertexRay& r) {
   return r.traced && (r.status == VertexStatus::Tir || pv.draw_traced);
+}
+
+// A refined lens's surfaces that are spheres or planes (bit 0 the front, bit 1 the back), met in closed form in
+// the shader (SPHERE_FRONT, SPHERE_BACK); *u: their curvatures and vertex heights (u_spheres). Bit 2: its
+// outline is an ellipse or a circle (OUTLINE_ELLIPSE), *ellipse its centre and inverse half axes (u_ellipse).
+int refineSpheres(const Element& el, glm::vec4* u, glm::vec4* ellipse) {
+  int bits = 0;
+  double c = 0;
+  if (el.lens.front->sphereCurvature(&c)) {
+    bits |= 1;
+    (*u)[0] = float(c);
+    (*u)[1] = float(el.lens.front->zVertex());
+  }
+  if (el.lens.back->sphereCurvature(&c)) {
+    bits |= 2;
+    (*u)[2] = float(c);
+    (*u)[3] = float(el.lens.back->zVertex());
+  }
+  const cad::Outline& o = el.lens.outline;
+  if (o.shape() == cad::Outline::Shape::Ellipse || o.shape() == cad::Outline::Shape::Circle) {
+    bits |= 4;
+    const double a = 0.5 * o.width(), b = o.shape() == cad::Outline::Shape::Circle ? a : 0.5 * o.height();
+    *ellipse = glm::vec4(float(o.centre().x), float(o.centre().y), float(1.0 / a), float(1.0 / b));
+  }
+  return bits;
 }
 
 }  // namespace
@@ -361,7 +388,10 @@ void PvrrPass::drawPvrrElement(const ElementFrame& f, size_t first_slot, const P
   // scenes have them: never more than three channels), the planes variant.
   const bool rgb = rgbLens(el, f);
   const bool refined = refine_skip.size() > size_t(f.element) && refine_skip[size_t(f.element)].empty();
-  const Program& p = ctx.programs.pvrr(lens, channels, rgb, cam.planes, refined ? ctx.scene.render.refine : 0);
+  glm::vec4 spheres_uniform(0.0f), ellipse_uniform(0.0f);
+  const int spheres = refined && lens ? refineSpheres(el, &spheres_uniform, &ellipse_uniform) : 0;
+  const Program& p =
+      ctx.programs.pvrr(lens, channels, rgb, cam.planes, refined ? ctx.scene.render.refine : 0, spheres);
   p.use();
   p.set("u_view_proj", toFloat(cam.view_proj));
   p.set("u_offset", glm::vec3(anchor - cam.origin));
@@ -372,7 +402,6 @@ void PvrrPass::drawPvrrElement(const ElementFrame& f, size_t first_slot, const P
   p.set("u_map_b", kPlaneUnitG + 1);
   setLights(p, ctx.scene, cam.origin);
   setElementMaterial(p, el, f.element);
-  if (refined) setRefinement(p, f);
   // The seen point's channel: the one nearest the d line unless asked (the tracer's seen point is the d
   // line's ray; with RGB channels that is G exactly, with N spectral samples the nearest bin midpoint).
   size_t seen_c = channels / 2;
@@ -387,6 +416,9 @@ void PvrrPass::drawPvrrElement(const ElementFrame& f, size_t first_slot, const P
       if (off(c) < off(seen_c)) seen_c = c;
   }
   const size_t sets = channels > 1 ? (channels + 2) / 3 : 1;
+  if (refined) setRefinement(p, f, seen_c);
+  if (spheres & 3) p.set("u_spheres", spheres_uniform);
+  if (spheres & 4) p.set("u_ellipse", ellipse_uniform);
   for (size_t v = 0; v < f.views.size(); ++v) {
     const PatchView& pv = f.views[v];
     const Framebuffer& map = *maps[first_slot + v];
@@ -412,10 +444,10 @@ void PvrrPass::drawPvrrElement(const ElementFrame& f, size_t first_slot, const P
     const glm::vec2 texels{float(region[0]), float(region[1])}, size{float(map.width()), float(map.height())};
     p.set("u_st_scale", texels / size);
     p.set("u_st_max", (texels - 0.5f) / size);
-    if (refined) setRefinementView(p, pv, map, map_side[first_slot + v]);
+    if (refined) setRefinementView(p, f.element, pv, map, map_side[first_slot + v]);
     for (size_t set = 0; set < sets; ++set) {
       MeshBuffers& mb = ctx.meshes.slot();
-      if (refined)
+      if (refined && !lens)
         uploadRefinedPatch(mb, f, pv, anchor);
       else
         uploadPatch(mb, f, pv, anchor, set, seen_c);
@@ -564,6 +596,7 @@ std::string PvrrPass::drawElements(RenderMode, const PassCamera& eye, const Fram
 void PvrrPass::prepareRefinement() {
   const int steps = ctx.scene.render.refine;
   refine_skip.assign(frames.size(), "off");
+  refine_lens = false;
   if (steps <= 0) return;
   bool any = false;
   for (size_t e = 0; e < frames.size(); ++e) {
@@ -571,7 +604,12 @@ void PvrrPass::prepareRefinement() {
     if (!refine_skip[e].empty()) continue;
     any = true;
     if (!surface_maps) surface_maps = std::make_unique<ImpostorMaps>(ctx.scene, ctx.options, ctx.max_texture_units);
-    surface_maps->updateMirrorMaps(e);
+    if (ctx.scene.elements[e].type == ElementType::Lens) {
+      surface_maps->updateLensMaps(e);
+      refine_lens = true;
+    } else {
+      surface_maps->updateMirrorMaps(e);
+    }
   }
   if (!any) return;
   if (!refine_sampler) {
@@ -590,7 +628,7 @@ void PvrrPass::prepareRefinement() {
   if (!refine_counters) {
     glGenBuffers(1, &refine_counters);
     glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, refine_counters);
-    glBufferData(GL_ATOMIC_COUNTER_BUFFER, 2 * sizeof(GLuint), nullptr, GL_DYNAMIC_READ);
+    glBufferData(GL_ATOMIC_COUNTER_BUFFER, 3 * sizeof(GLuint), nullptr, GL_DYNAMIC_READ);
   }
   glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, refine_counters);
   glClearBufferData(GL_ATOMIC_COUNTER_BUFFER, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
@@ -618,10 +656,24 @@ const PvrrPass::EdgeMidpoints& PvrrPass::edgeMidpoints(const ElementFrame& f) co
   return c.mids;
 }
 
-// The mirror's surface maps on the impostor mode's units (ImpostorMaps::setMirrorMaps; only the normal is read), then
-// the depth of the patch view's map; all filtered linearly.
-void PvrrPass::setRefinement(const Program& p, const ElementFrame& f) const {
-  surface_maps->setMirrorMaps(p, size_t(f.element));
+// A mirror: its surface maps on the impostor mode's units (ImpostorMaps::setMirrorMaps; only the normal is read),
+// then the depth of the patch view's map; all filtered linearly. A lens: the map's depth there, its refractor
+// height maps after it (read with texelFetch), the glass's index at each channel's wavelength and the channel
+// that gives the seen point.
+void PvrrPass::setRefinement(const Program& p, const ElementFrame& f, size_t seen_channel) const {
+  const Element& el = ctx.scene.elements[size_t(f.element)];
+  if (el.type == ElementType::Lens) {
+    surface_maps->setLensMaps(p, size_t(f.element), kRefineLensUnit);
+    glm::vec3 index(0.0f);
+    for (size_t c = 0; c < 3 && c < f.channels.size(); ++c) {
+      const double wl = f.channels[c].wavelength_nm > 0 ? f.channels[c].wavelength_nm : kLineD_nm;
+      index[int(c)] = float(el.dispersion.index(wl));  // as the vertex stage refracts channel c
+    }
+    p.set("u_channel_index", index);
+    p.set("u_seen_channel", int(seen_channel));
+  } else {
+    surface_maps->setMirrorMaps(p, size_t(f.element));
+  }
   p.set("u_map_depth", kRefineDepthUnit);
   p.set("u_count", refine_counting ? 1 : 0);
 }
@@ -630,13 +682,17 @@ void PvrrPass::unsetRefinement() const {
   for (int unit = kElementMapsUnit; unit <= kRefineDepthUnit; ++unit) glBindSampler(GLuint(unit), 0);
 }
 
-void PvrrPass::setRefinementView(const Program& p, const PatchView& pv, const Framebuffer& map, int side) const {
+void PvrrPass::setRefinementView(const Program& p, int element, const PatchView& pv, const Framebuffer& map,
+                                  int side) const {
   const bool on = refineViewSkipReason(pv).empty();
   p.set("u_refine", on ? 1 : 0);
   if (!on) return;
   glActiveTexture(GLenum(GL_TEXTURE0 + kRefineDepthUnit));
   glBindTexture(GL_TEXTURE_2D, map.depthTexture());
-  for (int unit = kElementMapsUnit; unit <= kRefineDepthUnit; ++unit) glBindSampler(GLuint(unit), refine_sampler);
+  // A lens's planes lie on the surface maps' units: only the depth takes the sampler.
+  const bool lens = ctx.scene.elements[size_t(element)].type == ElementType::Lens;
+  for (int unit = lens ? kRefineDepthUnit : kElementMapsUnit; unit <= kRefineDepthUnit; ++unit)
+    glBindSampler(GLuint(unit), refine_sampler);
   p.set("u_map_vp", toFloat(relativeViewProj(pv.volume.projection, pv.volume.view, pv.volume.eye)));
   const Mat4& P = pv.volume.projection;
   p.set("u_depth_lin", glm::vec3(float(P[2][2]), float(P[3][2]), float(pv.volume.near_m)));
@@ -655,7 +711,7 @@ std::string PvrrPass::finishedNote(const std::string& note) const {
   const std::string skipped = refinementSkips(&any);
   std::string refine = "refine (" + std::to_string(steps) + " steps):";
   if (any) {
-    GLuint n[2] = {0, 0};
+    GLuint n[3] = {0, 0, 0};
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_ATOMIC_COUNTER_BARRIER_BIT);
     glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, refine_counters);
     glGetBufferSubData(GL_ATOMIC_COUNTER_BUFFER, 0, sizeof(n), n);
@@ -669,6 +725,8 @@ std::string PvrrPass::finishedNote(const std::string& note) const {
     refine += " " + std::to_string(drawn) + " fragments drawn, " + std::to_string(n[0]) +
               " kept the interpolated coordinate (search ended off the map's surface), " + std::to_string(n[1]) +
               " kept it where the view ray missed the exact surface";
+    if (refine_lens)
+      refine += ", " + std::to_string(n[2]) + " kept it where a lens's exact path is totally reflected inside";
   }
   if (!skipped.empty()) refine += std::string(any ? ";" : "") + " not refined:" + skipped;
   return note.empty() ? refine : note + "; " + refine;

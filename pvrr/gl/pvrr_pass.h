@@ -52,9 +52,9 @@ class PvrrPass : public ModePass {
   // Per-fragment refinement (render.refine): which elements refine (refine_skip), their surface maps, the
   // fragment counters zeroed; and what the counters say once the frame's draws are done.
   void prepareRefinement();
-  void setRefinement(const Program& p, const ElementFrame& f) const;
+  void setRefinement(const Program& p, const ElementFrame& f, size_t seen_channel) const;
   void unsetRefinement() const;
-  void setRefinementView(const Program& p, const PatchView& pv, const Framebuffer& map, int side) const;
+  void setRefinementView(const Program& p, int element, const PatchView& pv, const Framebuffer& map, int side) const;
   std::string refinementSkips(bool* any) const;
   void uploadRefinedPatch(MeshBuffers& mb, const ElementFrame& f, const PatchView& pv, const Vec3& anchor) const;
   // The exact surface point (local frame) at the parameter-domain midpoint of each edge of refined element f's
@@ -74,10 +74,13 @@ class PvrrPass : public ModePass {
   uint64_t first_pass_serial = 0;
   unsigned mask_vao = 0, mask_vbo = 0;  // closeUnreadTexels' quads
   std::vector<std::string> refine_skip;  // per element: why it is not refined, "" when it is
-  unsigned refine_counters = 0;          // the second pass's failed and missed fragments (shaders/pvrr_refine.glsl)
+  unsigned refine_counters = 0;          // the second pass's failed, missed and (lenses) totally reflected
+                                         // fragments (shaders/pvrr_refine.glsl)
+  bool refine_lens = false;              // some refined element is a lens (its count in the note)
   unsigned refine_sampler = 0;           // linear filtering of the depth maps and the surface maps
   std::vector<unsigned> refine_queries;  // per element: its second-pass fragments (refined elements)
   std::unique_ptr<ImpostorMaps> surface_maps;  // the refined mirrors' surface maps (pvrr/impostor/surface_map.h)
+                                               // and lenses' refractor height maps (lens_height_map.h)
   bool refine_counting = false;          // drawing the second pass (counted), not a nested pass
   struct RefineMidpoints {
     cad::SurfacePtr surface;  // what they were computed for (held: never a reused address)

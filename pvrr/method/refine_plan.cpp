@@ -7,8 +7,9 @@ namespace pvrr {
 std::string refineSkipReason(const Scene& scene, const ElementFrame& f, int steps) {
   if (steps <= 0) return "off";
   const Element& el = scene.elements[size_t(f.element)];
-  if (el.type == ElementType::Lens) return "a lens: its exit rays are not refined";
-  if (f.rays.size() != 1) return "more than one channel";
+  // A lens refines each channel of its one draw (up to three); more are drawn in additive sets of three.
+  if (el.type == ElementType::Lens && f.rays.size() > 3) return "more than three channels (additive sets)";
+  if (el.type != ElementType::Lens && f.rays.size() != 1) return "more than one channel";
   if (beyondDepth(scene, f)) return "drawn dark at the depth limit";
   std::string reason;
   for (const PatchView& pv : f.views) {

@@ -14,8 +14,9 @@ namespace pvrr {
 constexpr double kExactFitRad = 1e-7;
 
 // Why element `f` (of `scene`) is not refined with `steps` secant steps, or "" when it is: off (steps 0), a
-// lens (its exit rays are not refined), more than one channel, drawn dark at the depth limit, or every patch
-// view exact or unrefinable (refineView).
+// mirror with more than one channel or a lens with more than three (spectral sets drawn additively), drawn dark
+// at the depth limit, or every patch view exact or unrefinable (refineView). A lens refines each of its
+// channels' exact exit rays (shaders/pvrr_refine.glsl).
 std::string refineSkipReason(const Scene& scene, const ElementFrame& f, int steps);
 
 // Why patch view pv is not refined, or "": exact already (kExactFitRad), or drawn from traced colours. A reversed

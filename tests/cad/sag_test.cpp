@@ -220,5 +220,23 @@ TEST(Sag, WithVertexShiftsOnlyZ) {
   EXPECT_EQ(makeSphere(1.2, kDisc)->withVertex(1)->describe(), "sphere R=1.2 m");
 }
 
+// sphereCurvature: spheres and planes only (pvrr refinement meets them in closed form), kept by withVertex; the
+// closed form c (x^2 + y^2 + Z^2) = 2 Z holds at the sag's points.
+TEST(Sag, SphereCurvatureOnlyForSpheresAndPlanes) {
+  double c = -1;
+  ASSERT_TRUE(makeSphere(-0.5, kDisc)->withVertex(-0.002)->sphereCurvature(&c));
+  EXPECT_EQ(c, -2.0);
+  ASSERT_TRUE(makePlane(kDisc)->sphereCurvature(&c));
+  EXPECT_EQ(c, 0.0);
+  EXPECT_TRUE(makeAsphere(0.5, 0.0, {}, kDisc)->sphereCurvature(&c));  // conic 0, no terms: a sphere
+  EXPECT_FALSE(makeAsphere(0.5, -0.5, {}, kDisc)->sphereCurvature(&c));
+  EXPECT_FALSE(makeAsphere(0.5, 0.0, {1e-3}, kDisc)->sphereCurvature(&c));
+  EXPECT_FALSE(makeToric(0.5, 0.7, 0.0, kDisc)->sphereCurvature(&c));
+  const SagSurfacePtr s = makeSphere(0.3, kDisc);
+  ASSERT_TRUE(s->sphereCurvature(&c));
+  const double x = 0.02, y = -0.01, Z = s->sag(x, y).z;
+  EXPECT_NEAR(c * (x * x + y * y + Z * Z), 2 * Z, 1e-15);
+}
+
 }  // namespace
 }  // namespace pvrr::cad
