@@ -13,6 +13,17 @@ namespace pvrr::gl {
 
 namespace {
 
+// The bound texture of `target`: linear filtering, clamped at its edges (along r too for a 3D texture),
+// one level.
+void linearClampedOneLevel(GLenum target) {
+  glTexParameteri(target, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(target, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(target, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(target, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  if (target == GL_TEXTURE_3D) glTexParameteri(target, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+  glTexParameteri(target, GL_TEXTURE_MAX_LEVEL, 0);
+}
+
 bool anyAmbientLight(const Scene& scene) {
   for (const Light& l : scene.lights)
     if (l.type == Light::Type::Ambient) return true;
@@ -109,12 +120,7 @@ AoFields::AoFields(const Scene& scene, int max_texture_units) : scene_(scene), u
   glTexImage3D(GL_TEXTURE_3D, 0, GL_RGBA8, GLsizei(row), GLsizei(n), GLsizei(n * fields_.size()), 0, GL_RGBA,
                GL_UNSIGNED_BYTE, texels.data());
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-  glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
-  glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAX_LEVEL, 0);
+  linearClampedOneLevel(GL_TEXTURE_3D);
   glBindTexture(GL_TEXTURE_3D, 0);
   volume_bytes_ = texels.size();
   // The ground maps: one R8 2D array, per field one layer per height.
@@ -137,11 +143,7 @@ AoFields::AoFields(const Scene& scene, int max_texture_units) : scene_(scene), u
     glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_R8, GLsizei(g), GLsizei(g), GLsizei(heights_.size() * fields_.size()), 0,
                  GL_RED, GL_UNSIGNED_BYTE, maps.data());
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAX_LEVEL, 0);
+    linearClampedOneLevel(GL_TEXTURE_2D_ARRAY);
     glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
     ground_bytes_ = maps.size();
   }
