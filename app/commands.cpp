@@ -25,7 +25,7 @@
 #include "pvrr/scene/scene_json.h"
 #include "pvrr/optics/spectrum.h"
 #include "pvrr/base/frame.h"
-#include "pvrr/method/caustic_mesh.h"
+#include "pvrr/method/reference_setup.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -231,25 +231,15 @@ RenderedFrame renderFrame(LoadedScene& ls, RenderMode mode, const std::string& g
   Scene& scene = ls.scene;
   if (mode == RenderMode::Raytrace) {
     RayScene rays(scene);
-    TraceOptions to;
-    to.max_depth = scene.render.max_depth;
-    to.dispersion = scene.render.dispersion;
-    to.spectral_samples = scene.render.spectral_samples;
-    // The caustic light of the lights with caustics on, once per render (docs/caustics.md).
-    FrameStages caustic_stage;
-    CausticPlanOptions po;
-    po.dispersion = scene.render.dispersion;
-    po.spectral_samples = scene.render.spectral_samples;
-    const std::optional<CausticLightField> caustics = 
-        referenceCaustics(rays, po, kReferenceCausticPhotons, caustic_stage);
-    if (caustics) to.caustics = &*caustics;
-    Tracer tracer(rays, to);
+    // The scene's options and the caustic light of the lights with caustics on, once per render.
+    const ReferenceSetup setup(rays);
+    Tracer tracer(rays, setup.options());
     Progress progress("ray tracing", 1.0);
     Frame f = tracer.render([&](double frac) { progress.update(frac); });
     progress.finish();
     static_cast<Frame&>(out) = std::move(f);  // with its stage "ray-trace"
-    if (caustics)
-      out.stages.stages.insert(out.stages.stages.begin(), caustic_stage.stages.begin(), caustic_stage.stages.end());
+    if (setup.hasCaustics())
+      out.stages.stages.insert(out.stages.stages.begin(), setup.stages().stages.begin(), setup.stages().stages.end());
     out.gl_backend = "none (CPU, Embree)";
     return out;
   }

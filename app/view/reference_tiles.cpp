@@ -11,6 +11,7 @@
 #include <cmath>
 
 #include "pvrr/base/image.h"
+#include "pvrr/method/reference_setup.h"
 #include "pvrr/trace/ray_scene.h"
 #include "pvrr/trace/tracer.h"
 
@@ -91,13 +92,13 @@ void ReferenceRun::traceAndMeasure() {
   prepareTracingThread();
   const auto t0 = std::chrono::steady_clock::now();
   allocate();
-  // The scene's own Embree scene and tracer, with the options pvrr render and compare give the reference.
+  // The scene's own Embree scene and tracer, set up as pvrr render and compare set up the reference: with the
+  // caustic light of the lights with caustics on (seconds before the first tile, on this thread; a cancel is
+  // heard after it).
   RayScene rays(*scene_);
-  TraceOptions to;
-  to.max_depth = scene_->render.max_depth;
-  to.dispersion = scene_->render.dispersion;
-  to.spectral_samples = scene_->render.spectral_samples;
-  const Tracer tracer(rays, to);
+  const ReferenceSetup setup(rays);
+  if (cancel_) return;
+  const Tracer tracer(rays, setup.options());
   const auto work = [this, &tracer] {
     try {
       traceTiles(tracer);

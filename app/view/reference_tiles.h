@@ -5,7 +5,8 @@
 // compare's heat map of it.
 //
 // Each pixel is Tracer::tracePixel at its centre, which is what Tracer::render computes (its packets give the
-// same exact primary hits), so the finished reference is compare's reference picture. The run holds a copy of
+// same exact primary hits), with the tracer set up as render and compare set it up (pvrr/method/reference_setup.h:
+// the caustic light of the lights with caustics on), so the finished reference is compare's reference picture. The run holds a copy of
 // the scene as it was (shared with whoever draws the mode's frame, app/view/seen_frames.h) and its own Embree
 // scene: the window's may move while it traces. The mode's frame may arrive while the tiles are traced; the
 // errors wait for it. Destroying a run cancels it (the threads stop after their current tile, or stop waiting)

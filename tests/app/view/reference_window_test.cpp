@@ -121,6 +121,39 @@ TEST(ViewReference, SpectaclesTurnedWithTheHeadMatchCompare) {
   fs::remove_all(dir);
 }
 
+// A light with caustics on: the live reference adds the caustic light as compare's reference does (the burning
+// lens's focal spot on the table, whose brightest pixels are several times the sun's irradiance), pixel for
+// pixel. Without it the spot's pixels differ by tens of codes and the lens passes the sun by Fresnel.
+TEST(ViewReference, CausticLightMatchesCompare) {
+  const fs::path dir = freshTestDir("view-reference-caustic");
+  const fs::path script = dir / "script.json", reference = dir / "reference.png", view = dir / "view.json",
+                 stats = dir / "stats.json", cmp = dir / "compare";
+  writeText(script, R"({"size": [160, 120], "events": [
+      {"at_frame": 1, "do": "reference"},
+      {"at_frame": 2, "do": "wipe", "x": 0},
+      {"at_frame": 3, "do": "screenshot", "file": ")" +
+                        reference.string() + R"("},
+      {"at_frame": 3, "do": "save_view", "file": ")" +
+                        view.string() + R"("},
+      {"at_frame": 4, "do": "quit"}]})");
+  CliResult r;
+  RUN_VIEW_OR_SKIP("models/burning-lens.json --script '" + script.string() + "' --stats '" + stats.string() + "'",
+                   &r);
+  ASSERT_EQ(r.code, 0) << r.err;
+  ASSERT_EQ(readJson(stats)["reference"]["state"], "done");
+  const CliResult c = runPvrr("compare '" + view.string() + "' --modes pvrr --frames 1 --out '" + cmp.string() + "'");
+  ASSERT_EQ(c.code, 0) << c.err;
+  const ImageRGB8 ref = readPng((cmp / "reference.png").string());
+  const ImageDiff d = compareImages(readPng(reference.string()), ref, kReferenceCodes);
+  EXPECT_EQ(d.failing_pixels, 0) << describe(d);
+  // The comparison covers the spot: compare's reference shows it (saturated pixels on the table).
+  int saturated = 0;
+  for (int y = 0; y < ref.height; ++y)
+    for (int x = 0; x < ref.width; ++x) saturated += ref.at(x, y)[0] == 255 && ref.at(x, y)[1] == 255;
+  EXPECT_GT(saturated, 0);
+  fs::remove_all(dir);
+}
+
 // The split line follows a drag that starts on it; a drag elsewhere turns the head, which makes the reference
 // another view's: it is discarded, saying why.
 TEST(ViewReference, DragMovesTheSplitLineOrTurnsTheHead) {
