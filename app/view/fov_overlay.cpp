@@ -157,11 +157,12 @@ void FovOverlay::draw(const Scene& scene, const SceneDesc& desc, const RayScene&
   if (index < 0 || size_t(index) >= scene.elements.size()) index = 0;
   const Mat4 pose = scene.elements.empty() ? Mat4(1.0) : scene.elements[size_t(index)].local_to_world;
   const bool ellipse = desc.vehicle && desc.vehicle->eye_ellipse && ellipse_choice_ != 0;
-  if (!traced_ || scene_build != build_ || element != asked_ || pose != pose_ || ellipse != ellipse_) {
+  if (!traced_ || scene_build != build_ || element != asked_ || pose != pose_ || ellipse != asked_ellipse_) {
     // Once per mirror pose (a turn of the element or a setting rebuilds the scene), not per frame.
     trace(scene, desc, rays, element);
     build_ = scene_build;
     asked_ = element;
+    asked_ellipse_ = ellipse;
     pose_ = pose;
   }
   const Mat4 view = ob.view();

@@ -52,6 +52,7 @@ class FovOverlay {
   int eye_samples_ = 0;   // eye positions traced (2 for the ocular points)
   int traces_ = 0;
   int build_ = -1, asked_ = -2, element_ = -1;  // the scene build and element traced for; the mirror used
+  bool asked_ellipse_ = false;                  // whether the eye ellipse was asked for (scene and checkbox)
   Mat4 pose_{0.0};
   std::string why_;  // why nothing is drawn (no vehicle, no mirror)
   struct Cell {
