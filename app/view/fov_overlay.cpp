@@ -217,17 +217,20 @@ void FovOverlay::panel() {
     ImGui::TextWrapped("nothing to show: %s", why_.c_str());
     return;
   }
-  if (has_ellipse_) {
-    // Offered where the scene has an eye ellipse (used unless turned off here).
-    bool ellipse = ellipse_;
-    if (ImGui::Checkbox("eye ellipse", &ellipse)) ellipse_choice_ = ellipse ? 1 : 0;
-    ImGui::SameLine();
-  }
-  if (ellipse_)
-    ImGui::Text("%d eye positions, %zu triangles, %d in view (left eye blue, right orange%s)", eye_samples_,
-                triangles_.size(), drawn_, per_sample_ ? "; per sample: a union is not one loop" : "");
-  else
+  if (!has_ellipse_) {
     ImGui::Text("%zu cells, %d in view (left eye blue, right orange, obstructed purple)", cells_.size(), drawn_);
+    return;
+  }
+  // Offered where the scene has an eye ellipse (used unless turned off here); what is shown on a line of its own.
+  bool ellipse = ellipse_;
+  if (ImGui::Checkbox("eye ellipse", &ellipse)) ellipse_choice_ = ellipse ? 1 : 0;
+  if (ellipse_)
+    ImGui::TextWrapped("%d eye positions, %zu triangles, %d in view (left eye blue, right orange; obstruction not "
+                       "shown%s)",
+                       eye_samples_, triangles_.size(), drawn_, per_sample_ ? "; filled per sample" : "");
+  else
+    ImGui::TextWrapped("the ocular points: %zu cells, %d in view (left eye blue, right orange, obstructed purple)",
+                       cells_.size(), drawn_);
 }
 
 nlohmann::json FovOverlay::stats() const {
