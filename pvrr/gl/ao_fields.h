@@ -45,20 +45,29 @@ class AoFields {
   bool active() const { return texture_ != 0; }
   // Binds the fields and sets program p's uniforms for a pass whose camera origin is `origin`.
   void bind(const Program& p, const Vec3& origin) const;
-  // How environment mesh m, whose box in world coordinates is `world_box`, is occluded now (the occluders'
-  // current motion): None when no other occluder's field reaches it (AoField::reach) or the fields are not
-  // active.
-  AoReceiver receiver(size_t m, const std::array<Vec3, 2>& world_box) const;
-  // Sets program p's uniforms for drawing environment mesh m, whose box in world coordinates is `world_box`:
-  // the fields that reach it (not its own occluder's), its ground maps' height.
-  void setReceiver(const Program& p, size_t m, const std::array<Vec3, 2>& world_box) const;
+  // How a draw of environment mesh m (or of the part of it whose box in world coordinates is `world_box`) is
+  // occluded now (the occluders' current motion): its variant and, per field, whether the field is weighted.
+  // `facing`: the one normal the shader uses over that part (a plane face, turned to the viewer), or null.
+  // With a normal, a field counts where its volume's occlusion for that normal, fade included, can reach
+  // kAoNegligible somewhere in the box (volumeBound); without, where the box is within the field's reach.
+  // None when no field counts or the fields are not active.
+  struct Draw {
+    AoReceiver kind = AoReceiver::None;
+    std::vector<float> reaches;  // per field: 1 counted, 0 not (its own occluder's: 0)
+    bool operator==(const Draw& o) const { return kind == o.kind && reaches == o.reaches; }
+  };
+  Draw receiver(size_t m, const std::array<Vec3, 2>& world_box, const Vec3* facing = nullptr) const;
+  // Sets program p's uniforms for such a draw of environment mesh m: the fields counted, its ground maps' height.
+  void setReceiver(const Program& p, size_t m, const Draw& d) const;
+  // The most occlusion field f's volume, fade included, casts at a point of world box `box` with unit normal n
+  // (world), its object where it is now: the largest grid value of the channels n reads over the cells the
+  // box's bounds in the field's frame touch, times the fade at the box's nearest point. Conservative.
+  double volumeBound(const AoField& f, const std::array<Vec3, 2>& box, const Vec3& n) const;
   // Notes the stage: the fields' count, size and precomputation time (once: "built"; later frames: "reused").
   void note(FrameStages& stages) const;
   const std::vector<AoField>& fields() const { return fields_; }
 
  private:
-  // The indices of the fields that reach mesh m (box: world), its own occluder's left out.
-  std::vector<int> reaching(size_t m, const std::array<Vec3, 2>& box) const;
 
   const Scene& scene_;
   std::vector<AoField> fields_;

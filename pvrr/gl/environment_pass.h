@@ -78,6 +78,18 @@ class EnvironmentPass {
   std::vector<bool> env_textured;  // per environment mesh: its material has a texture
   std::vector<std::array<Vec3, 2>> env_bounds;  // per environment mesh: its bounding box, relative to its anchor
   std::vector<Mat4> env_motion;  // per environment mesh: the Scene::meshMotion its buffers hold
+  // Per environment mesh, in a scene with ambient occlusion: its triangles grouped by plane (a faceted mesh of at
+  // most kMaxFaceGroups planes, such as a box's six faces), uploaded group after group, so that each part is
+  // drawn with the ambient occlusion its one normal needs (AoFields::receiver): a box face turned away from
+  // every car, or out of the reach of its occlusion, is drawn without. Empty: the mesh is one draw.
+  struct FaceGroup {
+    int first = 0, count = 0;  // its indices in the index buffer
+    Vec3 normal{0};            // the planes' normal, as uploaded
+    Vec3 point{0};             // a point of the plane, relative to the mesh's anchor
+    std::array<Vec3, 2> box;   // its vertices' bounding box, relative to the mesh's anchor
+  };
+  std::vector<std::vector<FaceGroup>> env_groups;
+  bool group_faces = false;  // the scene has ambient occlusion
   std::vector<Texture> textures;  // environment textures, in Scene::textures order
   const ShadowPass* shadows_ = nullptr;
   const CausticPass* caustics_ = nullptr;
