@@ -43,6 +43,8 @@ class AoFields {
   AoFields& operator=(const AoFields&) = delete;
 
   bool active() const { return texture_ != 0; }
+  // The texture unit of the fields (and of a pass's low-resolution occlusion image, on its GL_TEXTURE_2D target).
+  int unit() const { return unit_; }
   // Binds the fields and sets program p's uniforms for a pass whose camera origin is `origin`.
   void bind(const Program& p, const Vec3& origin) const;
   // How a draw of environment mesh m (or of the part of it whose box in world coordinates is `world_box`) is

@@ -159,6 +159,9 @@ bool EnvironmentPass::occludes(const std::vector<size_t>& moved) const {
 }
 
 EnvironmentPass::~EnvironmentPass() {
+  if (ao_fbo) glDeleteFramebuffers(1, &ao_fbo);
+  if (ao_image) glDeleteTextures(1, &ao_image);
+  if (ao_depth) glDeleteRenderbuffers(1, &ao_depth);
   for (auto& m : env_meshes) m.release();
   if (empty_vao) glDeleteVertexArrays(1, &empty_vao);
 }
@@ -215,7 +218,8 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
   glDepthFunc(reversed_depth ? GL_GREATER : GL_LESS);
   // The programs of the kinds of mesh the scene has, [ambient occlusion][faceted][textured], set up for this
   // pass when first drawn; a draw's ambient occlusion variant is chosen per mesh or face (AoFields::receiver).
-  const Program* kinds[3][2][2] = {};
+  const Program* kinds[4][2][2] = {};
+  glm::vec4 ao_image_map(0.0f);  // the occlusion image's coordinates (shaders/ambient_occlusion.glsl)
   auto program = [&](AoReceiver ao, bool faceted, bool textured) -> const Program& {
     const Program*& p = kinds[int(ao)][faceted][textured];
     if (p) return *p;
@@ -229,6 +233,10 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
     if (shadows_) shadows_->bind(*p, origin);
     if (caustics_) caustics_->bind(*p, origin);
     if (ao_) ao_->bind(*p, origin);
+    if (ao == AoReceiver::Screen) {
+      p->set("u_ao_image", ao_->unit());
+      p->set("u_ao_image_map", ao_image_map);
+    }
     glActiveTexture(GL_TEXTURE0);
     return *p;
   };
@@ -256,7 +264,15 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
     glCullFace(GL_BACK);
     glFrontFace(facingTrianglesWindCounterClockwise(vp) ? GL_CCW : GL_CW);
   }
-  bool culling = false;
+  // What to draw, in order: the meshes, or their faces (a plane's normal, turned to the viewer as the shader turns
+  // it), consecutive faces with the same ambient occlusion in one draw.
+  struct Part {
+    size_t m;
+    bool cull;
+    AoFields::Draw ao;
+    int first, count;
+  };
+  std::vector<Part> parts;
   CullCount count;
   const std::vector<std::array<Vec3, 2>> relative = boxes(origin);  // camera-relative
   for (const size_t m : drawOrder(relative, reversed_depth)) {
@@ -264,34 +280,104 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
     const bool cull = may_cull && mesh.closed_convex && near_clip.cannotOpen(relative[m][0], relative[m][1]);
     count.drawn += mesh.closed_convex;
     count.culled += cull;
-    if (cull != culling) {
-      cull ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
-      culling = cull;
-    }
     if (!ao_ || env_groups[m].empty()) {
-      drawPart(m, ao_ ? ao_->receiver(m, worldBox(m)) : AoFields::Draw{}, 0, env_meshes[m].count);
+      parts.push_back({m, cull, ao_ ? ao_->receiver(m, worldBox(m)) : AoFields::Draw{}, 0, env_meshes[m].count});
       continue;
     }
-    // Face by face (a plane's normal, turned to the viewer as the shader turns it), consecutive faces with the
-    // same ambient occlusion in one draw.
-    AoFields::Draw run;
-    int first = 0, indices = 0;
     for (const FaceGroup& g : env_groups[m]) {
       const double side = glm::dot(g.normal, g.point + mesh.anchor - viewer);
       const Vec3 facing = side > 0 ? -g.normal : g.normal;
       const AoFields::Draw d =
           ao_->receiver(m, {g.box[0] + mesh.anchor, g.box[1] + mesh.anchor}, side != 0 ? &facing : nullptr);
-      if (indices > 0 && !(d == run)) {
-        drawPart(m, run, first, indices);
-        indices = 0;
-      }
-      if (indices == 0) {
-        run = d;
-        first = g.first;
-      }
-      indices += g.count;
+      if (parts.empty() || parts.back().m != m || !(parts.back().ao == d))
+        parts.push_back({m, cull, d, g.first, 0});
+      parts.back().count += g.count;
     }
-    drawPart(m, run, first, indices);
+  }
+  // The static receivers' occlusion, evaluated into the pass's low-resolution occlusion image (kAoImageFactor
+  // times fewer pixels per axis) and read from it bilinearly: fewer evaluations of the fields, one texture lookup
+  // per fragment whatever the number of occluders. Not in the zooming-region and peeling passes.
+  const bool image = ao_ && ao_->active() && !reversed_depth && !peel;
+  auto screen = [&](const Part& part) { return image && part.ao.kind != AoReceiver::None && !scene.meshAnimated(part.m); };
+  if (std::any_of(parts.begin(), parts.end(), screen)) {
+    GLint viewport[4], target = 0;
+    glGetIntegerv(GL_VIEWPORT, viewport);
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &target);
+    const bool scissor = glIsEnabled(GL_SCISSOR_TEST), blend = glIsEnabled(GL_BLEND);
+    const int w = (viewport[2] + kAoImageFactor - 1) / kAoImageFactor, h = (viewport[3] + kAoImageFactor - 1) / kAoImageFactor;
+    if (w != ao_image_size[0] || h != ao_image_size[1]) {
+      if (!ao_fbo) {
+        glGenFramebuffers(1, &ao_fbo);
+        glGenTextures(1, &ao_image);
+        glGenRenderbuffers(1, &ao_depth);
+      }
+      glBindTexture(GL_TEXTURE_2D, ao_image);
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_R8, w, h, 0, GL_RED, GL_UNSIGNED_BYTE, nullptr);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
+      glBindTexture(GL_TEXTURE_2D, 0);
+      glBindRenderbuffer(GL_RENDERBUFFER, ao_depth);
+      glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, w, h);
+      glBindRenderbuffer(GL_RENDERBUFFER, 0);
+      glBindFramebuffer(GL_DRAW_FRAMEBUFFER, ao_fbo);
+      glFramebufferTexture2D(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, ao_image, 0);
+      glFramebufferRenderbuffer(GL_DRAW_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, ao_depth);
+      ao_image_size[0] = w;
+      ao_image_size[1] = h;
+    }
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, ao_fbo);
+    glViewport(0, 0, w, h);
+    glDisable(GL_SCISSOR_TEST);
+    glDisable(GL_BLEND);
+    const float zero[4] = {0, 0, 0, 0}, far = 1;
+    glClearBufferfv(GL_COLOR, 0, zero);
+    glClearBufferfv(GL_DEPTH, 0, &far);
+    // The static receivers alone, nearest first: a moving one, and what is drawn without occlusion, hide nothing
+    // here, so that the image about a car's outline holds the ground behind it, not the car.
+    const Program* occlusion[3][2] = {};
+    bool culling = false;
+    for (const Part& part : parts) {
+      if (!screen(part)) continue;
+      const Program*& p = occlusion[int(part.ao.kind)][env_faceted[part.m]];
+      if (!p) {
+        p = &programs.envOcclusion(env_faceted[part.m], part.ao.kind);
+        p->use();
+        p->set("u_view_proj", toFloat(vp));
+        p->set("u_view_origin", rays_from ? glm::vec3(*rays_from - origin) : glm::vec3(0.0f));
+        ao_->bind(*p, origin);
+        glActiveTexture(GL_TEXTURE0);
+      }
+      if (part.cull != culling) {
+        part.cull ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
+        culling = part.cull;
+      }
+      p->use();
+      p->set("u_offset", glm::vec3(scene.meshes[part.m].anchor - origin));
+      ao_->setReceiver(*p, part.m, part.ao);
+      glBindVertexArray(env_meshes[part.m].vao);
+      glDrawElements(GL_TRIANGLES, part.count, GL_UNSIGNED_INT, reinterpret_cast<const void*>(size_t(part.first) * sizeof(uint32_t)));
+    }
+    glDisable(GL_CULL_FACE);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, GLuint(target));
+    glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
+    if (scissor) glEnable(GL_SCISSOR_TEST);
+    if (blend) glEnable(GL_BLEND);
+    glActiveTexture(GLenum(GL_TEXTURE0 + ao_->unit()));
+    glBindTexture(GL_TEXTURE_2D, ao_image);
+    glActiveTexture(GL_TEXTURE0);
+    ao_image_map = glm::vec4(1.0f / float(viewport[2]), 1.0f / float(viewport[3]), -float(viewport[0]) / float(viewport[2]),
+                             -float(viewport[1]) / float(viewport[3]));
+  }
+  bool culling = false;
+  for (const Part& part : parts) {
+    if (part.cull != culling) {
+      part.cull ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
+      culling = part.cull;
+    }
+    drawPart(part.m, screen(part) ? AoFields::Draw{AoReceiver::Screen, {}} : part.ao, part.first, part.count);
   }
   glDisable(GL_CULL_FACE);
   glFrontFace(GL_CCW);

@@ -90,6 +90,11 @@ class EnvironmentPass {
   };
   std::vector<std::vector<FaceGroup>> env_groups;
   bool group_faces = false;  // the scene has ambient occlusion
+  // A pass's low-resolution occlusion image (the static receivers' ambient occlusion, R8) and its depth buffer,
+  // kAoImageFactor times fewer pixels per axis than the pass's viewport; remade when that size changes.
+  static constexpr int kAoImageFactor = 8;
+  mutable unsigned ao_fbo = 0, ao_image = 0, ao_depth = 0;
+  mutable int ao_image_size[2] = {0, 0};
   std::vector<Texture> textures;  // environment textures, in Scene::textures order
   const ShadowPass* shadows_ = nullptr;
   const CausticPass* caustics_ = nullptr;
