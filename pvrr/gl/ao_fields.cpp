@@ -13,17 +13,6 @@ namespace pvrr::gl {
 
 namespace {
 
-// The bound texture of `target`: linear filtering, clamped at its edges (along r too for a 3D texture),
-// one level.
-void linearClampedOneLevel(GLenum target) {
-  glTexParameteri(target, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glTexParameteri(target, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTexParameteri(target, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTexParameteri(target, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  if (target == GL_TEXTURE_3D) glTexParameteri(target, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
-  glTexParameteri(target, GL_TEXTURE_MAX_LEVEL, 0);
-}
-
 bool anyAmbientLight(const Scene& scene) {
   for (const Light& l : scene.lights)
     if (l.type == Light::Type::Ambient) return true;
@@ -68,6 +57,15 @@ Planes horizontalPlanes(const Scene& scene) {
 }
 
 }  // namespace
+
+void linearClampedOneLevel(unsigned target) {
+  glTexParameteri(target, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(target, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(target, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(target, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  if (target == GL_TEXTURE_3D) glTexParameteri(target, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+  glTexParameteri(target, GL_TEXTURE_MAX_LEVEL, 0);
+}
 
 std::string ambientOcclusionSkipReason(const Scene& scene) {
   if (!scene.render.ambient_occlusion.on) return "off (render.ambient_occlusion)";

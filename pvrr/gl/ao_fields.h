@@ -33,6 +33,10 @@ std::string ambientOcclusionSkipReason(const Scene& scene);
 // AO_PER_VERTEX; Ground: AO_GROUND, AO_HEIGHTS); none when the scene has no ambient occlusion or for AoReceiver::None.
 std::vector<std::string> aoDefines(const Scene& scene, AoReceiver receiver = AoReceiver::Volume);
 
+// Sets the bound texture of `target` (GL_TEXTURE_2D, _2D_ARRAY, _3D): linear filtering, clamped at its edges
+// (along r too for a 3D texture), one level.
+void linearClampedOneLevel(unsigned target);
+
 class AoFields {
  public:
   // Builds and uploads the fields (nothing when ambientOcclusionSkipReason is not empty). Their unit is

@@ -313,11 +313,7 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
       }
       glBindTexture(GL_TEXTURE_2D, ao_image);
       glTexImage2D(GL_TEXTURE_2D, 0, GL_R8, w, h, 0, GL_RED, GL_UNSIGNED_BYTE, nullptr);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
+      linearClampedOneLevel(GL_TEXTURE_2D);
       glBindTexture(GL_TEXTURE_2D, 0);
       glBindRenderbuffer(GL_RENDERBUFFER, ao_depth);
       glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, w, h);
