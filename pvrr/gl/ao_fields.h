@@ -8,10 +8,15 @@
 // uploaded per pass, so an animated car keeps its occlusion.
 //
 // What a draw pays (llvmpipe shades both sides of every per-fragment branch, so the choice is made per draw,
-// by program variant: AoReceiver): a mesh whose box lies outside every other occluder's reach (where the fade
-// is 0) is drawn without ambient occlusion; a horizontal plane facing up (grounds, pavements: static, not an
-// occluder, every normal vertical, one height) reads the ground maps (pvrr/method/ao_field.h groundMap: one
-// bilinear lookup per occluder) while every occluder turns about the vertical only; the rest read the volumes.
+// by program variant: AoReceiver). A faceted mesh is drawn plane by plane (a box's faces;
+// pvrr/gl/environment_pass.h), each with the fields whose volume can cast kAoNegligible on it with its one
+// normal (volumeBound: a face turned away from every car, such as the inner face of a door, has none); other
+// meshes with the fields whose reach their box meets. What no field counts for is drawn without ambient
+// occlusion. Of the rest, a horizontal plane facing up (grounds, pavements: static, not an occluder, every
+// normal vertical, one height) is evaluated from the ground maps (pvrr/method/ao_field.h groundMap: one
+// bilinear lookup per occluder) while every occluder turns about the vertical only, anything else from the
+// volumes. Static receivers are evaluated so only into the pass's low-resolution occlusion image, which their
+// fragments read (AoReceiver::Screen); moving ones (a car under another's field) evaluate the fields per fragment.
 #pragma once
 #include <array>
 #include <string>
