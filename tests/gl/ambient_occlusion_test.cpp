@@ -32,8 +32,10 @@ constexpr double kGroundAlbedo = 0.7, kAmbient = 0.5, kMirrorReflectance = 0.9;
 constexpr double kModeOcclusionRel = 0.5;
 
 // A car of six boxes (one occluder, "car") on a 30 m ground, an ambient light only. `animation`: the car's
-// parts' "animation" member (or empty); `mirror`: an element array's contents; `ao`: render.ambient_occlusion.
-SceneDesc carDesc(const std::string& animation, const std::string& mirror, const std::string& ao) {
+// parts' "animation" member (or empty); `mirror`: an element array's contents; `ao`: render.ambient_occlusion;
+// `extra`: more environment objects (each with a leading comma); `eye`: the observer's eye.
+SceneDesc carDesc(const std::string& animation, const std::string& mirror, const std::string& ao,
+                  const std::string& extra = "", const std::string& eye = "[4.5, 5.5, 6.5]") {
   std::string parts;
   const char* boxes[] = {R"("centre": [0, 0.75, 0], "size": [1.8, 0.8, 4.4])",
                          R"("centre": [0, 1.45, 0.3], "size": [1.6, 0.6, 2.4])",
@@ -45,9 +47,9 @@ SceneDesc carDesc(const std::string& animation, const std::string& mirror, const
     parts += std::string(R"(, {"type": "box", "ambient_occlusion": "car", "material": {"color": [0.6, 0.1, 0.1]}, )") + b +
              (animation.empty() ? "" : ", \"animation\": " + animation) + "}";
   const std::string text = R"({"version": 1, "units": "m",
-    "observer": {"eye": [4.5, 5.5, 6.5], "target": [0, 0.3, 0], "fov_y_deg": 55, "image_size": [200, 150]},
+    "observer": {"eye": )" + eye + R"(, "target": [0, 0.3, 0], "fov_y_deg": 55, "image_size": [200, 150]},
     "environment": [{"type": "ground", "name": "road", "point": [0, 0, 0], "normal": [0, 1, 0], "size": [30, 30],
-                     "material": {"color": [0.7, 0.7, 0.7]}})" + parts + R"(],
+                     "material": {"color": [0.7, 0.7, 0.7]}})" + parts + extra + R"(],
     "lights": [{"type": "ambient", "color": [0.5, 0.5, 0.5]}],
     "elements": [)" + mirror + R"(],
     "render": {"background": [0, 0, 0], "ambient_occlusion": )" + ao + "}}";
@@ -196,6 +198,40 @@ TEST_P(AmbientOcclusionTest, TheGroundInAMirrorAgreesInPvrrMode) {
   gl::Renderer renderer(s, rays, gl::RendererOptions{});
   expectAgrees(groundDifference(ref, renderer.render(RenderMode::Pvrr), 1, kMirrorReflectance, Vec3(0)),
                "in the mirror (pvrr)", 300, 0.6);
+}
+
+// A wall beside the car, seen from either side: the face toward the car is darkened by it; the face turned away
+// from it, whose hemisphere the car is not in, is drawn without ambient occlusion (AoFields::volumeBound): there
+// the very pixels of the picture without.
+TEST_P(AmbientOcclusionTest, AFaceTurnedAwayFromTheCarIsDrawnWithout) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  const std::string wall =
+      R"(, {"type": "box", "name": "wall", "centre": [3, 1, 0], "size": [0.2, 2, 6], "material": {"color": [0.7, 0.7, 0.7]}})";
+  for (const double side : {-1.0, 1.0}) {  // the face at x = 3 + 0.1 side; -1: the one toward the car
+    const std::string eye = side < 0 ? "[-3, 2, 8]" : "[9, 2, 8]";
+    const Scene on = buildScene(carDesc("", "", "true", wall, eye)), off = buildScene(carDesc("", "", "false", wall, eye));
+    RayScene rays_on(on), rays_off(off);
+    gl::Renderer r_on(on, rays_on, gl::RendererOptions{}), r_off(off, rays_off, gl::RendererOptions{});
+    const gl::RasterFrame a = r_on.render(RenderMode::Raster), b = r_off.render(RenderMode::Raster);
+    int pixels = 0, equal = 0;
+    double darkening = 0;
+    for (size_t i = 0; i < b.seen.size(); ++i) {
+      const Vec3 p = b.seen[i];
+      if (std::abs(p.x - (3 + 0.1 * side)) > 1e-3 || std::abs(p.z) > 2.9 || p.y < 0.1 || p.y > 1.9) continue;
+      ++pixels;
+      equal += a.color[i] == b.color[i];
+      darkening += (b.color[i].x - a.color[i].x) / (kGroundAlbedo * kAmbient);
+    }
+    std::printf("[ ambient occlusion ] wall face %s the car: %d pixels, mean occlusion %.4f, %d unchanged\n",
+                side < 0 ? "toward" : "turned from", pixels, pixels ? darkening / pixels : 0.0, equal);
+    ASSERT_GT(pixels, 1000);
+    if (side < 0) {
+      EXPECT_GT(darkening / pixels, 0.02);
+    } else {
+      EXPECT_EQ(equal, pixels);
+    }
+  }
 }
 
 TEST_P(AmbientOcclusionTest, OffChangesNoPixel) {
