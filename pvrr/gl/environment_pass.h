@@ -36,6 +36,8 @@ class EnvironmentPass {
   // planes: into a planes map. with_seen: write seen points even when RendererOptions::seen_points is off
   // (impostor cube maps). peel: an impostor cube's second layer (the first layer's cubes bound from kPeelUnit and
   // kFirstCubeUnit).
+  // With ambient occlusion, a forward pass that is not a peel first draws the static receivers' occlusion into
+  // its low-resolution occlusion image (binding its own framebuffer and viewport, then restoring the caller's).
   // Returns how many closed convex meshes it drew and culled.
   CullCount draw(const Mat4& view, const Mat4& proj, const Vec3& origin, bool reversed_depth = false,
                  const Vec3* rays_from = nullptr, bool planes = false, bool with_seen = false, bool peel = false) const;
