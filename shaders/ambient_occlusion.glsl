@@ -7,7 +7,17 @@
 // field reaches is drawn without AMBIENT_OCCLUSION at all. llvmpipe shades both sides of a per-fragment branch,
 // so nothing here branches per fragment; a field that does not reach the draw is weighted by 0 (a loop over
 // a uniform list of them, dynamically indexed, measured slower).
-#if defined(AMBIENT_OCCLUSION)
+#if defined(AMBIENT_OCCLUSION) && defined(AO_SCREEN)
+// A static receiver in a pass that drew the occlusion image first (pvrr/gl/environment_pass.cpp): its occlusion,
+// evaluated from the fields at an eighth of the resolution per axis, read bilinearly where the fragment lies.
+#if !defined(AO_VERTEX)
+uniform sampler2D u_ao_image;
+uniform vec4 u_ao_image_map;  // the image's coordinates: gl_FragCoord.xy * map.xy + map.zw (the pass's viewport)
+float ambientOcclusion(vec3 x, vec3 n) {
+  return texture(u_ao_image, gl_FragCoord.xy * u_ao_image_map.xy + u_ao_image_map.zw).r;
+}
+#endif
+#elif defined(AMBIENT_OCCLUSION)
 uniform vec3 u_ao_centre[AO_FIELDS];    // the bounding sphere's centre, relative to the camera origin
 uniform mat3 u_ao_rotation[AO_FIELDS];  // the field's frame to the world (its object's motion)
 uniform float u_ao_radius[AO_FIELDS];

@@ -45,6 +45,11 @@ void main() {
 #elif defined(AMBIENT_OCCLUSION)
   o_color.rgb -= albedo * u_ambient * ambientOcclusion(v_pos, n);
 #endif
+#if defined(AO_IMAGE) && defined(FACETED)
+  o_color = vec4(ambientOcclusion(v_pos, v_face_normal), 0.0, 0.0, 1.0);  // the occlusion image alone
+#elif defined(AO_IMAGE)
+  o_color = vec4(ambientOcclusion(v_pos, n), 0.0, 0.0, 1.0);
+#endif
   o_seen = vec4(v_pos, 1.0);
   o_surface = vec4(0.0);
 }

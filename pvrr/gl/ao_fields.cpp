@@ -13,17 +13,6 @@ namespace pvrr::gl {
 
 namespace {
 
-// The bound texture of `target`: linear filtering, clamped at its edges (along r too for a 3D texture),
-// one level.
-void linearClampedOneLevel(GLenum target) {
-  glTexParameteri(target, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glTexParameteri(target, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTexParameteri(target, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTexParameteri(target, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  if (target == GL_TEXTURE_3D) glTexParameteri(target, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
-  glTexParameteri(target, GL_TEXTURE_MAX_LEVEL, 0);
-}
-
 bool anyAmbientLight(const Scene& scene) {
   for (const Light& l : scene.lights)
     if (l.type == Light::Type::Ambient) return true;
@@ -69,6 +58,15 @@ Planes horizontalPlanes(const Scene& scene) {
 
 }  // namespace
 
+void linearClampedOneLevel(unsigned target) {
+  glTexParameteri(target, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(target, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(target, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(target, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  if (target == GL_TEXTURE_3D) glTexParameteri(target, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+  glTexParameteri(target, GL_TEXTURE_MAX_LEVEL, 0);
+}
+
 std::string ambientOcclusionSkipReason(const Scene& scene) {
   if (!scene.render.ambient_occlusion.on) return "off (render.ambient_occlusion)";
   if (occluderCount(scene) == 0) return "no environment object has \"ambient_occlusion\"";
@@ -78,6 +76,7 @@ std::string ambientOcclusionSkipReason(const Scene& scene) {
 
 std::vector<std::string> aoDefines(const Scene& scene, AoReceiver receiver) {
   if (receiver == AoReceiver::None || !ambientOcclusionSkipReason(scene).empty()) return {};
+  if (receiver == AoReceiver::Screen) return {"#define AMBIENT_OCCLUSION", "#define AO_SCREEN"};
   std::vector<std::string> d = {"#define AMBIENT_OCCLUSION", "#define AO_FIELDS " + std::to_string(occluderCount(scene)),
                                 "#define AO_VOLUME " + std::to_string(kAoVolumeSize)};
   // 6 varying components per occluder (offset and face normal): with the environment's own 14, within the 64
@@ -175,36 +174,83 @@ void AoFields::bind(const Program& p, const Vec3& origin) const {
   }
 }
 
-std::vector<int> AoFields::reaching(size_t m, const std::array<Vec3, 2>& box) const {
-  std::vector<int> out;
+double AoFields::volumeBound(const AoField& f, const std::array<Vec3, 2>& box, const Vec3& n_world) const {
+  if (f.volume.empty()) return 0;
+  const Mat4 motion = occluderMotion(scene_, f.occluder);
+  const Mat3 rt = glm::transpose(Mat3(motion));
+  const Vec3 c(motion * Vec4(f.centre, 1.0));
+  // The box's bounds in the field's frame (offsets from its centre).
+  Vec3 lo(kInf), hi(-kInf);
+  for (int k = 0; k < 8; ++k) {
+    const Vec3 corner((k & 1 ? box[1] : box[0]).x, (k & 2 ? box[1] : box[0]).y, (k & 4 ? box[1] : box[0]).z);
+    const Vec3 p = rt * (corner - c);
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  const Vec3 nearest = glm::clamp(Vec3(0.0), lo, hi);
+  const double fade = aoFade(f.radius * f.radius / std::max(glm::dot(nearest, nearest), 1e-300));
+  if (fade <= 0) return 0;
+  // The channels the normal reads (ambient cube: the sign of each non-zero component).
+  const Vec3 n = rt * n_world;
+  int channels[3], count = 0;
+  for (int a = 0; a < 3; ++a)
+    if (std::abs(n[a]) > 1e-9) channels[count++] = 2 * a + (n[a] < 0);
+  // The grid points trilinear lookups within the bounds interpolate (ao_field.cpp's volumeOcclusion).
+  const int sz = kAoVolumeSize;
+  int i0[3], i1[3];
+  for (int a = 0; a < 3; ++a) {
+    const auto grid = [&](double x) { return std::clamp((aoWarp(x, f.radius) + 1) / 2 * sz - 0.5, 0.0, double(sz - 1)); };
+    i0[a] = int(std::floor(grid(lo[a])));
+    i1[a] = int(std::ceil(grid(hi[a])));
+  }
+  int most = 0;
+  for (int k = i0[2]; k <= i1[2]; ++k)
+    for (int j = i0[1]; j <= i1[1]; ++j)
+      for (int i = i0[0]; i <= i1[0]; ++i) {
+        const uint8_t* o = &f.volume[((size_t(k) * sz + size_t(j)) * sz + size_t(i)) * 8];
+        for (int c2 = 0; c2 < count; ++c2) most = std::max(most, int(o[channels[c2]]));
+      }
+  return fade * most / 255.0;
+}
+
+AoFields::Draw AoFields::receiver(size_t m, const std::array<Vec3, 2>& box, const Vec3* facing) const {
+  Draw d;
+  if (!active()) return d;
+  d.reaches.assign(fields_.size(), 0.0f);
   const int self = scene_.meshes[m].occluder;
+  bool any = false;
   for (size_t i = 0; i < fields_.size(); ++i) {
     const AoField& f = fields_[i];
     if (f.occluder == self || f.volume.empty()) continue;
-    const Mat4 motion = occluderMotion(scene_, f.occluder);
-    const Vec3 c(motion * Vec4(f.centre, 1.0));
-    const Vec3 nearest = glm::clamp(c, box[0], box[1]);
-    if (glm::dot(nearest - c, nearest - c) < f.reach * f.reach) out.push_back(int(i));
+    bool counts = false;
+    if (facing) {
+      counts = volumeBound(f, box, *facing) >= kAoNegligible;
+    } else {
+      const Mat4 motion = occluderMotion(scene_, f.occluder);
+      const Vec3 c(motion * Vec4(f.centre, 1.0));
+      const Vec3 nearest = glm::clamp(c, box[0], box[1]);
+      counts = glm::dot(nearest - c, nearest - c) < f.reach * f.reach;
+    }
+    d.reaches[i] = counts ? 1.0f : 0.0f;
+    any = any || counts;
   }
-  return out;
-}
-
-AoReceiver AoFields::receiver(size_t m, const std::array<Vec3, 2>& box) const {
-  if (!active() || reaching(m, box).empty()) return AoReceiver::None;
+  if (!any) {
+    d.reaches.clear();
+    return d;
+  }
   // Every occluder turning about the vertical only, not lifted: the ground maps' planes stay at their heights.
   bool upright = true;
   for (const AoField& f : fields_) {
     const Mat4 motion = occluderMotion(scene_, f.occluder);
     upright = upright && std::abs(motion[1][1] - 1) < kLevelTolerance && std::abs(motion[3][1]) < kLevelTolerance;
   }
-  return upright && m < mesh_height_.size() && mesh_height_[m] >= 0 ? AoReceiver::Ground : AoReceiver::Volume;
+  d.kind = upright && m < mesh_height_.size() && mesh_height_[m] >= 0 ? AoReceiver::Ground : AoReceiver::Volume;
+  return d;
 }
 
-void AoFields::setReceiver(const Program& p, size_t m, const std::array<Vec3, 2>& box) const {
-  if (!active()) return;
-  const std::vector<int> list = reaching(m, box);
-  for (size_t f = 0; f < fields_.size(); ++f)
-    p.set("u_ao_reaches[" + std::to_string(f) + "]", std::find(list.begin(), list.end(), int(f)) != list.end() ? 1.0f : 0.0f);
+void AoFields::setReceiver(const Program& p, size_t m, const Draw& d) const {
+  if (!active() || d.kind == AoReceiver::None || d.kind == AoReceiver::Screen) return;
+  for (size_t f = 0; f < fields_.size(); ++f) p.set("u_ao_reaches[" + std::to_string(f) + "]", d.reaches[f]);
   p.set("u_ao_height", m < mesh_height_.size() ? std::max(0, mesh_height_[m]) : 0);
 }
 

@@ -52,9 +52,10 @@ EnvironmentPass::EnvironmentPass(const Scene& s, const RendererOptions& o, const
   env_meshes.resize(scene.meshes.size());
   env_bounds.resize(scene.meshes.size());
   env_motion.resize(scene.meshes.size());
+  env_groups.resize(scene.meshes.size());
+  group_faces = ambientOcclusionSkipReason(scene).empty();
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
     const EnvMesh& mesh = scene.meshes[m];
-    upload(m);
     // Faceted: each triangle's three normals equal and perpendicular to it (a supplied normal tilted from
     // its face would make the per-vertex two-sided flip differ from the per-fragment one). Decided once: an
     // animated mesh moves rigidly, which keeps a faceted mesh's normals equal (each is rotated alike).
@@ -66,6 +67,7 @@ EnvironmentPass::EnvironmentPass(const Scene& s, const RendererOptions& o, const
       return perpendicular && glm::length(mesh.normals[t.y] - n) <= 1e-6f && glm::length(mesh.normals[t.z] - n) <= 1e-6f;
     }));
     env_textured.push_back(scene.materials[size_t(mesh.material)].texture >= 0);
+    upload(m);
     // Its program, built now (not in the first frame's first pass) so that its compile time and any
     // compile error come with the renderer.
     programs.env(env_faceted.back(), env_textured.back(), false);
@@ -84,7 +86,48 @@ void EnvironmentPass::upload(size_t m) {
   }
   std::vector<uint32_t> idx;
   idx.reserve(mesh.triangles.size() * 3);
-  for (const auto& t : mesh.triangles) idx.insert(idx.end(), {t.x, t.y, t.z});
+  std::vector<FaceGroup>& groups = env_groups[m];
+  groups.clear();
+  if (group_faces && env_faceted[m]) {
+    // Each triangle's plane: its normal (exactly) and offset along it (within float rounding).
+    constexpr size_t kMaxFaceGroups = 12;
+    std::vector<double> offsets;
+    std::vector<size_t> of(mesh.triangles.size());
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const glm::vec3 n = mesh.normals[mesh.triangles[t].x], p = mesh.positions[mesh.triangles[t].x];
+      const double d = glm::dot(Vec3(n), Vec3(p));
+      size_t g = 0;
+      while (g < groups.size() && !(glm::vec3(groups[g].normal) == n && std::abs(offsets[g] - d) <= 1e-5 * (1 + std::abs(d)))) ++g;
+      if (g == groups.size()) {
+        if (g == kMaxFaceGroups) {
+          groups.clear();
+          break;
+        }
+        FaceGroup f;
+        f.normal = Vec3(n);
+        f.point = Vec3(p);
+        f.box = {Vec3(kInf), Vec3(-kInf)};
+        groups.push_back(f);
+        offsets.push_back(d);
+      }
+      of[t] = g;
+    }
+    for (size_t g = 0; g < groups.size(); ++g) {
+      groups[g].first = int(idx.size());
+      for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+        if (of[t] != g) continue;
+        const auto& tri = mesh.triangles[t];
+        idx.insert(idx.end(), {tri.x, tri.y, tri.z});
+        for (const uint32_t v : {tri.x, tri.y, tri.z}) {
+          groups[g].box[0] = glm::min(groups[g].box[0], Vec3(mesh.positions[v]));
+          groups[g].box[1] = glm::max(groups[g].box[1], Vec3(mesh.positions[v]));
+        }
+      }
+      groups[g].count = int(idx.size()) - groups[g].first;
+    }
+  }
+  if (groups.empty())
+    for (const auto& t : mesh.triangles) idx.insert(idx.end(), {t.x, t.y, t.z});
   uploadMesh(env_meshes[m], data, {3, 3, 2}, idx);
   Vec3 lo(mesh.positions.empty() ? glm::vec3(0) : mesh.positions[0]), hi(lo);
   for (const glm::vec3& pos : mesh.positions) {
@@ -116,6 +159,9 @@ bool EnvironmentPass::occludes(const std::vector<size_t>& moved) const {
 }
 
 EnvironmentPass::~EnvironmentPass() {
+  if (ao_fbo) glDeleteFramebuffers(1, &ao_fbo);
+  if (ao_image) glDeleteTextures(1, &ao_image);
+  if (ao_depth) glDeleteRenderbuffers(1, &ao_depth);
   for (auto& m : env_meshes) m.release();
   if (empty_vao) glDeleteVertexArrays(1, &empty_vao);
 }
@@ -171,15 +217,13 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
   glDepthMask(GL_TRUE);
   glDepthFunc(reversed_depth ? GL_GREATER : GL_LESS);
   // The programs of the kinds of mesh the scene has, [ambient occlusion][faceted][textured], set up for this
-  // pass; a mesh's ambient occlusion variant is chosen per draw (AoFields::receiver).
-  const Program* kinds[3][2][2] = {};
-  std::vector<AoReceiver> ao_kind(scene.meshes.size(), AoReceiver::None);
-  for (size_t m = 0; m < scene.meshes.size(); ++m) {
-    const bool faceted = env_faceted[m], textured = env_textured[m];
-    if (ao_) ao_kind[m] = ao_->receiver(m, worldBox(m));
-    const Program*& p = kinds[int(ao_kind[m])][faceted][textured];
-    if (p) continue;
-    p = &programs.env(faceted, textured, planes, with_seen, peel, ao_kind[m]);
+  // pass when first drawn; a draw's ambient occlusion variant is chosen per mesh or face (AoFields::receiver).
+  const Program* kinds[4][2][2] = {};
+  glm::vec4 ao_image_map(0.0f);  // the occlusion image's coordinates (shaders/ambient_occlusion.glsl)
+  auto program = [&](AoReceiver ao, bool faceted, bool textured) -> const Program& {
+    const Program*& p = kinds[int(ao)][faceted][textured];
+    if (p) return *p;
+    p = &programs.env(faceted, textured, planes, with_seen, peel, ao);
     p->use();
     if (peel) p->set("u_peel", kPeelUnit);
     p->set("u_view_proj", toFloat(vp));
@@ -189,8 +233,26 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
     if (shadows_) shadows_->bind(*p, origin);
     if (caustics_) caustics_->bind(*p, origin);
     if (ao_) ao_->bind(*p, origin);
-  }
-  glActiveTexture(GL_TEXTURE0);
+    if (ao == AoReceiver::Screen) {
+      p->set("u_ao_image", ao_->unit());
+      p->set("u_ao_image_map", ao_image_map);
+    }
+    glActiveTexture(GL_TEXTURE0);
+    return *p;
+  };
+  // Indices [first, first + count) of mesh m, drawn with ambient occlusion d.
+  auto drawPart = [&](size_t m, const AoFields::Draw& d, int first, int count) {
+    const EnvMesh& mesh = scene.meshes[m];
+    const Program& p = program(d.kind, env_faceted[m], env_textured[m]);
+    p.use();
+    p.set("u_offset", glm::vec3(mesh.anchor - origin));
+    p.set("u_albedo", glm::vec3(scene.materials[size_t(mesh.material)].color));
+    if (ao_) ao_->setReceiver(p, m, d);
+    if (env_textured[m]) glBindTexture(GL_TEXTURE_2D, textures[size_t(scene.materials[size_t(mesh.material)].texture)].name());
+    glBindVertexArray(env_meshes[m].vao);
+    glDrawElements(GL_TRIANGLES, count, GL_UNSIGNED_INT, reinterpret_cast<const void*>(size_t(first) * sizeof(uint32_t)));
+  };
+  const Vec3 viewer = rays_from ? *rays_from : origin;  // where the two-sided normals face
   // Back faces of closed convex meshes that near clipping cannot cut open (RendererOptions::cull_back_faces,
   // NearClip): a ray from the centre of projection to a back-face point first crosses a front face
   // of the same solid, itself beyond the near plane, which the depth test keeps instead. Not with reversed
@@ -202,26 +264,116 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
     glCullFace(GL_BACK);
     glFrontFace(facingTrianglesWindCounterClockwise(vp) ? GL_CCW : GL_CW);
   }
-  bool culling = false;
+  // What to draw, in order: the meshes, or their faces (a plane's normal, turned to the viewer as the shader turns
+  // it), consecutive faces with the same ambient occlusion in one draw.
+  struct Part {
+    size_t m;
+    bool cull;
+    AoFields::Draw ao;
+    int first, count;
+  };
+  std::vector<Part> parts;
   CullCount count;
   const std::vector<std::array<Vec3, 2>> relative = boxes(origin);  // camera-relative
   for (const size_t m : drawOrder(relative, reversed_depth)) {
     const EnvMesh& mesh = scene.meshes[m];
-    const DiffuseMaterial& mat = scene.materials[size_t(mesh.material)];
-    const Program& p = *kinds[int(ao_kind[m])][env_faceted[m]][env_textured[m]];
     const bool cull = may_cull && mesh.closed_convex && near_clip.cannotOpen(relative[m][0], relative[m][1]);
     count.drawn += mesh.closed_convex;
     count.culled += cull;
-    if (cull != culling) {
-      cull ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
-      culling = cull;
+    if (!ao_ || env_groups[m].empty()) {
+      parts.push_back({m, cull, ao_ ? ao_->receiver(m, worldBox(m)) : AoFields::Draw{}, 0, env_meshes[m].count});
+      continue;
     }
-    p.use();
-    p.set("u_offset", glm::vec3(mesh.anchor - origin));
-    p.set("u_albedo", glm::vec3(mat.color));
-    if (ao_) ao_->setReceiver(p, m, worldBox(m));
-    if (env_textured[m]) glBindTexture(GL_TEXTURE_2D, textures[size_t(mat.texture)].name());
-    gl::draw(env_meshes[m]);
+    for (const FaceGroup& g : env_groups[m]) {
+      const double side = glm::dot(g.normal, g.point + mesh.anchor - viewer);
+      const Vec3 facing = side > 0 ? -g.normal : g.normal;
+      const AoFields::Draw d =
+          ao_->receiver(m, {g.box[0] + mesh.anchor, g.box[1] + mesh.anchor}, side != 0 ? &facing : nullptr);
+      if (parts.empty() || parts.back().m != m || !(parts.back().ao == d))
+        parts.push_back({m, cull, d, g.first, 0});
+      parts.back().count += g.count;
+    }
+  }
+  // The static receivers' occlusion, evaluated into the pass's low-resolution occlusion image (kAoImageFactor
+  // times fewer pixels per axis) and read from it bilinearly: fewer evaluations of the fields, one texture lookup
+  // per fragment whatever the number of occluders. Not in the zooming-region and peeling passes.
+  const bool image = ao_ && ao_->active() && !reversed_depth && !peel;
+  auto screen = [&](const Part& part) { return image && part.ao.kind != AoReceiver::None && !scene.meshAnimated(part.m); };
+  if (std::any_of(parts.begin(), parts.end(), screen)) {
+    GLint viewport[4], target = 0;
+    glGetIntegerv(GL_VIEWPORT, viewport);
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &target);
+    const bool scissor = glIsEnabled(GL_SCISSOR_TEST), blend = glIsEnabled(GL_BLEND);
+    const int w = (viewport[2] + kAoImageFactor - 1) / kAoImageFactor, h = (viewport[3] + kAoImageFactor - 1) / kAoImageFactor;
+    if (w != ao_image_size[0] || h != ao_image_size[1]) {
+      if (!ao_fbo) {
+        glGenFramebuffers(1, &ao_fbo);
+        glGenTextures(1, &ao_image);
+        glGenRenderbuffers(1, &ao_depth);
+      }
+      glBindTexture(GL_TEXTURE_2D, ao_image);
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_R8, w, h, 0, GL_RED, GL_UNSIGNED_BYTE, nullptr);
+      linearClampedOneLevel(GL_TEXTURE_2D);
+      glBindTexture(GL_TEXTURE_2D, 0);
+      glBindRenderbuffer(GL_RENDERBUFFER, ao_depth);
+      glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, w, h);
+      glBindRenderbuffer(GL_RENDERBUFFER, 0);
+      glBindFramebuffer(GL_DRAW_FRAMEBUFFER, ao_fbo);
+      glFramebufferTexture2D(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, ao_image, 0);
+      glFramebufferRenderbuffer(GL_DRAW_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, ao_depth);
+      ao_image_size[0] = w;
+      ao_image_size[1] = h;
+    }
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, ao_fbo);
+    glViewport(0, 0, w, h);
+    glDisable(GL_SCISSOR_TEST);
+    glDisable(GL_BLEND);
+    const float zero[4] = {0, 0, 0, 0}, far = 1;
+    glClearBufferfv(GL_COLOR, 0, zero);
+    glClearBufferfv(GL_DEPTH, 0, &far);
+    // The static receivers alone, nearest first: a moving one, and what is drawn without occlusion, hide nothing
+    // here, so that the image about a car's outline holds the ground behind it, not the car.
+    const Program* occlusion[3][2] = {};
+    bool culling = false;
+    for (const Part& part : parts) {
+      if (!screen(part)) continue;
+      const Program*& p = occlusion[int(part.ao.kind)][env_faceted[part.m]];
+      if (!p) {
+        p = &programs.envOcclusion(env_faceted[part.m], part.ao.kind);
+        p->use();
+        p->set("u_view_proj", toFloat(vp));
+        p->set("u_view_origin", rays_from ? glm::vec3(*rays_from - origin) : glm::vec3(0.0f));
+        ao_->bind(*p, origin);
+        glActiveTexture(GL_TEXTURE0);
+      }
+      if (part.cull != culling) {
+        part.cull ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
+        culling = part.cull;
+      }
+      p->use();
+      p->set("u_offset", glm::vec3(scene.meshes[part.m].anchor - origin));
+      ao_->setReceiver(*p, part.m, part.ao);
+      glBindVertexArray(env_meshes[part.m].vao);
+      glDrawElements(GL_TRIANGLES, part.count, GL_UNSIGNED_INT, reinterpret_cast<const void*>(size_t(part.first) * sizeof(uint32_t)));
+    }
+    glDisable(GL_CULL_FACE);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, GLuint(target));
+    glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
+    if (scissor) glEnable(GL_SCISSOR_TEST);
+    if (blend) glEnable(GL_BLEND);
+    glActiveTexture(GLenum(GL_TEXTURE0 + ao_->unit()));
+    glBindTexture(GL_TEXTURE_2D, ao_image);
+    glActiveTexture(GL_TEXTURE0);
+    ao_image_map = glm::vec4(1.0f / float(viewport[2]), 1.0f / float(viewport[3]), -float(viewport[0]) / float(viewport[2]),
+                             -float(viewport[1]) / float(viewport[3]));
+  }
+  bool culling = false;
+  for (const Part& part : parts) {
+    if (part.cull != culling) {
+      part.cull ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
+      culling = part.cull;
+    }
+    drawPart(part.m, screen(part) ? AoFields::Draw{AoReceiver::Screen, {}} : part.ao, part.first, part.count);
   }
   glDisable(GL_CULL_FACE);
   glFrontFace(GL_CCW);

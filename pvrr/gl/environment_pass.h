@@ -36,6 +36,8 @@ class EnvironmentPass {
   // planes: into a planes map. with_seen: write seen points even when RendererOptions::seen_points is off
   // (impostor cube maps). peel: an impostor cube's second layer (the first layer's cubes bound from kPeelUnit and
   // kFirstCubeUnit).
+  // With ambient occlusion, a forward pass that is not a peel first draws the static receivers' occlusion into
+  // its low-resolution occlusion image (binding its own framebuffer and viewport, then restoring the caller's).
   // Returns how many closed convex meshes it drew and culled.
   CullCount draw(const Mat4& view, const Mat4& proj, const Vec3& origin, bool reversed_depth = false,
                  const Vec3* rays_from = nullptr, bool planes = false, bool with_seen = false, bool peel = false) const;
@@ -78,6 +80,23 @@ class EnvironmentPass {
   std::vector<bool> env_textured;  // per environment mesh: its material has a texture
   std::vector<std::array<Vec3, 2>> env_bounds;  // per environment mesh: its bounding box, relative to its anchor
   std::vector<Mat4> env_motion;  // per environment mesh: the Scene::meshMotion its buffers hold
+  // Per environment mesh, in a scene with ambient occlusion: its triangles grouped by plane (a faceted mesh of at
+  // most kMaxFaceGroups planes, such as a box's six faces), uploaded group after group, so that each part is
+  // drawn with the ambient occlusion its one normal needs (AoFields::receiver): a box face turned away from
+  // every car, or out of the reach of its occlusion, is drawn without. Empty: the mesh is one draw.
+  struct FaceGroup {
+    int first = 0, count = 0;  // its indices in the index buffer
+    Vec3 normal{0};            // the planes' normal, as uploaded
+    Vec3 point{0};             // a point of the plane, relative to the mesh's anchor
+    std::array<Vec3, 2> box;   // its vertices' bounding box, relative to the mesh's anchor
+  };
+  std::vector<std::vector<FaceGroup>> env_groups;
+  bool group_faces = false;  // the scene has ambient occlusion
+  // A pass's low-resolution occlusion image (the static receivers' ambient occlusion, R8) and its depth buffer,
+  // kAoImageFactor times fewer pixels per axis than the pass's viewport; remade when that size changes.
+  static constexpr int kAoImageFactor = 8;
+  mutable unsigned ao_fbo = 0, ao_image = 0, ao_depth = 0;
+  mutable int ao_image_size[2] = {0, 0};
   std::vector<Texture> textures;  // environment textures, in Scene::textures order
   const ShadowPass* shadows_ = nullptr;
   const CausticPass* caustics_ = nullptr;

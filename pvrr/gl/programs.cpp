@@ -48,6 +48,14 @@ const Program& Programs::env(bool faceted, bool textured, bool planes, bool with
   return built("env.vert", "env.frag", d);
 }
 
+const Program& Programs::envOcclusion(bool faceted, AoReceiver ao) const {
+  std::vector<std::string> d = {"#define AO_IMAGE"};
+  if (seen_points_) d.push_back("#define NO_SEEN_POINTS");  // (defines() adds it otherwise)
+  if (faceted) d.push_back("#define FACETED");
+  for (const std::string& s : aoDefines(scene_, ao)) d.push_back(s);
+  return built("env.vert", "env.frag", d);
+}
+
 const Program& Programs::sky(bool planes, bool with_seen, bool first_layer) const {
   if (first_layer) return built("sky.vert", "sky.frag", {kWithSeenPoints, "#define PEEL", "#define FIRST_LAYER"});
   if (with_seen && !seen_points_) return built("sky.vert", "sky.frag", {kWithSeenPoints});

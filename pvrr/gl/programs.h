@@ -14,8 +14,9 @@
 namespace pvrr::gl {
 
 // How an environment draw's fragments are ambient-occluded (the program variant; pvrr/gl/ao_fields.h): not at
-// all, from the ground maps (a horizontal plane facing up), from the occlusion volumes.
-enum class AoReceiver { None, Ground, Volume };
+// all, from the ground maps (a horizontal plane facing up), from the occlusion volumes, from the pass's
+// low-resolution occlusion image (static receivers: pvrr/gl/environment_pass.h).
+enum class AoReceiver { None, Ground, Volume, Screen };
 
 class Programs {
  public:
@@ -38,6 +39,9 @@ class Programs {
   // variant (aoDefines; nothing without render.ambient_occlusion).
   const Program& env(bool faceted, bool textured, bool planes, bool with_seen = false, bool peel = false,
                      AoReceiver ao = AoReceiver::Volume) const;
+  // The environment's occlusion alone (AO_IMAGE: colour = the occluded fraction), from the fields (ao: Ground or
+  // Volume), into a pass's low-resolution occlusion image.
+  const Program& envOcclusion(bool faceted, AoReceiver ao) const;
   // first_layer: an impostor cube's second layer, where nothing lies beyond the first (shaders/sky.frag).
   const Program& sky(bool planes, bool with_seen = false, bool first_layer = false) const;
   // Elements as plain surfaces (raster mode, and elements drawn dark at the depth limit).
