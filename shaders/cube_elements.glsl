@@ -50,6 +50,7 @@ uniform mat3 u_lens_to_local;     // world directions -> the lens's local frame 
     c = layer == 1 ? texture(u_cubes1[k], l).rgb : texture(u_cubes[k], l).rgb;                                     \
     s = layer == 1 ? texture(u_seen_cubes1[k], l) : texture(u_seen_cubes[k], l);                                   \
     nid = layer == 1 ? texture(u_normal_cubes1[k], l) : texture(u_normal_cubes[k], l);                             \
+    if (g_escaped) c = u_background, s = vec4(x - centre + R * u_far, 0.0), nid = vec4(0.0);                        \
   }
 #else
 #define CUBE_LOOKUP(k)                                                                                              \

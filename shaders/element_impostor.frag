@@ -24,6 +24,9 @@ uniform mat3 u_to_local;          // world directions -> the element's local fra
 uniform samplerCube u_cube1;      // the second layers (depth-peeled)
 uniform samplerCube u_seen_cube1;
 #endif
+#if IMPOSTOR_LAYERS > 1
+uniform vec3 u_background;        // render.background: what a ray that escapes past an occluder sees (g_escaped)
+#endif
 uniform int u_seen_channel;       // IMPOSTOR_CHANNELS 3: the channel whose ray gives the seen point
 #if defined(LENS)
 uniform int u_max_events;         // the events inside the glass the tracer follows: render.max_depth - 1
@@ -44,6 +47,7 @@ void envHit(vec3 x, vec3 R, out vec3 colour, out vec4 seen) {
   vec3 l = layeredHit(u_seen_cube, u_seen_cube1, x, R, layer);
   colour = layer == 1 ? texture(u_cube1, l).rgb : texture(u_cube, l).rgb;
   seen = layer == 1 ? texture(u_seen_cube1, l) : texture(u_seen_cube, l);
+  if (g_escaped) colour = u_background, seen = vec4(x + R * u_far, 0.0);  // past an occluder to the sky
 #else
   vec3 l = impostorHit(u_seen_cube, x, R);
   checkResolved(u_seen_cube, l);

@@ -381,6 +381,10 @@ void CubePass::drawElement(size_t e, int layer_draw, const PassCamera& eye) {
   if (impostor && !lens) maps.setMirrorMaps(p, e);
   if (follow > 0) maps.setCubeElements(p, e, eye.origin, layers, cubes, cubes1);
   if (impostor && lens) maps.setLensMaps(p, e);
+  if (impostor) {  // what a search that escapes past an occluder sees (shaders/impostor_search.glsl, g_escaped)
+    p.set("u_background", glm::vec3(ctx.scene.render.background));
+    p.set("u_far", float(ctx.scene.render.far_distance_m));
+  }
   if (impostor) p.set("u_seen_channel", ctx.options.seen_channel < 0 ? 1 : std::min(ctx.options.seen_channel, 2));
   draw(ctx.meshes.at(element_slot[e]));
 }

@@ -194,6 +194,7 @@ struct ExtremeCase {
   std::string scene;  // relative to the source tree
   std::string sets;   // --set options and the size
   std::vector<std::string> must_be_right;  // modes whose picture must be right (fixed, or right by design)
+  double impostor_min_psnr_db = 0;          // impostor mode's colour PSNR against the reference must exceed it
 };
 
 // Its name in gtest's messages (gtest prints a parameter's bytes otherwise).
@@ -204,8 +205,12 @@ std::vector<ExtremeCase> extremeCases() {
   return {
       // A 100 m mirror 10 km away: impostor mode's cubes could not order depths with a 1 mm near plane.
       {"far mirror", "tests/data/stress/far-mirror.json", small, {"pvrr", "impostor"}},
-      // Two facing plane mirrors: impostor mode's searches end off the maps (flagged), envmap's parallax.
-      {"mirror tunnel", "tests/data/stress/mirror-tunnel.json", small, {"pvrr"}},
+      // Two facing plane mirrors: envmap's parallax (flagged). Impostor mode: the back mirror's rays that pass
+      // behind the red ball and over the front mirror's edge escape to the sky (they ended on the front
+      // mirror's texel and went on in its cubes: 1.4' median, 37 % of the searches off the maps, PSNR 13.4 dB),
+      // now 0.014' median, 1.1 % off the maps (still flagged: the depth edges of the nested reflections,
+      // p95 7454'), PSNR 20.1 dB (pvrr mode 20.9 dB).
+      {"mirror tunnel", "tests/data/stress/mirror-tunnel.json", small, {"pvrr", "impostor"}, 18.0},
       // 1 m of sag at the rim, 87 deg slopes: the reference and impostor mode agree (0.07' median).
       {"steep asphere", "tests/data/stress/steep-asphere.json", small, {"impostor"}},
       // A 35 mm thick biconvex lens of radii 45 mm: total internal reflection over much of it.
@@ -258,8 +263,15 @@ TEST_P(ExtremeScene, RightOrFlaggedInEveryRasterMode) {
       std::cout << "[ measured ] " << c.name << ", " << mode << ": median " << median << "', "
                 << (flagged.empty() ? "good" : "flagged") << "\n";
       const bool must = std::find(c.must_be_right.begin(), c.must_be_right.end(), mode) != c.must_be_right.end();
-      if (must) EXPECT_LT(median, kRightArcmin) << mode;
-      if (median >= kRightArcmin) EXPECT_FALSE(flagged.empty()) << mode << ": median " << median << "' and good";
+      if (must) {
+        EXPECT_LT(median, kRightArcmin) << mode;
+      }
+      if (mode == "impostor") {
+        EXPECT_GT(j["psnr_db"].get<double>(), c.impostor_min_psnr_db) << mode;
+      }
+      if (median >= kRightArcmin) {
+        EXPECT_FALSE(flagged.empty()) << mode << ": median " << median << "' and good";
+      }
       // Each flagged element has its line on the command line.
       for (const std::string& name : flagged) {
         // compare's prefix: the mode padded to 8 characters (app/compare.cpp).
