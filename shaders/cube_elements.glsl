@@ -109,12 +109,12 @@ vec3 followCubes(int cur, vec3 x, vec3 R, int depth, int channel, out vec4 seen,
       vec3 n_in = normalize(lensTexel(from_back, entry.xy).yzw);
       if (dot(vl, n_in) >= 0.0) return vec3(0.0);  // along the surface: nothing to refract
       vec3 dir;
-      float tr;
+      vec3 tr;
       bool rim;
       int spent;
       vec3 q = throughLens(entry, vl, n_in, u_index[channel], u_max_depth - 1 - depth, dir, tr, rim, spent);
       refracted = true;
-      if (tr <= 0.0) {  // absorbed inside the glass, or at its rim
+      if (tr == vec3(0.0)) {  // absorbed inside the glass, or at its rim
         seen = rim ? vec4(lens_centre + (q + u_far * dir) * u_lens_to_local, 0.0)
                    : vec4(lens_centre + q * u_lens_to_local, 1.0);
         return vec3(0.0);

@@ -89,12 +89,12 @@ void main() {
       for (int ch = 0; ch < IMPOSTOR_CHANNELS; ++ch) {
         int k = IMPOSTOR_CHANNELS == 3 ? ch : 1;
         vec3 dir;
-        float tr;
+        vec3 tr;
         bool rim;
         int spent;
         vec3 q = throughLens(entry, v, n_in, u_index[k], u_max_events, dir, tr, rim, spent);
         bool seen_here = ch == (IMPOSTOR_CHANNELS == 3 ? u_seen_channel : 0);
-        if (tr <= 0.0) {  // absorbed, as in the tracer: dark
+        if (tr == vec3(0.0)) {  // absorbed, as in the tracer: dark
           if (seen_here) seen = rim ? vec4((q + u_far * dir) * u_to_local, 0.0) : vec4(q * u_to_local, 1.0);
           continue;
         }

@@ -13,6 +13,7 @@ uniform vec2 u_hm_z;              // the back surface's lowest z and the front s
 uniform float u_hm_reach;         // the maps' diagonal: no straight path inside the glass is longer
 uniform float u_far;              // render.far_distance_m: where a ray absorbed at the rim puts its seen point
 uniform vec3 u_index;             // the glass's index at the R, G and B wavelengths (.y: the d line)
+uniform vec3 u_absorption;        // the glass's absorption coefficient per channel, 1/m (0: clear; Element::absorption_per_m)
 vec4 lensTexel(bool back, vec2 xy) {
   vec2 st = (xy - u_hm.xy) * u_hm.zw;
   return back ? bilinear(u_lens_back, st) : bilinear(u_lens_front, st);
@@ -110,14 +111,17 @@ vec3 entryPoint(vec3 x, vec3 v, bool back) {
 // meets the surface with outward normal n. It refracts in, then follows the events inside the glass as the
 // tracer does up to its depth limit (max_events; render.max_depth is at most MAX_DEPTH_LIMIT): each is an
 // exit (refraction, exact Fresnel) or a total internal reflection. Returns the exit point and sets the exit
-// direction, the transmittance and the tracer's events spent on the way (entry, inside, exit);
-// transmittance 0: absorbed, at the returned point (the depth limit) or, with `rim`, where the ray left the
+// direction, the transmittance per channel and the tracer's events spent on the way (entry, inside, exit);
+// transmittance: the interfaces' Fresnel terms times the glass's absorption over the path inside it,
+// exp(-u_absorption L) per channel (the caller keeps the channel it traces, or all three when one path serves
+// all); vec3(0): absorbed, at the returned point (the depth limit) or, with `rim`, where the ray left the
 // outline (the tracer's lens has no rim surface: its seen point lies u_far along `dir`, the ray inside).
-vec3 throughLens(vec3 x, vec3 v, vec3 n, float eta, int max_events, out vec3 dir, out float transmittance,
+vec3 throughLens(vec3 x, vec3 v, vec3 n, float eta, int max_events, out vec3 dir, out vec3 transmittance,
                  out bool rim, out int spent) {
   float cos_i = -dot(v, n);
   vec3 d = refract(v, n, 1.0 / eta);
-  transmittance = 1.0 - fresnelDielectric(cos_i, 1.0, eta);
+  float fresnel = 1.0 - fresnelDielectric(cos_i, 1.0, eta);
+  float inside = 0.0;  // the path's length inside the glass
   rim = false;
   vec3 p = x;
   for (int event = 0; event < MAX_DEPTH_LIMIT; ++event) {
@@ -128,6 +132,7 @@ vec3 throughLens(vec3 x, vec3 v, vec3 n, float eta, int max_events, out vec3 dir
       break;
     }
     p += t * d;
+    inside += t;
     if (event >= max_events) break;  // absorbed at p
     vec3 nout = normalize(lensTexel(back, p.xy).yzw);
     float c = dot(d, nout);
@@ -135,14 +140,15 @@ vec3 throughLens(vec3 x, vec3 v, vec3 n, float eta, int max_events, out vec3 dir
     vec3 out_dir = refract(d, -nout, eta);
     if (out_dir != vec3(0.0)) {
       dir = out_dir;
-      transmittance *= 1.0 - fresnelDielectric(c, eta, 1.0);
+      vec3 glass = u_absorption == vec3(0.0) ? vec3(1.0) : exp(-u_absorption * inside);
+      transmittance = (fresnel * (1.0 - fresnelDielectric(c, eta, 1.0))) * glass;
       spent = event + 2;  // the entry, the events inside, the exit
       return p;
     }
     d = reflect(d, nout);  // total internal reflection
   }
   dir = d;
-  transmittance = 0.0;
+  transmittance = vec3(0.0);
   spent = 0;
   return p;
 }

@@ -60,13 +60,14 @@ float shadowPcf(sampler2DArrayShadow s, vec3 uvz, float layer) {
 }
 #endif
 
-// The fraction of the light reaching the point at map coordinates uvz of layer `layer`.
-float shadowAt(vec3 uvz, float layer) {
+// The fraction of the light reaching the point at map coordinates uvz of layer `layer`, per channel (a tinted
+// lens passes each channel its own share).
+vec3 shadowAt(vec3 uvz, float layer) {
   uvz.z = min(uvz.z, 1.0);
-  float lit = shadowPcf(u_shadow_depth, uvz, layer);
+  vec3 lit = vec3(shadowPcf(u_shadow_depth, uvz, layer));
 #if defined(SHADOW_LENSES)
   float behind_lens = 1.0 - shadowPcf(u_shadow_lens_depth, uvz, layer);
-  lit *= mix(1.0, textureLod(u_shadow_lens_t, vec3(uvz.xy, layer), 0.0).r, behind_lens);
+  lit *= mix(vec3(1.0), textureLod(u_shadow_lens_t, vec3(uvz.xy, layer), 0.0).rgb, behind_lens);
 #endif
   return lit;
 }
@@ -98,7 +99,7 @@ vec3 shadowedLight(vec3 p, vec3 n) {
   for (int i = 0; i < NUM_DIR_LIGHTS; ++i) {
     float c = -dot(n, u_dir_light_dir[i]);
     if (c <= 0.0) continue;
-    float f = 1.0;
+    vec3 f = vec3(1.0);
     if (u_dir_shadow_layer[i] >= 0.0) {
       vec4 q = u_dir_shadow_matrix[i] * vec4(p + n * (kShadowNormalOffset * u_dir_shadow_texel_m[i]), 1.0);
       f = shadowAt(q.xyz / q.w * 0.5 + 0.5, u_dir_shadow_layer[i]);
@@ -113,7 +114,7 @@ vec3 shadowedLight(vec3 p, vec3 n) {
     if (!(d2 > 0.0)) continue;
     float c = dot(n, to) * inversesqrt(d2);
     if (c <= 0.0) continue;
-    float f = 1.0;
+    vec3 f = vec3(1.0);
     if (u_point_shadow_layer[i] >= 0.0) {
       vec3 a = abs(to);
       // A texel at distance m along the face's axis: 2 tan_half m / side.

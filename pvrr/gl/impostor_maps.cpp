@@ -80,6 +80,7 @@ void ImpostorMaps::setLensMaps(const Program& p, size_t e, int first_unit, const
   p.set("u_hm_z", glm::vec2(float(m.map.back_z_min), float(m.map.front_z_max)));
   p.set(rotation, glm::mat3(Mat3(el.world_to_local)));
   const double* wl = kRgbWavelengths_nm;
+  p.set("u_absorption", glm::vec3(el.absorption_per_m));  // a tinted lens (lens_march.glsl throughLens)
   p.set("u_index", glm::vec3(float(el.dispersion.index(wl[0])), float(el.dispersion.index(wl[1])),
                              float(el.dispersion.index(wl[2]))));
 }

@@ -162,7 +162,7 @@ void ShadowPass::makeTextures() {
   makeArray(depth_, GL_DEPTH_COMPONENT32F, GL_DEPTH_COMPONENT, GL_FLOAT, true);
   if (layout_.lenses) {
     makeArray(lens_depth_, GL_DEPTH_COMPONENT32F, GL_DEPTH_COMPONENT, GL_FLOAT, true);
-    makeArray(lens_t_, GL_R16F, GL_RED, GL_FLOAT, false);
+    makeArray(lens_t_, GL_RGBA16F, GL_RGBA, GL_FLOAT, false);  // per channel: a tinted lens (lensShadowPassed)
   }
   glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
   glGenFramebuffers(1, &fbo_);
@@ -242,7 +242,7 @@ void ShadowPass::render() {
       const Element& el = scene_.elements[e];
       if (el.type != ElementType::Lens) continue;
       lens.set("u_view_proj", toFloat(layer.proj * layer.view * el.local_to_world));
-      lens.set("u_transmittance", layer.caustics ? 0.0f : float(lensShadowTransmittance(el)));
+      lens.set("u_transmittance", layer.caustics ? glm::vec3(0.0f) : glm::vec3(lensShadowPassed(el)));
       draw(element_meshes_[e]);
     }
   }

@@ -10,7 +10,8 @@
 // and filtered as 3 x 3 bilinear taps one texel apart (PCF over a 4 x 4 texel footprint, read by four
 // gathers; measured in docs/accuracy.md "Shadows", its cost in docs/performance.md "Shadows").
 // Casters: the environment meshes and the mirrors (opaque); the lenses go into their own depth layers with
-// their transmittance (1 - R0)^2 beside (pvrr/trace/shadow_rays.h): a point behind the nearest lens from the
+// their transmittance beside, per channel (RGBA16F): (1 - R0)^2, times a tinted lens's absorption over its mean
+// thickness (lensShadowPassed, pvrr/trace/shadow_rays.h): a point behind the nearest lens from the
 // light gets that lens's transmittance, behind an opaque caster nothing; for a light whose caustics are on
 // (pvrr/gl/caustic_pass.h) nothing either, as the light through the lens arrives as the caustic. The maps are
 // rendered when the

@@ -41,7 +41,9 @@ struct CausticPlanOptions {
 
 // One exact photon at a mesh vertex: where it left its element and how much power per unit aperture measure
 // it carries (W/m^2 of aperture for a directional light, W per unit tangent-plane area for a point light,
-// after the element's reflectance or Fresnel transmittances and the sample's colour weight).
+// after the element's reflectance or Fresnel transmittances, a tinted lens's absorption along the photon's path
+// inside the glass, exp(-alpha_c L) per channel (followPhoton, pvrr/trace/light_tracer.h), and the sample's
+// colour weight).
 struct CausticVertex {
   Vec2 xy{0};  // aperture coordinates
   Vec3 origin{0}, direction{0};

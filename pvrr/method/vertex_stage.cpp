@@ -217,6 +217,8 @@ static void traceVertexRaysFrom(const RayScene& rays, ElementFrame& f, const Vec
         const double trans = (1.0 - fresnelDielectric(cos_in, 1.0, n_glass)) *
                              (out.tir ? 0.0 : 1.0 - fresnelDielectric(cos_back, n_glass, 1.0));
         vr.transmittance = Vec3(trans);
+        // A tinted lens's glass absorbs along the internal path, per channel (exactly 1 for clear glass).
+        if (el.absorbing()) vr.transmittance *= el.internalTransmittance(glm::length(back.point - p));
         vr.origin = back.point;
         if (out.tir) {
           vr.status = VertexStatus::Tir;

@@ -33,7 +33,9 @@ struct VertexRay {
   Vec3 hit{0};     // the exact hit point, or the far point of an escaping ray
   // Lenses: the direction inside the glass, the back-surface point and its unit normal.
   Vec3 internal_dir{0}, back_point{0}, back_normal{0};
-  Vec3 transmittance{1.0};  // lens: Fresnel transmittance of both interfaces (per RGB channel)
+  // Lens: Fresnel transmittance of both interfaces times, for a tinted lens, the glass's absorption over the
+  // internal path vertex -> back_point, exp(-alpha_c L) per RGB channel c (Element::absorption_per_m).
+  Vec3 transmittance{1.0};
   // A lens vertex whose internal ray is totally reflected at the back surface (status Tir; transmittance 0)
   // when VertexStageOptions::tir_trace_depth > 0: what the reference tracer shows along the vertex's
   // incoming ray at this channel's wavelength (the light reflected inside the lens and leaving through the

@@ -278,4 +278,22 @@ Metal lookupMetal(const std::string& name) {
   throw Error("mirror metal \"" + name + "\": unknown; expected one of " + joinNames(metalNames()));
 }
 
+Vec3 absorptionFromInternalTransmittance(const Vec3& tau_i, double thickness_m) {
+  if (!(thickness_m > 0) || !std::isfinite(thickness_m))
+    throw Error("internal transmittance: the reference thickness must be a finite length > 0, got " +
+                std::to_string(thickness_m));
+  Vec3 alpha(0.0);
+  for (int c = 0; c < 3; ++c) {
+    if (!(tau_i[c] > 0 && tau_i[c] <= 1))
+      throw Error("internal transmittance: expected each channel in (0, 1], got " + std::to_string(tau_i[c]));
+    alpha[c] = tau_i[c] == 1 ? 0.0 : -std::log(tau_i[c]) / thickness_m;
+  }
+  return alpha;
+}
+
+Vec3 internalTransmittance(const Vec3& absorption_per_m, double length_m) {
+  if (absorption_per_m == Vec3(0.0)) return Vec3(1.0);
+  return glm::exp(-absorption_per_m * length_m);
+}
+
 }  // namespace pvrr

@@ -72,11 +72,25 @@ class Dispersion {
   std::array<double, 3> B_{}, C_um2_{};
 };
 
+// Absorption in the glass (a tinted lens, a coloured filter glass). Glass catalogues quote the internal
+// transmittance tau_i: the fraction of light that survives a path of a reference thickness inside the glass,
+// the interfaces' Fresnel losses excluded (Schott quotes tau_i at 10 mm). By the Beer-Lambert law a path of
+// length L keeps exp(-alpha L) with the absorption coefficient alpha = -ln(tau_i) / thickness.
+// Per RGB channel; alpha in 1/metre (scene lengths are stored in metres).
+constexpr double kInternalTransmittanceThickness_m = 0.010;  // the catalogues' reference path, 10 mm
+// alpha (1/m) per channel from tau_i in (0, 1] per channel over thickness_m (> 0). Throws pvrr::Error otherwise.
+Vec3 absorptionFromInternalTransmittance(const Vec3& tau_i, double thickness_m = kInternalTransmittanceThickness_m);
+// exp(-alpha L) per channel: what a path of length_m inside the glass keeps. Exactly (1, 1, 1) for alpha = 0.
+Vec3 internalTransmittance(const Vec3& absorption_per_m, double length_m);
+
 // A named lens material of the library.
 struct LensMaterial {
   std::string name;         // the lookup key, e.g. "polycarbonate"
   std::string description;  // human-readable, with the data source
   Dispersion dispersion;
+  // Absorption coefficient per channel, 1/m (absorptionFromInternalTransmittance). The library's materials
+  // are clear glasses: 0; a scene's lens material may set it ("internal_transmittance", docs/scene-format.md).
+  Vec3 absorption_per_m{0.0};
 };
 
 // The library of spectacle and optical-glass materials. Names (case-insensitive): "cr39", "trivex",

@@ -324,6 +324,23 @@ void buildMirror(Element& el, const ElementDesc& e) {
   }
 }
 
+// A lens's mean thickness over its outline: the average of the thickness at the centres of a 64 x 64 grid over
+// the outline's bounding box that fall inside it (the centre thickness if none does).
+double meanThickness(const cad::LensSolid& lens) {
+  constexpr int kSide = 64;
+  const cad::Outline& o = lens.outline;
+  double sum = 0;
+  int count = 0;
+  for (int j = 0; j < kSide; ++j)
+    for (int i = 0; i < kSide; ++i) {
+      const Vec2 p = o.centre() + Vec2(o.width() * ((i + 0.5) / kSide - 0.5), o.height() * ((j + 0.5) / kSide - 0.5));
+      if (!o.contains(p)) continue;
+      sum += lens.thicknessAt(p.x, p.y);
+      ++count;
+    }
+  return count > 0 ? sum / count : lens.centre_thickness;
+}
+
 // A lens's glass and its two surfaces, from a prescription or given: element i of `file`, named `what` in
 // messages.
 void buildLens(Element& el, const ElementDesc& e, const std::string& file, size_t i, const std::string& what) {
@@ -337,6 +354,7 @@ void buildLens(Element& el, const ElementDesc& e, const std::string& file, size_
   if (!lm.dispersion) disp = Dispersion::constant(disp.n_d());
   el.dispersion = disp;
   el.dispersion_on = lm.dispersion;
+  el.absorption_per_m = absorptionFromInternalTransmittance(lm.internal_transmittance, lm.internal_transmittance_thickness_m);
   if (!e.outline) throw Error("a lens needs an outline");
   cad::SagSurfacePtr front, back;
   double t = e.centre_thickness_m;
@@ -358,6 +376,7 @@ void buildLens(Element& el, const ElementDesc& e, const std::string& file, size_
     back = makeLensSurface(e.back, el.outline, where + ".back");
   }
   el.lens = cad::makeLens(front, back, el.outline, t, e.min_edge_thickness_m, what);
+  el.shadow_path_m = meanThickness(el.lens);
 }
 
 }  // namespace

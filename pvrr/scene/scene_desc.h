@@ -197,6 +197,10 @@ struct LensMaterialDesc {
   // Sellmeier: n^2 - 1 = sum B_i l^2 / (l^2 - C_i), wavelength l in micrometres, C_i in um^2.
   std::array<double, 3> sellmeier_b{}, sellmeier_c_um2{};
   bool dispersion = true;  // false: n_d at every wavelength even when the render disperses
+  // Absorption in the glass: the internal transmittance tau_i per channel (R, G, B), each in (0, 1], over a
+  // path of internal_transmittance_thickness_m inside the glass (Fresnel losses excluded). 1: clear glass.
+  Vec3 internal_transmittance{1.0};
+  double internal_transmittance_thickness_m = 0.010;  // the catalogues' reference path (kInternalTransmittanceThickness_m)
 };
 
 // A spectacle prescription the build turns into surfaces. Powers in dioptres (back vertex powers).

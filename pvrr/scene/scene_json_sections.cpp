@@ -467,11 +467,15 @@ MirrorMaterialDesc readMirrorMaterial(const Ctx& c, const json* j, const std::st
 LensMaterialDesc readLensMaterial(const Ctx& c, const json* j, const std::string& path) {
   const std::string what = "a lens material {\"name\": ...} | {\"n_d\": ..., \"V_d\": ...} | "
                            "{\"sellmeier\": {\"B\": [3], \"C\": [3]}}";
-  Obj o(c, j, path, what, {"name", "n_d", "V_d", "sellmeier", "dispersion"});
+  Obj o(c, j, path, what,
+        {"name", "n_d", "V_d", "sellmeier", "dispersion", "internal_transmittance", "internal_transmittance_thickness"});
   LensMaterialDesc m;
   const int forms = int(o.has("name")) + int(o.has("n_d") || o.has("V_d")) + int(o.has("sellmeier"));
   if (forms != 1)
-    c.expected(path, "exactly one of {\"name\"}, {\"n_d\", \"V_d\"} or {\"sellmeier\"} (plus \"dispersion\")", j);
+    c.expected(path,
+               "exactly one of {\"name\"}, {\"n_d\", \"V_d\"} or {\"sellmeier\"} (plus \"dispersion\", "
+               "\"internal_transmittance\", \"internal_transmittance_thickness\")",
+               j);
   if (o.has("name")) {
     // The material library (pvrr/optics/material.h) is the catalogue: its names, its n_d and V_d.
     m.kind = LensMaterialDesc::Kind::Named;
@@ -504,6 +508,27 @@ LensMaterialDesc readLensMaterial(const Ctx& c, const json* j, const std::string
     m.V_d = o.number("V_d", closed(10, 120));
   }
   m.dispersion = o.boolean("dispersion", true);
+  // Absorption: tau_i as one number (grey) or [r, g, b], each in (0, 1], over a reference path (a length in the
+  // file's unit, default 10 mm as glass catalogues quote it).
+  if (o.has("internal_transmittance")) {
+    const json* t = o.get("internal_transmittance");
+    const std::string twhat = "an internal transmittance in (0, 1] or [r, g, b] with each in (0, 1]";
+    const Range unit = leftOpen(0, 1);
+    if (t->is_array()) {
+      if (t->size() != 3) o.expected("internal_transmittance", twhat);
+      for (int i = 0; i < 3; ++i) {
+        const json& e = (*t)[size_t(i)];
+        if (!e.is_number() || !std::isfinite(e.get<double>()) || !unit.contains(e.get<double>()))
+          o.expected("internal_transmittance", twhat);
+        m.internal_transmittance[i] = e.get<double>();
+      }
+    } else {
+      if (!t->is_number()) o.expected("internal_transmittance", twhat);
+      m.internal_transmittance = Vec3(o.number("internal_transmittance", unit, "an internal transmittance"));
+    }
+  }
+  m.internal_transmittance_thickness_m =
+      o.length("internal_transmittance_thickness", kPositive, kInternalTransmittanceThickness_m);
   return m;
 }
 

@@ -154,6 +154,9 @@ PhotonFate followPhoton(const RayScene& rays, int element, double wavelength_nm,
     } else {
       hit = hitInsideLens(rays, inside, o, d, t_min);
       if (!hit.hit()) return PhotonFate::Absorbed;  // out through the lens's edge band, not modelled as a surface
+      // The glass absorbs along the segment (Beer-Lambert, per channel; exactly 1 for clear glass).
+      const Element& glass = scene.elements[size_t(inside)];
+      if (glass.absorbing()) p.power *= glass.internalTransmittance(glm::length(hit.point - o));
     }
     if (depth == 0 && (hit.kind != HitKind::Element || hit.element != element)) return PhotonFate::Missed;
     if (hit.kind != HitKind::Element) {

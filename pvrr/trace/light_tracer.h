@@ -18,8 +18,9 @@
 // - Transport: mirrors multiply by their reflectance (a metal's conductor Fresnel reflectance per channel, or at
 //   the sample's wavelength in the spectral mode), lens interfaces by the exact unpolarised Fresnel
 //   transmittance 1 - R at the sample's index n(lambda) (pvrr/optics/optics.h); TIR is followed; a mirror's back,
-//   a lens's edge band and the depth limit absorb. The lens glass itself is taken as non-absorbing (the scene
-//   format has no absorption coefficient); so is the air.
+//   a lens's edge band and the depth limit absorb. A tinted lens's glass absorbs: each segment of length L
+//   inside it multiplies the photon's power by exp(-alpha_c L) per channel c (Element::absorption_per_m, from the
+//   material's "internal_transmittance"); the air does not absorb.
 // - Dispersion (TraceOptions' modes): off: one sample at the d line, weight (1, 1, 1); rgb: three samples at the
 //   C, d, F lines, each keeping its channel; spectral: N samples with the colour-matching weights of
 //   pvrr/optics/spectrum.h. Scenes without a dispersing lens (or, spectral, a tabulated metal) trace one sample.

@@ -17,6 +17,11 @@ double lensShadowTransmittance(const Element& lens) {
   return (1.0 - r0) * (1.0 - r0);
 }
 
+Vec3 lensShadowPassed(const Element& lens) {
+  const Vec3 fresnel(lensShadowTransmittance(lens));
+  return lens.absorbing() ? fresnel * lens.internalTransmittance(lens.shadow_path_m) : fresnel;
+}
+
 Vec3 ShadowRays::transmittance(const Light& l, const Vec3& p) const {
   if (!l.shadows || l.type == Light::Type::Ambient) return Vec3(1.0);
   Vec3 d;
@@ -30,14 +35,15 @@ Vec3 ShadowRays::transmittance(const Light& l, const Vec3& p) const {
     d = to / t_max;
   }
   const Scene& scene = rays_.scene();
-  double t_min = rays_.epsilon(), passed = 1.0;
+  double t_min = rays_.epsilon();
+  Vec3 passed(1.0);
   for (int crossing = 0; crossing < kMaxCrossings; ++crossing) {
     const RayHit hit = rays_.intersect(p, d, t_min, t_max);
-    if (!hit.hit()) return Vec3(passed);
+    if (!hit.hit()) return passed;
     if (hit.kind == HitKind::Environment) return Vec3(0.0);
     const Element& el = scene.elements[size_t(hit.element)];
     if (el.type == ElementType::Mirror || (caustic_lights_block_ && l.caustics)) return Vec3(0.0);
-    passed *= std::sqrt(lensShadowTransmittance(el));  // one interface: 1 - R0
+    passed *= glm::sqrt(lensShadowPassed(el));  // one interface: 1 - R0 (and half the glass's absorption)
     t_min = hit.t + rays_.epsilon();
   }
   return Vec3(0.0);

@@ -10,7 +10,11 @@
 //   segment through both faces keeps (1 - R0)^2 (lensShadowTransmittance). Normal incidence, not the ray's
 //   own angle: the raster path's shadow maps hold one transmittance per lens (shaders/shadow_lookup.glsl),
 //   and the two agree by construction. The segment is not bent by the lens (where the light it refracts
-//   lands is a caustic).
+//   lands is a caustic). A tinted lens (Element::absorption_per_m) also absorbs, per channel, as over a path of
+//   its mean thickness (Element::shadow_path_m, over the outline): the whole lens passes
+//   (1 - R0)^2 exp(-alpha_c shadow_path_m) (lensShadowPassed), each interface crossed the square root of that.
+//   A per-lens constant again, for the shadow maps' sake; against the exact straight chord through the glass
+//   it errs by alpha times the chord's departure from the mean thickness (docs/caustics.md "Absorption").
 // - with `caustic_lights_block` (the reference picture with the caustic light added, TraceOptions::caustics):
 //   for a light with caustics on (Light::caustics), a lens blocks fully too, as in the raster shadow maps: its
 //   light arrives refracted, as the caustic (pvrr/trace/light_tracer.h), not straight through.
@@ -23,12 +27,15 @@ namespace pvrr {
 
 // (1 - R0)^2: what a lens passes of light crossing both its faces near normal incidence.
 double lensShadowTransmittance(const Element& lens);
+// What the shadow rule passes of a lens per channel: lensShadowTransmittance(lens) times the glass's
+// absorption over its mean thickness, exp(-alpha_c shadow_path_m); grey (1 - R0)^2 for a clear lens.
+Vec3 lensShadowPassed(const Element& lens);
 
 class ShadowRays {
  public:
   explicit ShadowRays(const RayScene& rays, bool caustic_lights_block = false)
       : rays_(rays), caustic_lights_block_(caustic_lights_block) {}
-  // The fraction of light `l` that reaches `p`, per channel (grey: lenses attenuate every channel alike);
+  // The fraction of light `l` that reaches `p`, per channel (grey unless a tinted lens is crossed);
   // 1 for a light with shadows off and for an ambient light.
   Vec3 transmittance(const Light& l, const Vec3& p) const;
 

@@ -55,6 +55,9 @@ TraceResult Tracer::traceImpl(const Vec3& o_in, const Vec3& d_in, double wavelen
     if (inside >= 0) {
       // Inside a lens: the next event is on one of its own surfaces.
       hit = hitInsideLens(rays_, inside, o, d, t_min);
+      // The glass absorbs along the segment inside it (Beer-Lambert, per channel; exactly 1 for clear glass).
+      const Element& glass = scene_.elements[size_t(inside)];
+      if (hit.hit() && glass.absorbing()) throughput *= glass.internalTransmittance(glm::length(hit.point - o));
       if (!hit.hit()) {
         // Leaving through the lens's edge band, which is not modelled as a surface: absorbed.
         if (path) path->push_back({o, d, "absorb", inside, false, {}, {}, 1, 1});

@@ -7,7 +7,9 @@
 //
 // Lens model (shared with the raster path): light passing a lens is weighted by the exact Fresnel
 // transmittance (1 - R) of each interface it crosses; the light a lens surface reflects is not added.
-// Total internal reflection inside a lens is followed (up to the depth limit). A mirror reflects with its
+// Total internal reflection inside a lens is followed (up to the depth limit). A tinted lens's glass absorbs:
+// each segment of length L inside it multiplies the throughput by exp(-alpha_c L) per channel c
+// (Element::absorption_per_m; a spectral or rgb sample's channel weight gets the same factor). A mirror reflects with its
 // reflectance (or the conductor Fresnel reflectance of its metal, per channel); its back side is dark.
 //
 // Dispersion (DispersionMode, pvrr/scene/render_desc.h): "off" traces one ray with each lens's index at the d
