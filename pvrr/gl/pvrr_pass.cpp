@@ -387,8 +387,8 @@ void PvrrPass::uploadRefinedPatch(MeshBuffers& mb, const ElementFrame& f, const 
 // The centre is where a smooth function's quadratic interpolant errs most; the misses above it are those of
 // triangles across a knot line of the surface (its normal's third derivative jumps) or a depth edge, and of
 // coarse grids. Measured on the car mirror (15 x 15, 392 triangles in view; docs/accuracy.md "Per-fragment
-// refinement"), triangles searched and median / p95 at 640 x 480: 0.01' 193, 0.0090' / 0.074'; 0.1' 115,
-// 0.0106' / 0.097'; 0.3' 95, 0.0113' / 0.118'; 1' 83, 0.0118' / 0.27' (all searched: 0.0084' / 0.074'). At
+// refinement"), triangles searched and median / p95 at 640 x 480: 0.01' 180, 0.0090' / 0.074'; 0.1' 115,
+// 0.0106' / 0.097'; 0.3' 97, 0.0112' / 0.118'; 1' 92, 0.0114' / 0.17' (all searched: 0.0084' / 0.074'). At
 // 160 x 120 0.3' let the p95 reach 1.2' (0.1': 0.98'; all searched 0.61'). A test mirror's 9 x 9 grid
 // (refine_test.cpp) misses by more than 0.1' nearly everywhere (121 to 125 of 128 searched), its 17 x 17 grid
 // in 67 of 512.
