@@ -11,6 +11,8 @@
 //   NO_SEEN_POINTS  colour only: the seen-point maps are not read (RendererOptions::seen_points off)
 //   REFINE n     fragments that search their exact ray in the map, n secant steps (render.refine;
 //                pvrr_refine.glsl): a mirror's reflected ray (CHANNELS 1), or a lens's exit ray per channel (LENS)
+//   REFINE_P2    (a refined mirror's triangles that need no search; CHANNELS 1, without REFINE) the texture
+//                coordinate from the triangle's quadratic interpolant through its exact rays (pvrr_refine.glsl)
 #include "element_inputs.glsl"
 uniform sampler2D u_map;         // first pass colour (linear)
 uniform sampler2D u_seen_map;    // first pass seen points, relative to the map's camera origin (LINEAR)
@@ -71,6 +73,8 @@ void main() {
 #else
 #if defined(REFINE)
   vec2 st0 = refinedST(view, mapST(v_st0));  // the seen channel's too: a mirror has one
+#elif defined(REFINE_P2)
+  vec2 st0 = quadraticST();
 #else
   vec2 st0 = mapST(v_st0);
 #endif
@@ -89,7 +93,7 @@ void main() {
   // (positions are not affine across a perspective image: up to ~0.4' in the burning lens's 130-150 deg maps).
   vec4 seen = texture(u_seen_map, st_seen);
   if (refine_seen_ok && seen.w > 0.999) seen.xyz = refine_seen;
-#elif defined(REFINE)
+#elif defined(REFINE) || defined(REFINE_P2)
   vec4 seen = texture(u_seen_map, st0);
 #else
   vec4 seen = texture(u_seen_map, mapST(v_st_seen));

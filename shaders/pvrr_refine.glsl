@@ -20,8 +20,22 @@
 // Atomic counters count, in the second pass, the fragments whose view ray missed the exact surface (the
 // triangles' silhouette overhang) and those whose search failed; pvrr/gl/pvrr_pass.cpp counts the fragments
 // drawn with a query and reads both into the second pass's note once the frame has finished.
-#if defined(REFINE) && CHANNELS != 1 && !defined(LENS)
+#if (defined(REFINE) || defined(REFINE_P2)) && CHANNELS != 1 && !defined(LENS)
 #error "REFINE: a mirror's one channel only"
+#endif
+#if defined(REFINE_P2)
+// A refined mirror's triangle whose exact rays the CPU found smooth enough (pvrr/gl/pvrr_pass.cpp
+// refinedSplit): its texture coordinate is the quadratic (P2) interpolant, in the flat triangle's barycentric
+// coordinates, of the exact rays' volume coordinates at its corners and at the points where the view rays
+// through its edges' midpoints meet the exact surface; no search, no texture read beyond the unrefined ones.
+// v_st0: the corner's volume coordinate (s, t, 1); v_st1.xy: its barycentric corner (b1, b2); v_st2, v_w1: the
+// deviations D01, D12, D20 of the edges' midpoint nodes from the edges' means (the same at all three corners).
+vec2 quadraticST() {
+  vec2 b = v_st1.xy;
+  float b0 = 1.0 - b.x - b.y;
+  vec2 st = v_st0.xy + 4.0 * (b0 * b.x * v_st2.xy + b.x * b.y * vec2(v_st2.z, v_w1.x) + b.y * b0 * v_w1.yz);
+  return min(st * u_st_scale, u_st_max);
+}
 #endif
 #if defined(REFINE)
 uniform bool u_refine;          // this patch view is refined (else the interpolated coordinate, as without REFINE)

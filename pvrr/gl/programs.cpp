@@ -75,6 +75,7 @@ const Program& Programs::pvrr(bool lens, size_t channels, bool rgb, bool planes,
   std::vector<std::string> d = {channels > 1 ? "#define CHANNELS 3" : "#define CHANNELS 1"};
   if (lens) d.push_back("#define LENS");
   if (rgb) d.push_back("#define RGB_CHANNELS");
+  if (refine == kRefineQuadratic) d.push_back("#define REFINE_P2");
   if (refine > 0) {
     // Its counters and its depth edge test (shaders/pvrr_refine.glsl): GL 4.2's atomic counters and GL 4.0's
     // textureGather, in a GLSL 3.30 shader.

@@ -55,6 +55,8 @@ class Programs {
   // spheres (a refined lens): bit 0 its front, bit 1 its back is a sphere or plane, met in closed form
   // (SPHERE_FRONT, SPHERE_BACK); bit 2 its outline is an ellipse or circle, tested in closed form
   // (OUTLINE_ELLIPSE).
+  // refine kRefineQuadratic: a refined mirror's triangles that need no search (REFINE_P2).
+  static constexpr int kRefineQuadratic = -1;
   const Program& pvrr(bool lens, size_t channels, bool rgb, bool planes, int refine = 0, int spheres = 0) const;
   // Distance-impostor elements (shaders/element_impostor.frag): a mirror, or a lens with one or three
   // wavelengths; cube_elements > 0: searches that meet a mirror in a cube go on in its cubes (CUBE_ELEMENTS).

@@ -56,7 +56,30 @@ class PvrrPass : public ModePass {
   void unsetRefinement() const;
   void setRefinementView(const Program& p, int element, const PatchView& pv, const Framebuffer& map, int side) const;
   std::string refinementSkips(bool* any) const;
-  void uploadRefinedPatch(MeshBuffers& mb, const ElementFrame& f, const PatchView& pv, const Vec3& anchor) const;
+  // tris: the patch's triangles to upload (indices into GridPatch::triangles); null: all of them.
+  void uploadRefinedPatch(MeshBuffers& mb, const ElementFrame& f, const PatchView& pv, const Vec3& anchor,
+                          const std::vector<uint32_t>* tris = nullptr) const;
+  // The quadratic split of a refined mirror's patch in the second pass (docs/method.md "Per-fragment
+  // refinement"): the triangles whose exact rays at their edges' midpoints and centre (refineNodes) follow one
+  // smooth surface of the map, and whose quadratic interpolant of those rays' coordinates meets the exact one at
+  // the centre within kQuadraticTolRad, go to `quadratic` (uploaded as the REFINE_P2 program reads them); the
+  // others' indices to *searched (uploadRefinedPatch). Returns the number of quadratic triangles.
+  size_t uploadQuadraticPatch(MeshBuffers& quadratic, std::vector<uint32_t>* searched, const ElementFrame& f,
+                              const PatchView& pv, const Vec3& anchor) const;
+  // A node of the quadratic split: where the view ray from the element's eye through a point of the flat
+  // triangle (an edge's midpoint, or the centre) meets the exact surface, reflected and traced into the scene.
+  struct RefineNode {
+    Vec3 hit{0};           // the exact hit, or the escaping ray's far point
+    bool valid = false;    // the view ray met the exact surface within its parameter domain
+    bool escaped = false;  // the reflected ray hit nothing
+  };
+  // The nodes of refined mirror f in this frame (edges by edgeKey, centres by triangleKey), computed once per
+  // frame in which anything moved.
+  const std::unordered_map<uint64_t, RefineNode>& refineNodes(const ElementFrame& f) const;
+  static uint64_t triangleKey(uint32_t i, uint32_t j, uint32_t k) {
+    const uint32_t a = std::min({i, j, k}), c = std::max({i, j, k}), b = i ^ j ^ k ^ a ^ c;
+    return 1ull << 63 | uint64_t(a) << 42 | uint64_t(b) << 21 | c;
+  }
   // The exact surface point (local frame) at the parameter-domain midpoint of each edge of refined element f's
   // grid triangles, by edgeKey of its grid vertices; cached while its surface and grid stay the same.
   using EdgeMidpoints = std::unordered_map<uint64_t, Vec3>;
@@ -82,10 +105,20 @@ class PvrrPass : public ModePass {
   std::unique_ptr<ImpostorMaps> surface_maps;  // the refined mirrors' surface maps (pvrr/impostor/surface_map.h)
                                                // and lenses' refractor height maps (lens_height_map.h)
   bool refine_counting = false;          // drawing the second pass (counted), not a nested pass
+  mutable size_t refine_quadratic = 0, refine_searched = 0;  // this frame's second-pass triangles of each kind
   struct RefineMidpoints {
     cad::SurfacePtr surface;  // what they were computed for (held: never a reused address)
     std::vector<Vec2> params;
     EdgeMidpoints mids;
+    // The quadratic split's starting points: the exact surface (local frame) at each edge's midpoint (edgeKey)
+    // and each triangle's centre (triangleKey) in the parameter domain: parameters, point and derivatives.
+    struct Start {
+      Vec2 uv{0};
+      Vec3 p{0}, du{0}, dv{0};
+    };
+    std::unordered_map<uint64_t, Start> starts;
+    std::unordered_map<uint64_t, RefineNode> nodes;  // this frame's (refineNodes)
+    bool nodes_fresh = false;
   };
   mutable std::vector<RefineMidpoints> refine_mids;  // per element (edgeMidpoints)
 };
