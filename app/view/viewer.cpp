@@ -217,6 +217,25 @@ void Viewer::frame() {
     probe_fresh_ = true;
   }
   window_.context().makeCurrent();
+  if (!wipe_drawn_) {
+    // The wipe's first draw, where a software GL compiles its shaders' code: here, of the first frame, into the
+    // back buffer that the frame (drawn into it, or presented) then overwrites, not at the first reference.
+    wipe_->present(renderer_->colorTexture(), ob.width, ob.height, 0.5 * ob.width, true);
+    wipe_drawn_ = true;
+  }
+  {
+    // The renderer's second pass straight into the back buffer (no present pass), but while the wipe shows the
+    // frame beside the reference (it reads the frame's texture), where the window cannot take it, and on a frame
+    // with a screenshot of the frame alone: that one is drawn into the texture and presented, as pvrr render
+    // draws it. In the back buffer GL rasterizes the frame mirrored (a window's rows are stored top-down, a
+    // texture's bottom-up), so a pixel whose centre lies exactly on a triangle's edge can fall to the other
+    // triangle (1-3 pixels of 76,800 at 320 x 240 in the tests' views), and GL's sRGB encode is a code off the
+    // exact one for about 6 % of values (docs/performance.md); the frame-alone screenshot is render's picture.
+    int fw = 0, fh = 0;
+    window_.framebufferSize(&fw, &fh);
+    renderer_->setIntoDefaultFramebuffer(direct_allowed_ && window_.takesFrameDirectly() && !reference_ &&
+                                         pending_screenshots_.empty() && fw == ob.width && fh == ob.height);
+  }
   // A screenshot frame is drawn whole, every stage run (its own empty cache), so that it is what pvrr render
   // draws of the saved view: frames that reuse earlier maps (map reuse, render.map_reuse_margin_deg) differ
   // from a fresh frame in places, as they do in pvrr render --frames --orbit.
@@ -224,13 +243,6 @@ void Viewer::frame() {
   const gl::RasterFrame f = renderer_->render(mode_, pending_screenshots_.empty() ? &cache_ : &whole);
   cache_.environment_changed = false;  // the environment never changes while the window is open
   const auto t_render = Clock::now();
-  if (!wipe_drawn_) {
-    // The wipe's first draw, where a software GL compiles its shaders' code: here, of the first frame, into the
-    // back buffer that the frame's present (and the panel over the rest) then overwrites, not at the first
-    // reference.
-    wipe_->present(renderer_->colorTexture(), ob.width, ob.height, 0.5 * ob.width, true);
-    wipe_drawn_ = true;
-  }
   // The panel first made (no GL), then the frame presented around its opaque rectangle, then the panel drawn.
   window_.beginPanel();
   fov_overlay_.draw(ls_.scene, ls_.desc, *rays_, selected_, scene_builds_, ob);  // under the panel, in panel shots
@@ -411,6 +423,10 @@ std::optional<PixelRect> Viewer::panelHole() const {
 }
 
 void Viewer::presentFrame(const Observer& ob) {
+  if (!reference_ && renderer_->drewIntoDefaultFramebuffer()) {
+    ++direct_frames_;  // the frame is in the back buffer already
+    return;
+  }
   if (!reference_) {
     const std::optional<PixelRect> hole = panelHole();
     panel_hole_frames_ += hole ? 1 : 0;
@@ -563,7 +579,12 @@ json Viewer::stats() const {
             {"swap", t.empty() ? 0.0 : median(swap_ms_)}}},
           // Frames presented around the panel's opaque rectangle (the last frame's, window pixels, rows
           // top-down, [x0, x1) x [y0, y1)): the frame under it is not drawn.
-          {"present", {{"panel_hole_frames", panel_hole_frames_},
+          // Frames drawn by the renderer straight into the window's back buffer (no present pass), and that
+          // buffer's depth bits and colour encoding (app/view/window.h takesFrameDirectly).
+          {"present", {{"direct_frames", direct_frames_},
+                       {"window_depth_bits", window_.depthBits()},
+                       {"window_srgb", window_.srgbCapable()},
+                       {"panel_hole_frames", panel_hole_frames_},
                        {"panel_rect", {panel_rect_.x0, panel_rect_.y0, panel_rect_.x1, panel_rect_.y1}}}},
           // The panel drawn from its picture (app/view/panel_cache.h): pictures made, frames copied from one.
           {"panel", {{"pictures", window_.panelCache().pictures()}, {"copies", window_.panelCache().copies()}}},
