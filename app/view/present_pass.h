@@ -19,6 +19,7 @@ struct PixelRect {
   int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
   bool empty() const { return x1 <= x0 || y1 <= y0; }
   bool operator==(const PixelRect& o) const { return x0 == o.x0 && y0 == o.y0 && x1 == o.x1 && y1 == o.y1; }
+  bool contains(const PixelRect& o) const { return o.x0 >= x0 && o.y0 >= y0 && o.x1 <= x1 && o.y1 <= y1; }
 };
 
 // The uniform block SrgbBuckets of shaders/srgb_encode.glsl: 2048 words, each two buckets (16 bits, the lower

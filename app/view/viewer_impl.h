@@ -166,6 +166,8 @@ class Viewer {
   const ImDrawList* panel_list_ = nullptr;
   int panel_hole_frames_ = 0;  // frames presented around the panel
   int direct_frames_ = 0;      // frames the renderer drew into the back buffer (no present pass)
+  PixelRect covered_;          // the panel's rectangle that this frame's renderer left out
+  int panel_covered_frames_ = 0, panel_redraws_ = 0;
   // The renderer may draw into the back buffer; PVRR_VIEW_PRESENT_PASS=1 turns it off (the present pass
   // every frame), to measure the two against each other in one build (docs/performance.md).
   bool direct_allowed_ = !std::getenv("PVRR_VIEW_PRESENT_PASS") || std::string(std::getenv("PVRR_VIEW_PRESENT_PASS")) != "1";

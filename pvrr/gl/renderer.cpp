@@ -156,6 +156,7 @@ RasterFrame Renderer::render(RenderMode mode, FrameCache* cache) {
 void Renderer::setReadBack(bool on) { impl_->options.read_back = on; }
 void Renderer::setIntoDefaultFramebuffer(bool on) { impl_->options.into_default_framebuffer = on; }
 bool Renderer::drewIntoDefaultFramebuffer() const { return impl_->drew_into_default; }
+void Renderer::setCoveredRect(const std::array<int, 4>& rect) { impl_->options.covered_rect = rect; }
 std::vector<CausticMap> Renderer::causticMaps() const { return impl_->caustics->readMaps(); }
 const CausticPlan& Renderer::causticPlan() const { return impl_->caustics->plan(); }
 unsigned Renderer::colorTexture() const {
@@ -230,6 +231,16 @@ std::string Renderer::Impl::secondPass(RenderMode mode, ModePass& pass, CullCoun
   const Framebuffer& target = drew_into_default ? *default_target : *frame_target;
   if (drew_into_default) glEnable(GL_FRAMEBUFFER_SRGB);
   target.clearDepth();  // no colour clear: the sky covers every pixel nothing else does
+  const std::array<int, 4>& covered = options.covered_rect;
+  if (drew_into_default && covered[2] > covered[0] && covered[3] > covered[1]) {
+    // What the caller draws over: depth at the near plane, nothing passes there (RendererOptions::covered_rect).
+    const float near_depth = 0.0f;
+    glDepthMask(GL_TRUE);
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(covered[0], covered[1], covered[2] - covered[0], covered[3] - covered[1]);
+    glClearBufferfv(GL_DEPTH, 0, &near_depth);
+    glDisable(GL_SCISSOR_TEST);
+  }
   // The elements come first: the depth state must not depend on what an earlier pass (or none) left.
   glEnable(GL_DEPTH_TEST);
   glDepthMask(GL_TRUE);

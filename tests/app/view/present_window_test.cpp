@@ -68,6 +68,9 @@ void checkFrameAroundThePanel(bool present_pass) {
     EXPECT_EQ(st["panel_hole_frames"].get<int>(), 0) << st;
     EXPECT_TRUE(st["window_srgb"].get<bool>()) << st;
     EXPECT_GT(st["window_depth_bits"].get<int>(), 0) << st;
+    // Drawn less the panel's rectangle from the frame after the panel first showed (ImGui's second), but where
+    // the panel changed since the frame before and the frame was drawn again whole.
+    EXPECT_GE(st["panel_covered_frames"].get<int>(), 3) << st;
   }
   const auto rect = st["panel_rect"].get<std::vector<int>>();
   ASSERT_EQ(rect.size(), 4u);
