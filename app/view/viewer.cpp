@@ -259,6 +259,7 @@ void Viewer::frame() {
   gl::FrameCache whole;
   gl::RasterFrame f = renderer_->render(mode_, pending_screenshots_.empty() ? &cache_ : &whole);
   cache_.environment_changed = false;  // the environment never changes while the window is open
+  if (!renderer_->drewIntoDefaultFramebuffer()) covered_ = {};  // drawn into its texture, whole
   const auto t_render = Clock::now();
   // The panel first made (no GL), then the frame presented around its opaque rectangle, then the panel drawn.
   window_.beginPanel();
