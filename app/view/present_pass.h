@@ -1,7 +1,10 @@
 // The viewer's present pass: the renderer's linear frame (Renderer::colorTexture) copied into the window's
 // default framebuffer, sRGB-encoded exactly as pvrr render encodes a picture (pvrr::linearToSrgb8 of the 16-bit
 // value the renderer's target holds), outside an optional hole: the panel's opaque rectangle, where the frame
-// would be drawn over (docs/performance.md "The window's frame: where its time goes").
+// would be drawn over (docs/performance.md "The window's frame: where its time goes"). Used where the renderer
+// does not draw its second pass into the window itself (gl::RendererOptions::into_default_framebuffer: beside a
+// live reference, for the screenshot of the frame alone, a window without an sRGB or depth buffer, or
+// PVRR_VIEW_PRESENT_PASS=1).
 //
 // The encode (shaders/srgb_encode.glsl) reads a table of 4096 buckets from a uniform block; passes that present
 // the frame as this one does (the wipe, app/view/wipe.h) include the same file and bind the same block.
@@ -19,6 +22,7 @@ struct PixelRect {
   int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
   bool empty() const { return x1 <= x0 || y1 <= y0; }
   bool operator==(const PixelRect& o) const { return x0 == o.x0 && y0 == o.y0 && x1 == o.x1 && y1 == o.y1; }
+  bool contains(const PixelRect& o) const { return o.x0 >= x0 && o.y0 >= y0 && o.x1 <= x1 && o.y1 <= y1; }
 };
 
 // The uniform block SrgbBuckets of shaders/srgb_encode.glsl: 2048 words, each two buckets (16 bits, the lower

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <deque>
@@ -34,6 +35,17 @@
 
 namespace pvrr::app {
 namespace view {
+namespace {
+
+// A rectangle of window pixels (rows top-down) in GL's window coordinates (rows bottom-up): x0, y0, x1, y1; all
+// zero for an empty one.
+std::array<int, 4> glRect(const PixelRect& r, int height) {
+  if (r.empty()) return {};
+  return {r.x0, height - r.y1, r.x1, height - r.y0};
+}
+
+}  // namespace
+
 namespace {
 
 // This thread's CPU time (ms): what a step costs the window's thread, apart from the time others held the cores.
@@ -217,20 +229,38 @@ void Viewer::frame() {
     probe_fresh_ = true;
   }
   window_.context().makeCurrent();
+  if (!wipe_drawn_) {
+    // The wipe's first draw, where a software GL compiles its shaders' code: here, of the first frame, into the
+    // back buffer that the frame (drawn into it, or presented) then overwrites, not at the first reference.
+    wipe_->present(renderer_->colorTexture(), ob.width, ob.height, 0.5 * ob.width, true);
+    wipe_drawn_ = true;
+  }
+  {
+    // The renderer's second pass straight into the back buffer (no present pass), but while the wipe shows the
+    // frame beside the reference (it reads the frame's texture), where the window cannot take it, and on a frame
+    // with a screenshot of the frame alone: that one is drawn into the texture and presented, as pvrr render
+    // draws it. In the back buffer GL rasterizes the frame mirrored (a window's rows are stored top-down, a
+    // texture's bottom-up), so a pixel whose centre lies exactly on a triangle's edge can fall to the other
+    // triangle (1-3 pixels of 76,800 at 320 x 240 in the tests' views), and GL's sRGB encode is a code off the
+    // exact one for about 6 % of values (docs/performance.md); the frame-alone screenshot is render's picture.
+    int fw = 0, fh = 0;
+    window_.framebufferSize(&fw, &fh);
+    const bool direct = direct_allowed_ && window_.takesFrameDirectly() && !reference_ &&
+                        pending_screenshots_.empty() && fw == ob.width && fh == ob.height;
+    renderer_->setIntoDefaultFramebuffer(direct);
+    // Drawn into the window, the frame leaves out the panel's opaque rectangle as the last frame drew it (the
+    // panel is made after the frame, which it describes); checked against this frame's panel below.
+    covered_ = direct && panelDrawn() ? panel_rect_ : PixelRect{};
+    renderer_->setCoveredRect(glRect(covered_, ob.height));
+  }
   // A screenshot frame is drawn whole, every stage run (its own empty cache), so that it is what pvrr render
   // draws of the saved view: frames that reuse earlier maps (map reuse, render.map_reuse_margin_deg) differ
   // from a fresh frame in places, as they do in pvrr render --frames --orbit.
   gl::FrameCache whole;
-  const gl::RasterFrame f = renderer_->render(mode_, pending_screenshots_.empty() ? &cache_ : &whole);
+  gl::RasterFrame f = renderer_->render(mode_, pending_screenshots_.empty() ? &cache_ : &whole);
   cache_.environment_changed = false;  // the environment never changes while the window is open
+  if (!renderer_->drewIntoDefaultFramebuffer()) covered_ = {};  // drawn into its texture, whole
   const auto t_render = Clock::now();
-  if (!wipe_drawn_) {
-    // The wipe's first draw, where a software GL compiles its shaders' code: here, of the first frame, into the
-    // back buffer that the frame's present (and the panel over the rest) then overwrites, not at the first
-    // reference.
-    wipe_->present(renderer_->colorTexture(), ob.width, ob.height, 0.5 * ob.width, true);
-    wipe_drawn_ = true;
-  }
   // The panel first made (no GL), then the frame presented around its opaque rectangle, then the panel drawn.
   window_.beginPanel();
   fov_overlay_.draw(ls_.scene, ls_.desc, *rays_, selected_, scene_builds_, ob);  // under the panel, in panel shots
@@ -238,6 +268,15 @@ void Viewer::frame() {
   panel_list_ = nullptr;
   if (show_panel_) panel(f, shown_ms);
   window_.endPanel();
+  if (!covered_.empty() && !(panelDrawn() && panel_rect_.contains(covered_))) {
+    // The panel moved, shrank, collapsed or went this frame: the frame drawn again, whole (rare: the panel's
+    // size follows its sections).
+    renderer_->setCoveredRect({});
+    f = renderer_->render(mode_, &cache_);
+    covered_ = {};
+    ++panel_redraws_;
+  }
+  panel_covered_frames_ += covered_.empty() ? 0 : 1;
   const auto t_panel_made = Clock::now();
   presentFrame(ob);
   const auto t_present = Clock::now();
@@ -411,6 +450,10 @@ std::optional<PixelRect> Viewer::panelHole() const {
 }
 
 void Viewer::presentFrame(const Observer& ob) {
+  if (!reference_ && renderer_->drewIntoDefaultFramebuffer()) {
+    ++direct_frames_;  // the frame is in the back buffer already
+    return;
+  }
   if (!reference_) {
     const std::optional<PixelRect> hole = panelHole();
     panel_hole_frames_ += hole ? 1 : 0;
@@ -563,7 +606,16 @@ json Viewer::stats() const {
             {"swap", t.empty() ? 0.0 : median(swap_ms_)}}},
           // Frames presented around the panel's opaque rectangle (the last frame's, window pixels, rows
           // top-down, [x0, x1) x [y0, y1)): the frame under it is not drawn.
-          {"present", {{"panel_hole_frames", panel_hole_frames_},
+          // Frames drawn by the renderer straight into the window's back buffer (no present pass), and that
+          // buffer's depth bits and colour encoding (app/view/window.h takesFrameDirectly).
+          // Of those, frames drawn less the panel's rectangle (its depth cleared to the near plane:
+          // gl::RendererOptions::covered_rect), and frames drawn again whole because the panel had changed.
+          {"present", {{"direct_frames", direct_frames_},
+                       {"panel_covered_frames", panel_covered_frames_},
+                       {"panel_redraws", panel_redraws_},
+                       {"window_depth_bits", window_.depthBits()},
+                       {"window_srgb", window_.srgbCapable()},
+                       {"panel_hole_frames", panel_hole_frames_},
                        {"panel_rect", {panel_rect_.x0, panel_rect_.y0, panel_rect_.x1, panel_rect_.y1}}}},
           // The panel drawn from its picture (app/view/panel_cache.h): pictures made, frames copied from one.
           {"panel", {{"pictures", window_.panelCache().pictures()}, {"copies", window_.panelCache().copies()}}},

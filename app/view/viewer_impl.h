@@ -5,6 +5,7 @@
 #include <GLFW/glfw3.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <deque>
 #include <memory>
 #include <optional>
@@ -164,6 +165,12 @@ class Viewer {
   PixelRect panel_rect_, panel_outer_;  // less a pixel all round; and all its pixels
   const ImDrawList* panel_list_ = nullptr;
   int panel_hole_frames_ = 0;  // frames presented around the panel
+  int direct_frames_ = 0;      // frames the renderer drew into the back buffer (no present pass)
+  PixelRect covered_;          // the panel's rectangle that this frame's renderer left out
+  int panel_covered_frames_ = 0, panel_redraws_ = 0;
+  // The renderer may draw into the back buffer; PVRR_VIEW_PRESENT_PASS=1 turns it off (the present pass
+  // every frame), to measure the two against each other in one build (docs/performance.md).
+  bool direct_allowed_ = !std::getenv("PVRR_VIEW_PRESENT_PASS") || std::string(std::getenv("PVRR_VIEW_PRESENT_PASS")) != "1";
   bool panelDrawn() const;     // the panel is in this frame's draw data
   std::optional<PixelRect> panelHole() const;
   std::vector<std::string> pending_screenshots_, panel_screenshots_;

@@ -1,6 +1,7 @@
 // The viewer's window: GLFW 3 with a GL 4.5 core context (3.3 at least) adopted as a pvrr::gl::GlContext, so the
-// same Renderer draws in it; Dear ImGui for the panel; the renderer's frame presented sRGB-encoded into the
-// default framebuffer. The only place that includes GLFW; GL through glad (pvrr/gl/gl.h).
+// same Renderer draws in it; Dear ImGui for the panel. The renderer's second pass draws into the window's back
+// buffer itself, sRGB-encoded by GL (takesFrameDirectly), or its frame is presented sRGB-encoded from its texture
+// (present()). The only place that includes GLFW; GL through glad (pvrr/gl/gl.h).
 #pragma once
 #include <functional>
 #include <memory>
@@ -71,6 +72,13 @@ class Window {
   // framebuffer, encoded to sRGB as pvrr::srgbPicture encodes a picture, but for the pixels of `hole` (where an
   // opaque panel will be drawn over it).
   void present(unsigned texture, int width, int height, const std::optional<PixelRect>& hole = std::nullopt);
+  // Whether the renderer may draw its second pass into the window's back buffer
+  // (gl::RendererOptions::into_default_framebuffer): it has a depth buffer and an sRGB encoding. Otherwise
+  // present() draws the renderer's texture into it.
+  bool takesFrameDirectly() const { return srgb_ && depth_bits_ > 0; }
+  // The back buffer's depth bits and whether its colour is sRGB-encoded (for the stats).
+  int depthBits() const { return depth_bits_; }
+  bool srgbCapable() const { return srgb_; }
   // ImGui frame: begin before building the panel, end after it (ImGui::Render: the draw lists made, nothing
   // drawn), then draw it over the presented frame.
   void beginPanel();
@@ -97,6 +105,8 @@ class Window {
   std::unique_ptr<PresentPass> present_;
   std::unique_ptr<PanelCache> panel_cache_;
   bool imgui_ = false;
+  int depth_bits_ = 0;
+  bool srgb_ = false;
 };
 
 }  // namespace pvrr::app::view

@@ -246,8 +246,21 @@ Framebuffer::Framebuffer(int width, int height, const std::vector<ColorFormat>& 
 
 Framebuffer::~Framebuffer() { release(); }
 
+Framebuffer Framebuffer::defaultOfCurrentContext(int width, int height) {
+  requireCurrentContext("Framebuffer::defaultOfCurrentContext");
+  if (width <= 0 || height <= 0) throw Error("Framebuffer::defaultOfCurrentContext: each side must be at least 1 pixel");
+  Framebuffer f;
+  f.width_ = width;
+  f.height_ = height;
+  f.colors_ = {ColorFormat::SRGB8A8};
+  f.color_textures_ = {0};
+  f.context_ = GlContext::current();
+  f.default_ = true;
+  return f;
+}
+
 void Framebuffer::release() noexcept {
-  if (context_ != nullptr && GlContext::current() == context_) {
+  if (context_ != nullptr && GlContext::current() == context_ && !default_) {
     if (fbo_ != 0) glDeleteFramebuffers(1, &fbo_);
     if (!color_textures_.empty()) {
       glDeleteTextures(static_cast<GLsizei>(color_textures_.size()), color_textures_.data());
@@ -257,12 +270,14 @@ void Framebuffer::release() noexcept {
   fbo_ = 0;
   color_textures_.clear();
   depth_texture_ = 0;
+  default_ = false;
 }
 
 Framebuffer::Framebuffer(Framebuffer&& other) noexcept
     : width_(other.width_), height_(other.height_), colors_(std::move(other.colors_)), fbo_(other.fbo_),
       color_textures_(std::move(other.color_textures_)), depth_texture_(other.depth_texture_),
-      context_(other.context_) {
+      context_(other.context_), default_(other.default_) {
+  other.default_ = false;
   other.fbo_ = 0;
   other.color_textures_.clear();
   other.depth_texture_ = 0;
@@ -278,6 +293,8 @@ Framebuffer& Framebuffer::operator=(Framebuffer&& other) noexcept {
     color_textures_ = std::move(other.color_textures_);
     depth_texture_ = other.depth_texture_;
     context_ = other.context_;
+    default_ = other.default_;
+    other.default_ = false;
     other.fbo_ = 0;
     other.color_textures_.clear();
     other.depth_texture_ = 0;
@@ -287,21 +304,22 @@ Framebuffer& Framebuffer::operator=(Framebuffer&& other) noexcept {
 
 void Framebuffer::bind() const {
   requireCurrentContext("Framebuffer::bind");
-  if (fbo_ == 0) throw Error("Framebuffer::bind: framebuffer was moved from");
+  if (fbo_ == 0 && !default_) throw Error("Framebuffer::bind: framebuffer was moved from");
   if (GlContext::current() != context_) throw Error("Framebuffer::bind: framebuffer belongs to another GL context");
   glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+  if (default_) glDrawBuffer(GL_BACK);
   glViewport(0, 0, width_, height_);
 }
 
 void Framebuffer::clear(const std::array<float, 4>& rgba, float depth) const {
   bind();
   for (std::size_t i = 0; i < colors_.size(); ++i) glClearBufferfv(GL_COLOR, static_cast<GLint>(i), rgba.data());
-  if (depth_texture_ != 0) glClearBufferfv(GL_DEPTH, 0, &depth);
+  if (depth_texture_ != 0 || default_) glClearBufferfv(GL_DEPTH, 0, &depth);
 }
 
 void Framebuffer::clearDepth(float depth) const {
   bind();
-  if (depth_texture_ != 0) glClearBufferfv(GL_DEPTH, 0, &depth);
+  if (depth_texture_ != 0 || default_) glClearBufferfv(GL_DEPTH, 0, &depth);
 }
 
 void Framebuffer::bindRegion(int width, int height) const {
@@ -314,7 +332,7 @@ void Framebuffer::bindRegion(int width, int height) const {
 
 void Framebuffer::bindRegionClearDepth(int width, int height, float depth) const {
   bindRegion(width, height);
-  if (depth_texture_ == 0) return;
+  if (depth_texture_ == 0 && !default_) return;
   glEnable(GL_SCISSOR_TEST);
   glScissor(0, 0, width, height);
   glClearBufferfv(GL_DEPTH, 0, &depth);
@@ -340,6 +358,7 @@ void Framebuffer::checkAttachment(int attachment) const {
 
 void Framebuffer::readInto(int attachment, unsigned int type, void* pixels, std::size_t bytes_per_pixel) const {
   checkAttachment(attachment);
+  if (default_) throw Error("Framebuffer: the default framebuffer is not read back here");
   bind();
   glReadBuffer(GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(attachment));
   glPixelStorei(GL_PACK_ALIGNMENT, 1);

@@ -64,6 +64,12 @@ class Framebuffer {
   // framebuffer incomplete (naming the status, e.g. GL_FRAMEBUFFER_UNSUPPORTED).
   Framebuffer(int width, int height, const std::vector<ColorFormat>& colors,
               DepthFormat depth = DepthFormat::Depth24);
+  // The current context's default framebuffer (a window's back buffer) as a target of width x height pixels:
+  // bind() binds framebuffer 0 and draws into GL_BACK; it owns nothing. One colour attachment (colorFormat(0)
+  // SRGB8A8, colorTexture(0) 0: there is no texture to read) and a depth attachment cleared as any other; their
+  // real formats are the window's, which the caller checks (app/view/window.h). No readback (readRGBA8,
+  // readFloat4 throw).
+  static Framebuffer defaultOfCurrentContext(int width, int height);
   ~Framebuffer();
   Framebuffer(Framebuffer&& other) noexcept;
   Framebuffer& operator=(Framebuffer&& other) noexcept;
@@ -92,6 +98,7 @@ class Framebuffer {
   unsigned int fboName() const { return fbo_; }
   unsigned int colorTexture(int attachment) const;
   unsigned int depthTexture() const { return depth_texture_; }  // 0 with DepthFormat::None
+  bool isDefault() const { return default_; }                  // defaultOfCurrentContext
 
   // The attachment's pixels as RGBA8, width * height * 4 bytes, rows TOP-DOWN (GL's bottom-up rows flipped).
   // Float attachments are clamped to [0, 1] and converted by GL. Leaves this framebuffer bound for reading.
@@ -101,6 +108,7 @@ class Framebuffer {
   std::vector<float> readFloat4(int attachment = 0) const;
 
  private:
+  Framebuffer() = default;
   void checkAttachment(int attachment) const;
   void readInto(int attachment, unsigned int type, void* pixels, std::size_t bytes_per_pixel) const;
   void release() noexcept;
@@ -111,6 +119,7 @@ class Framebuffer {
   std::vector<unsigned int> color_textures_;
   unsigned int depth_texture_ = 0;
   GlContext* context_ = nullptr;
+  bool default_ = false;  // framebuffer 0 of context_ (fbo_ stays 0, nothing owned)
 };
 
 }  // namespace pvrr::gl

@@ -92,6 +92,8 @@ struct Renderer::Impl {
   GlLimits limits;                            // queryGlLimits, with the first context()
   std::vector<double> limits_checked;         // mapLimitsKey of the last frame checkMapLimits passed
   std::unique_ptr<Framebuffer> frame_target;  // the second pass: colour, seen point, surface point
+  std::unique_ptr<Framebuffer> default_target;  // the second pass into the window (into_default_framebuffer)
+  bool drew_into_default = false;             // the last frame's second pass went into default_target
   // The passes of each mode (made with the renderer; each compiles its programs when a frame first needs them).
   RasterPass raster_pass;
   PvrrPass pvrr_pass;
@@ -152,9 +154,14 @@ RasterFrame Renderer::render(RenderMode mode, FrameCache* cache) {
   return impl_->render(mode, cache);
 }
 void Renderer::setReadBack(bool on) { impl_->options.read_back = on; }
+void Renderer::setIntoDefaultFramebuffer(bool on) { impl_->options.into_default_framebuffer = on; }
+bool Renderer::drewIntoDefaultFramebuffer() const { return impl_->drew_into_default; }
+void Renderer::setCoveredRect(const std::array<int, 4>& rect) { impl_->options.covered_rect = rect; }
 std::vector<CausticMap> Renderer::causticMaps() const { return impl_->caustics->readMaps(); }
 const CausticPlan& Renderer::causticPlan() const { return impl_->caustics->plan(); }
-unsigned Renderer::colorTexture() const { return impl_->frame_target ? impl_->frame_target->colorTexture(0) : 0u; }
+unsigned Renderer::colorTexture() const {
+  return impl_->frame_target && !impl_->drew_into_default ? impl_->frame_target->colorTexture(0) : 0u;
+}
 
 RasterFrame Renderer::Impl::render(RenderMode mode, FrameCache* cache) {
   const auto frame_start = Clock::now();
@@ -207,14 +214,33 @@ std::string Renderer::Impl::secondPass(RenderMode mode, ModePass& pass, CullCoun
   // drawn in several additive draws (more than three channels): their partial sums can be negative or above
   // 1 (spectral weights), and a normalised target would clamp each before the sum.
   const ColorFormat colour = options.seen_points || pass.additiveDraws() ? ColorFormat::RGBA32F : ColorFormat::RGBA16;
-  if (!frame_target || frame_target->width() != ob.width || frame_target->height() != ob.height ||
-      frame_target->colorFormat(0) != colour)
+  // A window's frame straight into its back buffer (RendererOptions::into_default_framebuffer).
+  drew_into_default = options.into_default_framebuffer && !options.seen_points && !options.read_back &&
+                      !pass.additiveDraws();
+  if (drew_into_default) {
+    if (!default_target || default_target->width() != ob.width || default_target->height() != ob.height)
+      default_target = std::make_unique<Framebuffer>(Framebuffer::defaultOfCurrentContext(ob.width, ob.height));
+  } else if (!frame_target || frame_target->width() != ob.width || frame_target->height() != ob.height ||
+             frame_target->colorFormat(0) != colour) {
     frame_target = std::make_unique<Framebuffer>(
         ob.width, ob.height,
         options.seen_points ? std::vector<ColorFormat>{colour, ColorFormat::RGBA32F, ColorFormat::RGBA32F}
                             : std::vector<ColorFormat>{colour},
         DepthFormat::Depth32F);
-  frame_target->clearDepth();  // no colour clear: the sky covers every pixel nothing else does
+  }
+  const Framebuffer& target = drew_into_default ? *default_target : *frame_target;
+  if (drew_into_default) glEnable(GL_FRAMEBUFFER_SRGB);
+  target.clearDepth();  // no colour clear: the sky covers every pixel nothing else does
+  const std::array<int, 4>& covered = options.covered_rect;
+  if (drew_into_default && covered[2] > covered[0] && covered[3] > covered[1]) {
+    // What the caller draws over: depth at the near plane, nothing passes there (RendererOptions::covered_rect).
+    const float near_depth = 0.0f;
+    glDepthMask(GL_TRUE);
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(covered[0], covered[1], covered[2] - covered[0], covered[3] - covered[1]);
+    glClearBufferfv(GL_DEPTH, 0, &near_depth);
+    glDisable(GL_SCISSOR_TEST);
+  }
   // The elements come first: the depth state must not depend on what an earlier pass (or none) left.
   glEnable(GL_DEPTH_TEST);
   glDepthMask(GL_TRUE);
@@ -225,10 +251,11 @@ std::string Renderer::Impl::secondPass(RenderMode mode, ModePass& pass, CullCoun
   PassCamera eye;
   eye.origin = ob.eye;
   eye.view_proj = relativeViewProj(proj, view, ob.eye);
-  const std::string note = pass.drawElements(mode, eye, *frame_target);
+  const std::string note = pass.drawElements(mode, eye, target);
   // The environment after the elements: behind a lens or mirror it fails the early depth test, unshaded.
-  frame_target->bind();
+  target.bind();
   *culled = environment.draw(view, proj, ob.eye);
+  if (drew_into_default) glDisable(GL_FRAMEBUFFER_SRGB);
   glFinish();
   checkGlError("rendering a frame");
   return pass.finishedNote(note);

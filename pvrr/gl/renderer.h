@@ -13,6 +13,7 @@
 // Spectral dispersion: N channels share one first pass per patch; the second pass adds ceil(N / 3) draws
 // of three channels each, weighted per channel (pvrr/optics/spectrum.h), into the colour attachment only.
 #pragma once
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -78,6 +79,20 @@ struct RendererOptions : PassPlanOptions {
   // picture changes only where two meshes tie in depth; false keeps the scene's order, for the tests that
   // compare.
   bool sort_environment = true;
+  // A window's frame (app/view): the second pass draws into the current context's default framebuffer (the
+  // window's back buffer, of the observer's size, with a depth buffer and an sRGB-capable colour buffer, which
+  // the caller checks), encoded to 8-bit sRGB by GL as it is written (GL_FRAMEBUFFER_SRGB, on for the pass
+  // only), so that no pass copies the frame into the window. Only for a picture-only frame left on the GPU
+  // (seen_points and read_back false) whose elements are drawn once each (no spectral dispersion: its partial
+  // sums need the float target); otherwise, or false, the frame goes into its texture (colorTexture()).
+  // Renderer::drewIntoDefaultFramebuffer says which the last frame did. pvrr render never sets it.
+  bool into_default_framebuffer = false;
+  // With into_default_framebuffer: pixels the caller draws over opaquely after the frame (a window's panel),
+  // [x0, x1) x [y0, y1) in GL's window coordinates (rows bottom-up), all zero for none. Their depth is cleared
+  // to the near plane before the second pass, so that every fragment there fails the depth test before it is
+  // shaded (llvmpipe tests depth first where a shader neither discards nor writes depth), and their colour is
+  // left as the back buffer held it. Not for a frame drawn into its texture, which stays whole.
+  std::array<int, 4> covered_rect{};
 };
 
 // The options a scene asks for: its render section's planning settings (map_size, map_texels_per_pixel,
@@ -104,9 +119,18 @@ class Renderer {
   RasterFrame render(RenderMode mode, FrameCache* cache = nullptr);
   // RendererOptions::read_back for the next frames (e.g. only the last of a run is written out).
   void setReadBack(bool on);
+  // RendererOptions::into_default_framebuffer for the next frames (a window turns it off while it shows the
+  // frame through a pass of its own, e.g. beside a reference).
+  void setIntoDefaultFramebuffer(bool on);
+  // Whether the last frame was drawn into the default framebuffer (RendererOptions::into_default_framebuffer);
+  // colorTexture() is then 0.
+  bool drewIntoDefaultFramebuffer() const;
+  // RendererOptions::covered_rect for the next frames.
+  void setCoveredRect(const std::array<int, 4>& rect);
   // The GL texture holding the last frame's linear colour (0 before the first frame), for a window to present
   // without a readback: GL_TEXTURE_2D of the frame's size, rows bottom-up as GL stores them, RGBA16 or RGBA32F
-  // (RendererOptions::seen_points). Valid until the next render() in the renderer's context.
+  // (RendererOptions::seen_points). Valid until the next render() in the renderer's context. 0 when the last
+  // frame went into the default framebuffer.
   unsigned colorTexture() const;
   // The receivers' caustic light maps as the last frame drew them (pvrr/gl/caustic_pass.h); empty without
   // caustics.

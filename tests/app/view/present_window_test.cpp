@@ -1,6 +1,7 @@
-// The window's present pass around the panel (label `window`): the frame is not presented under the panel's
-// opaque rectangle, the panel is copied from its picture (app/view/panel_cache.h), and every pixel outside it
-// still equals pvrr render of the view.
+// The window's frame around the panel (label `window`), both ways it reaches the window: drawn by the renderer
+// straight into the back buffer (gl::RendererOptions::into_default_framebuffer, the default), or into a texture
+// presented around the panel's opaque rectangle (PVRR_VIEW_PRESENT_PASS=1); the panel copied from its picture
+// (app/view/panel_cache.h); the pixels outside it against pvrr render of the view.
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -23,9 +24,16 @@ constexpr int kWindowVsRenderCodes = 1;
 // Pixels this close to the panel's reported rectangle are not judged (its border and the one-pixel margin the
 // hole leaves inside it).
 constexpr int kPanelMarginPx = 2;
+// Drawn into the back buffer, the frame is rasterized mirrored (the window's rows are stored top-down, a
+// texture's bottom-up): a pixel whose centre lies exactly on a triangle's edge may fall to the other triangle
+// (1-3 pixels of 76,800 at 320 x 240 measured, whole codes apart), and GL's sRGB encode is off the exact code by
+// one for about 6 % of values (within kWindowVsRenderCodes). At most this fraction of the pixels outside the
+// panel may differ by more than a code.
+constexpr double kMirroredEdgeTieFraction = 1e-4;
 
-TEST(ViewPresent, FramePresentedAroundThePanelMatchesRenderOutsideIt) {
-  const fs::path dir = freshTestDir("view-present-hole");
+// `present_pass`: PVRR_VIEW_PRESENT_PASS=1 for the run (the frame presented from its texture).
+void checkFrameAroundThePanel(bool present_pass) {
+  const fs::path dir = freshTestDir(present_pass ? "view-present-hole" : "view-present-direct");
   const fs::path script = dir / "script.json", shot = dir / "window.png", view = dir / "view.json",
                  rendered = dir / "render.png", stats = dir / "stats.json";
   writeText(script, R"({"size": [800, 450], "events": [
@@ -35,6 +43,10 @@ TEST(ViewPresent, FramePresentedAroundThePanelMatchesRenderOutsideIt) {
       {"at_frame": 6, "do": "save_view", "file": ")" + view.string() + R"("},
       {"at_frame": 7, "do": "quit"}]})");
   CliResult r;
+  struct EnvGuard {  // the variable set for this run only, however the test leaves
+    explicit EnvGuard(bool on) { if (on) setenv("PVRR_VIEW_PRESENT_PASS", "1", 1); }
+    ~EnvGuard() { unsetenv("PVRR_VIEW_PRESENT_PASS"); }
+  } env(present_pass);
   // Map reuse off: every frame drawn whole, as pvrr render draws the saved view (a frame that reuses an earlier
   // pose's maps differs from it in places; the frame-alone screenshot draws whole by itself, this one does not).
   RUN_VIEW_OR_SKIP("models/car-mirror.json --set render.map_reuse_margin_deg=0 --script '" + script.string() + "' --stats '" + stats.string() + "'", &r);
@@ -46,8 +58,20 @@ TEST(ViewPresent, FramePresentedAroundThePanelMatchesRenderOutsideIt) {
   EXPECT_GE(all["panel"]["copies"].get<int>(), 5) << all["panel"];
   EXPECT_GE(all["panel"]["pictures"].get<int>(), 1) << all["panel"];
   EXPECT_LE(all["panel"]["pictures"].get<int>(), all["panel"]["copies"].get<int>()) << all["panel"];
-  // Every frame but ImGui's first (the panel sizes itself unseen) was presented around the panel.
-  EXPECT_GE(st["panel_hole_frames"].get<int>(), 5) << st;
+  if (present_pass) {
+    // Every frame but ImGui's first (the panel sizes itself unseen) was presented around the panel.
+    EXPECT_GE(st["panel_hole_frames"].get<int>(), 5) << st;
+    EXPECT_EQ(st["direct_frames"].get<int>(), 0) << st;
+  } else {
+    // Every frame drawn straight into the window (Xvfb's GLX gives a depth buffer and an sRGB-capable one).
+    EXPECT_EQ(st["direct_frames"].get<int>(), 7) << st;
+    EXPECT_EQ(st["panel_hole_frames"].get<int>(), 0) << st;
+    EXPECT_TRUE(st["window_srgb"].get<bool>()) << st;
+    EXPECT_GT(st["window_depth_bits"].get<int>(), 0) << st;
+    // Drawn less the panel's rectangle from the frame after the panel first showed (ImGui's second), but where
+    // the panel changed since the frame before and the frame was drawn again whole.
+    EXPECT_GE(st["panel_covered_frames"].get<int>(), 3) << st;
+  }
   const auto rect = st["panel_rect"].get<std::vector<int>>();
   ASSERT_EQ(rect.size(), 4u);
   ASSERT_LT(rect[2], 800 - 100) << "the panel leaves a part of the window to check";
@@ -72,10 +96,17 @@ TEST(ViewPresent, FramePresentedAroundThePanelMatchesRenderOutsideIt) {
       failing += d > kWindowVsRenderCodes;
     }
   EXPECT_GT(outside, 100000);
-  EXPECT_EQ(failing, 0) << "of " << outside << " pixels outside the panel";
+  if (present_pass)
+    EXPECT_EQ(failing, 0) << "of " << outside << " pixels outside the panel";
+  else
+    EXPECT_LE(failing, int(kMirroredEdgeTieFraction * outside)) << "of " << outside << " pixels outside the panel";
   EXPECT_GT(inside_differs, 10000);  // the panel is there, over the frame
   fs::remove_all(dir);
 }
+
+TEST(ViewPresent, FrameDrawnIntoTheWindowMatchesRenderOutsideThePanel) { checkFrameAroundThePanel(false); }
+
+TEST(ViewPresent, FramePresentedAroundThePanelMatchesRenderOutsideIt) { checkFrameAroundThePanel(true); }
 
 }  // namespace
 }  // namespace pvrr::test
