@@ -11,6 +11,9 @@
 namespace pvrr {
 
 struct ElementFrame;
+namespace cad {
+struct GridPatch;
+}
 
 struct EyeSide {
   int seen = 0;  // vertices the viewer sees (ElementFrame::in_view == 2; all when in_view is empty)
@@ -31,6 +34,17 @@ std::string eyeSideNote(const Scene& scene, const ElementFrame& f);
 // nothing the lens shows); applyTracedFallback then draws those vertices from the tracer's colour along the
 // eye's ray through them (pvrr/method/frame_quality.h).
 void applyEyeSide(const Scene& scene, ElementFrame& f);
+
+// Seen lens vertices (middle channel, front side facing the eye) whose internal ray leaves the glass through
+// the lens's edge: its back point lies beyond the outline (on the back surface's extension, where vertex_stage
+// continues it), by more than kLensEdgeExitLimitArcmin as seen from the eye (the band of rays that truly leave
+// through the edge is about that wide). Over one patch's vertices, or all when patch is null.
+inline constexpr double kLensEdgeExitLimitArcmin = 10.0;
+struct LensEdgeExits {
+  int vertices = 0;
+  double max_beyond_m = 0, max_band_arcmin = 0;
+};
+LensEdgeExits lensEdgeExits(const Element& el, const ElementFrame& f, const cad::GridPatch* patch);
 
 // Whether f's vertex i is a lens vertex whose front surface faces away from f.eye.
 bool lensSeenFromBehind(const Element& el, const ElementFrame& f, size_t i);
