@@ -76,10 +76,11 @@ namespace {
 
 // Flags (degraded) every seen patch of a lens whose vertex rays leave the glass through its edge: their back
 // points lie beyond the outline, on the back surface's extension (vertex_stage continues them there so that
-// rim triangles interpolate smoothly), while the reference tracer stops them at the edge (drawn dark). Near
-// the rim a fraction of a millimetre is the drift of a vertex that lies on the rim; a lens turned against the
-// eye (the eye turned 30 deg behind a spectacle lens) sends whole bands of rays out through the edge, a
-// picture pvrr and envmap modes drew wrong with no flag (hunt-spec-eye-turned-30: p95 1384').
+// rim triangles interpolate smoothly), while the reference tracer stops them at the edge (drawn dark). A rim
+// vertex's drift of a fraction of a millimetre makes a band narrower than the limit (the burning lens: 0.8 mm
+// at 0.4 m, 6'); a lens turned against the eye (the eye turned 30 deg behind a spectacle lens) sends a band of
+// rays out through the edge that pvrr and envmap modes drew wrong with no flag (hunt-spec-eye-turned-30.json:
+// 186', p95 1384').
 void applyLensEdgeExits(const Element& el, ElementFrame& f) {
   const LensEdgeExits all = lensEdgeExits(el, f, nullptr);
   if (all.vertices == 0) return;
@@ -100,8 +101,9 @@ void applyLensEdgeExits(const Element& el, ElementFrame& f) {
   f.quality.verdict = std::max(f.quality.verdict, QualityVerdict::kDegraded);
   f.quality.action = (f.quality.action == "none" ? "" : f.quality.action + "; ") + std::to_string(marked) +
                      " patch(es) flagged: " + std::to_string(all.vertices) +
-                     " seen vertex ray(s) leave the glass through the edge of lens '" + el.name + "' (up to " + mm + "); pvrr mode continues them through the back surface's extension, "
-                     "the reference draws the edge dark; impostor mode traces the edge";
+                     " seen vertex ray(s) leave the glass through the edge of lens '" + el.name + "' (up to " + mm +
+                     "); pvrr mode continues them through the back surface's extension, the reference draws the "
+                     "edge dark; impostor mode traces the edge";
 }
 
 // Whether world point h lies on element e's front surface within its outline (sag surfaces only; a CAD or

@@ -2,7 +2,9 @@
 // user's terms). A mirror reflects on its front side only; its back is drawn dark in every mode, as the
 // reference tracer draws it, so an eye behind a mirror sees nothing reflected: the note says why. pvrr mode
 // traces a lens's vertex rays into its front surface; an eye on the lens's back side gets a note and the
-// frame's quality verdict says whether the picture can be trusted.
+// frame's quality verdict says whether the picture can be trusted. applyEyeSide also flags two pictures found
+// wrong and passed as good (docs/robustness.md, "Held-out-style hunt"): lens rays that leave the glass through
+// its edge, and other elements shown in a patch's map from a viewpoint far off the rays' directions.
 #pragma once
 #include <string>
 

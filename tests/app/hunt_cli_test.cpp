@@ -37,11 +37,14 @@ struct HuntCase {
 
 void PrintTo(const HuntCase& c, std::ostream* os) { *os << c.name; }
 
-bool has(const std::vector<std::string>& v, const std::string& s) { return std::find(v.begin(), v.end(), s) != v.end(); }
+bool has(const std::vector<std::string>& v, const std::string& s) {
+  return std::find(v.begin(), v.end(), s) != v.end();
+}
 
 std::vector<HuntCase> huntCases() {
   const std::string small = " --size 64x48";
-  const std::string rect = R"('elements[0].outline={"shape":"rectangle","width":0.2,"height":0.13,"corner_radius":0.02}')";
+  const std::string rect =
+      R"('elements[0].outline={"shape":"rectangle","width":0.2,"height":0.13,"corner_radius":0.02}')";
   return {
       // A -4 D spectacle lens with the eye turned 30 deg behind it: a band of rays leaves the glass through the
       // lens's edge. pvrr mode drew it through the back surface's extension, unflagged (p95 1384' at 96 x 72);
@@ -84,7 +87,8 @@ class HuntCli : public ::testing::TestWithParam<HuntCase> {
 TEST_P(HuntCli, RightOrFlaggedInEveryRasterMode) {
   const HuntCase& c = GetParam();
   const std::string out = (dir_ / "compare").string();
-  const CliResult r = runPvrr("compare '" + c.scene + "' --modes pvrr,envmap,impostor --gl osmesa --out '" + out + "'" + c.sets);
+  const CliResult r =
+      runPvrr("compare '" + c.scene + "' --modes pvrr,envmap,impostor --gl osmesa --out '" + out + "'" + c.sets);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
   const nlohmann::json m = nlohmann::json::parse(pvrr::test::slurp(out + "/metrics.json"));
@@ -104,7 +108,9 @@ TEST_P(HuntCli, RightOrFlaggedInEveryRasterMode) {
     if (has(c.p95_checked, mode) && p95 >= kBandArcmin)
       EXPECT_FALSE(flagged.empty()) << mode << ": p95 " << p95 << "' and good";
     for (const std::string& name : flagged) {
-      const std::string prefix = mode + std::string(mode.size() < 8 ? 8 - mode.size() : 0, ' ') + " quality: " + name + " ";
+      // compare's prefix: the mode padded to 8 characters (app/compare.cpp).
+      const std::string prefix =
+          mode + std::string(mode.size() < 8 ? 8 - mode.size() : 0, ' ') + " quality: " + name + " ";
       EXPECT_NE(r.out.find(prefix), std::string::npos) << prefix << "\n" << r.out;
     }
   }
