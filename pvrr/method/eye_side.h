@@ -2,7 +2,9 @@
 // user's terms). A mirror reflects on its front side only; its back is drawn dark in every mode, as the
 // reference tracer draws it, so an eye behind a mirror sees nothing reflected: the note says why. pvrr mode
 // traces a lens's vertex rays into its front surface; an eye on the lens's back side gets a note and the
-// frame's quality verdict says whether the picture can be trusted.
+// frame's quality verdict says whether the picture can be trusted. applyEyeSide also flags two pictures found
+// wrong and passed as good (docs/robustness.md, "Held-out-style hunt"): lens rays that leave the glass through
+// its edge, and other elements shown in a patch's map from a viewpoint far off the rays' directions.
 #pragma once
 #include <string>
 
@@ -11,6 +13,9 @@
 namespace pvrr {
 
 struct ElementFrame;
+namespace cad {
+struct GridPatch;
+}
 
 struct EyeSide {
   int seen = 0;  // vertices the viewer sees (ElementFrame::in_view == 2; all when in_view is empty)
@@ -31,6 +36,24 @@ std::string eyeSideNote(const Scene& scene, const ElementFrame& f);
 // nothing the lens shows); applyTracedFallback then draws those vertices from the tracer's colour along the
 // eye's ray through them (pvrr/method/frame_quality.h).
 void applyEyeSide(const Scene& scene, ElementFrame& f);
+
+// Seen lens vertices (middle channel, front side facing the eye) whose internal ray leaves the glass through
+// the lens's edge: its back point lies beyond the outline (on the back surface's extension, where vertex_stage
+// continues it), by more than kLensEdgeExitLimitArcmin as seen from the eye (the band of rays that truly leave
+// through the edge is about that wide). Over one patch's vertices, or all when patch is null.
+inline constexpr double kLensEdgeExitLimitArcmin = 10.0;
+struct LensEdgeExits {
+  int vertices = 0;
+  double max_beyond_m = 0, max_band_arcmin = 0;
+};
+LensEdgeExits lensEdgeExits(const Element& el, const ElementFrame& f, const cad::GridPatch* patch);
+
+// A seen patch whose vertex rays land on another element (its map shows that element as seen from the patch's
+// viewpoint) is flagged when the angle at the hit between the ray and the direction from the viewpoint is over
+// this (median over the patch's such vertices). Measured on the mirror pair at 96 x 72: 3.4' with its convex
+// mirror (pixels 0.84' median), 14' and 27' with the mirror turned concave (R -1 m; pixels 39' median, p95
+// 2489', and 63'): the pixels' error ran 2.3 to 2.7 times this measure, so 10' flags what nears the 60' line.
+inline constexpr double kNestedParallaxLimitArcmin = 10.0;
 
 // Whether f's vertex i is a lens vertex whose front surface faces away from f.eye.
 bool lensSeenFromBehind(const Element& el, const ElementFrame& f, size_t i);
