@@ -179,6 +179,16 @@ CubeQuality assessCubeQuality(const RayScene& rays, ElementFrame& f, RenderMode 
                            " vertices: envmap mode's rays enter a lens through its front surface, so the lens is "
                            "drawn wrong there; impostor or pvrr mode draws it");
   f.eye = eye;
+  if (mode == RenderMode::Envmap && lens) {
+    // As pvrr mode's vertices (eye_side.h lensEdgeExits): envmap mode looks the cube up in the exit direction
+    // of rays continued through the back surface's extension, where the reference stops them at the edge.
+    const LensEdgeExits e = lensEdgeExits(el, f, nullptr);
+    if (e.vertices > 0)
+      addReason(reasons, std::to_string(e.vertices) + " seen vertex ray(s) leave the glass through the lens's edge (up to " +
+                             fixed(1e3 * e.max_beyond_m, 1) + " mm beyond the outline, " + fixed(e.max_band_arcmin, 0) +
+                             "' as seen from the eye): envmap mode continues them through the back surface's "
+                             "extension, the reference draws the edge dark; impostor mode traces the edge");
+  }
   f.quality.note = eyeSideNote(scene, f);
   if (!reasons.empty()) flag(f, reasons);
   return q;

@@ -66,8 +66,19 @@ bool refineRaySurface(const cad::Surface& s, const Vec3& o, const Vec3& d, Vec2&
   const double scale = std::max({1.0, glm::length(o), std::abs(t)});
   // Convergence at a few ulps of the coordinates' magnitude: the best double precision can give.
   const double tol = 8.0 * std::numeric_limits<double>::epsilon() * scale;
+  // A surface undefined at a Newton step (a steep sphere's extension past |R|, followed for a rim ray: the +8 D
+  // lens of docs/robustness.md's hunt was refused there) is no intersection, not an error.
+  cad::SurfaceDerivs sd;
+  const auto evaluated = [&s, &sd](const Vec2& p) {
+    try {
+      sd = s.evaluate(p.x, p.y);
+      return true;
+    } catch (const Error&) {
+      return false;
+    }
+  };
   for (int it = 0; it < 30; ++it) {
-    cad::SurfaceDerivs sd = s.evaluate(uv.x, uv.y);
+    if (!evaluated(uv)) return false;
     Vec3 f = sd.p - (o + t * d);
     if (glm::length(f) <= tol) return std::isfinite(t);
     // Solve [du dv -d] (du, dv, dt)^T = -f.
@@ -84,7 +95,7 @@ bool refineRaySurface(const cad::Surface& s, const Vec3& o, const Vec3& d, Vec2&
     }
   }
   // Stalled within a few hundred ulps (a grazing hit): accept; anything worse is no intersection.
-  cad::SurfaceDerivs sd = s.evaluate(uv.x, uv.y);
+  if (!evaluated(uv)) return false;
   return std::isfinite(t) && glm::length(sd.p - (o + t * d)) < 64.0 * tol;
 }
 

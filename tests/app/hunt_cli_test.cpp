@@ -48,9 +48,9 @@ std::vector<HuntCase> huntCases() {
   return {
       // A -4 D spectacle lens with the eye turned 30 deg behind it: a band of rays leaves the glass through the
       // lens's edge. pvrr mode drew it through the back surface's extension, unflagged (p95 1384' at 96 x 72);
-      // now flagged (pvrr/method/eye_side.h, lensEdgeExits). envmap mode is as wrong and not yet flagged.
+      // now flagged (pvrr/method/eye_side.h, lensEdgeExits), and envmap mode, as wrong, by cube_quality.cpp.
       {"spectacle lens, eye turned 30 deg", "tests/data/stress/hunt-spec-eye-turned-30.json", small,
-       {"pvrr", "envmap", "impostor"}, {"pvrr", "impostor"}},
+       {"pvrr", "envmap", "impostor"}, {"pvrr", "envmap", "impostor"}},
       // A blind-spot door mirror: convex asphere R 1.4 m, conic -0.5, A4 = 25 m^-3 (steeper outboard).
       {"blind-spot asphere mirror", "models/car-mirror.json",
        R"( --set 'elements[0].surface={"type":"asphere","radius":1.4,"conic":-0.5,"coefficients":[25]}' --set )" +
@@ -61,6 +61,10 @@ std::vector<HuntCase> huntCases() {
        {"pvrr", "envmap", "impostor"}},
       {"spectacle lens high cylinder", "tests/data/stress/hunt-spec-cyl-6.json", small,
        {"pvrr", "envmap", "impostor"}, {"pvrr", "envmap", "impostor"}},
+      // +8 D from a prescription (CR-39, the build's 14 D base curve: back surface R 35.6 mm): pvrr mode's vertex
+      // stage refused it (a rim ray's Newton step past the back sphere's |R|, "sag undefined"); now traced.
+      {"spectacle lens +8 D", "tests/data/stress/hunt-spec-plus8.json", small, {"pvrr", "envmap", "impostor"},
+       {"pvrr", "envmap", "impostor"}},
       // A ball 2 cm and a box 1 cm in front of a plane mirror's glass.
       {"objects at the mirror", "tests/data/stress/hunt-plane-near-objects.json", small, {"pvrr", "impostor"},
        {"pvrr", "impostor"}},
@@ -103,10 +107,15 @@ TEST_P(HuntCli, RightOrFlaggedInEveryRasterMode) {
       if (e["quality"]["verdict"] != "good") flagged.push_back(e["name"].get<std::string>());
     std::cout << "[ measured ] " << c.name << ", " << mode << ": median " << median << "', p95 " << p95 << "', "
               << (flagged.empty() ? "good" : "flagged") << "\n";
-    if (has(c.must_be_right, mode)) EXPECT_LT(median, kRightArcmin) << mode;
-    if (median >= kRightArcmin) EXPECT_FALSE(flagged.empty()) << mode << ": median " << median << "' and good";
-    if (has(c.p95_checked, mode) && p95 >= kBandArcmin)
+    if (has(c.must_be_right, mode)) {
+      EXPECT_LT(median, kRightArcmin) << mode;
+    }
+    if (median >= kRightArcmin) {
+      EXPECT_FALSE(flagged.empty()) << mode << ": median " << median << "' and good";
+    }
+    if (has(c.p95_checked, mode) && p95 >= kBandArcmin) {
       EXPECT_FALSE(flagged.empty()) << mode << ": p95 " << p95 << "' and good";
+    }
     for (const std::string& name : flagged) {
       // compare's prefix: the mode padded to 8 characters (app/compare.cpp).
       const std::string prefix =
