@@ -43,13 +43,18 @@ class PvrrPass : public ModePass {
   // Per map slot held: whether it is in R, G and B planes.
   std::vector<bool> planesSlots() const;
   Framebuffer& mapTarget(size_t i, int size, bool planes);
+  // A vertex drawn from its traced colour in this patch: a totally reflected lens ray always; any other traced
+  // ray only in a patch drawn traced (a neighbouring patch that shares the vertex draws it from its map).
+  static bool usesTraced(const PatchView& pv, const VertexRay& r) {
+    return r.traced && (r.status == VertexStatus::Tir || pv.draw_traced);
+  }
   void uploadPatch(MeshBuffers& mb, const ElementFrame& f, const PatchView& pv, const Vec3& anchor, size_t set,
                    size_t seen_channel) const;
   void drawPvrrElement(const ElementFrame& f, size_t first_slot, const PassCamera& cam, int seen_channel);
   void drawDarkElement(const ElementFrame& f, const PassCamera& cam);
   int64_t closeUnreadTexels(const MapPass& mp, const std::array<int, 2>& region);
   CullCount renderPasses(size_t whole_slots, int64_t* skipped, int64_t* texels);
-  // Per-fragment refinement (render.refine): which elements refine (refine_skip), their surface maps, the
+  // Per-fragment refinement (render.refine; pvrr/gl/pvrr_refine.cpp): which elements refine (refine_skip), their surface maps, the
   // fragment counters zeroed; and what the counters say once the frame's draws are done.
   void prepareRefinement();
   void setRefinement(const Program& p, const ElementFrame& f, size_t seen_channel) const;
