@@ -159,9 +159,6 @@ bool EnvironmentPass::occludes(const std::vector<size_t>& moved) const {
 }
 
 EnvironmentPass::~EnvironmentPass() {
-  if (ao_fbo) glDeleteFramebuffers(1, &ao_fbo);
-  if (ao_image) glDeleteTextures(1, &ao_image);
-  if (ao_depth) glDeleteRenderbuffers(1, &ao_depth);
   for (auto& m : env_meshes) m.release();
   if (empty_vao) glDeleteVertexArrays(1, &empty_vao);
 }
@@ -294,43 +291,13 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
       parts.back().count += g.count;
     }
   }
-  // The static receivers' occlusion, evaluated into the pass's low-resolution occlusion image (kAoImageFactor
+  // The static receivers' occlusion, evaluated into the pass's low-resolution occlusion image (OcclusionImage::kFactor
   // times fewer pixels per axis) and read from it bilinearly: fewer evaluations of the fields, one texture lookup
   // per fragment whatever the number of occluders. Not in the zooming-region and peeling passes.
   const bool image = ao_ && ao_->active() && !reversed_depth && !peel;
   auto screen = [&](const Part& part) { return image && part.ao.kind != AoReceiver::None && !scene.meshAnimated(part.m); };
   if (std::any_of(parts.begin(), parts.end(), screen)) {
-    GLint viewport[4], target = 0;
-    glGetIntegerv(GL_VIEWPORT, viewport);
-    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &target);
-    const bool scissor = glIsEnabled(GL_SCISSOR_TEST), blend = glIsEnabled(GL_BLEND);
-    const int w = (viewport[2] + kAoImageFactor - 1) / kAoImageFactor, h = (viewport[3] + kAoImageFactor - 1) / kAoImageFactor;
-    if (w != ao_image_size[0] || h != ao_image_size[1]) {
-      if (!ao_fbo) {
-        glGenFramebuffers(1, &ao_fbo);
-        glGenTextures(1, &ao_image);
-        glGenRenderbuffers(1, &ao_depth);
-      }
-      glBindTexture(GL_TEXTURE_2D, ao_image);
-      glTexImage2D(GL_TEXTURE_2D, 0, GL_R8, w, h, 0, GL_RED, GL_UNSIGNED_BYTE, nullptr);
-      linearClampedOneLevel(GL_TEXTURE_2D);
-      glBindTexture(GL_TEXTURE_2D, 0);
-      glBindRenderbuffer(GL_RENDERBUFFER, ao_depth);
-      glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, w, h);
-      glBindRenderbuffer(GL_RENDERBUFFER, 0);
-      glBindFramebuffer(GL_DRAW_FRAMEBUFFER, ao_fbo);
-      glFramebufferTexture2D(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, ao_image, 0);
-      glFramebufferRenderbuffer(GL_DRAW_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, ao_depth);
-      ao_image_size[0] = w;
-      ao_image_size[1] = h;
-    }
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, ao_fbo);
-    glViewport(0, 0, w, h);
-    glDisable(GL_SCISSOR_TEST);
-    glDisable(GL_BLEND);
-    const float zero[4] = {0, 0, 0, 0}, far = 1;
-    glClearBufferfv(GL_COLOR, 0, zero);
-    glClearBufferfv(GL_DEPTH, 0, &far);
+    ao_image.begin();
     // The static receivers alone, nearest first: a moving one, and what is drawn without occlusion, hide nothing
     // here, so that the image about a car's outline holds the ground behind it, not the car.
     const Program* occlusion[3][2] = {};
@@ -357,15 +324,8 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
       glDrawElements(GL_TRIANGLES, part.count, GL_UNSIGNED_INT, reinterpret_cast<const void*>(size_t(part.first) * sizeof(uint32_t)));
     }
     glDisable(GL_CULL_FACE);
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, GLuint(target));
-    glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
-    if (scissor) glEnable(GL_SCISSOR_TEST);
-    if (blend) glEnable(GL_BLEND);
-    glActiveTexture(GLenum(GL_TEXTURE0 + ao_->unit()));
-    glBindTexture(GL_TEXTURE_2D, ao_image);
-    glActiveTexture(GL_TEXTURE0);
-    ao_image_map = glm::vec4(1.0f / float(viewport[2]), 1.0f / float(viewport[3]), -float(viewport[0]) / float(viewport[2]),
-                             -float(viewport[1]) / float(viewport[3]));
+    ao_image.end(ao_->unit());
+    ao_image_map = ao_image.coordinates();
   }
   bool culling = false;
   for (const Part& part : parts) {

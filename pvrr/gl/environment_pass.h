@@ -6,6 +6,7 @@
 
 #include "pvrr/gl/framebuffer.h"
 #include "pvrr/gl/gl_objects.h"
+#include "pvrr/gl/occlusion_image.h"
 #include "pvrr/gl/programs.h"
 #include "pvrr/gl/renderer.h"
 #include "pvrr/gl/stage_notes.h"
@@ -92,11 +93,8 @@ class EnvironmentPass {
   };
   std::vector<std::vector<FaceGroup>> env_groups;
   bool group_faces = false;  // the scene has ambient occlusion
-  // A pass's low-resolution occlusion image (the static receivers' ambient occlusion, R8) and its depth buffer,
-  // kAoImageFactor times fewer pixels per axis than the pass's viewport; remade when that size changes.
-  static constexpr int kAoImageFactor = 8;
-  mutable unsigned ao_fbo = 0, ao_image = 0, ao_depth = 0;
-  mutable int ao_image_size[2] = {0, 0};
+  // The passes' low-resolution occlusion image (the static receivers' ambient occlusion).
+  mutable OcclusionImage ao_image;
   std::vector<Texture> textures;  // environment textures, in Scene::textures order
   const ShadowPass* shadows_ = nullptr;
   const CausticPass* caustics_ = nullptr;

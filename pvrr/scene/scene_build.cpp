@@ -376,7 +376,7 @@ void buildLens(Element& el, const ElementDesc& e, const std::string& file, size_
     back = makeLensSurface(e.back, el.outline, where + ".back");
   }
   el.lens = cad::makeLens(front, back, el.outline, t, e.min_edge_thickness_m, what);
-  el.shadow_path_m = meanThickness(el.lens);
+  if (el.absorbing()) el.shadow_path_m = meanThickness(el.lens);  // read by the shadow rule of tinted lenses only
 }
 
 }  // namespace
