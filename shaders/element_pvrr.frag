@@ -83,7 +83,9 @@ void main() {
   c += v_w1 * texture(u_map, mapST(v_st1)).rgb + v_w2 * texture(u_map, mapST(v_st2)).rgb;
 #endif
 #endif
+#if !defined(REFINE_P2)  // the quadratic program's triangles have no traced vertex: v_tir is zero there
   c += v_tir.rgb;  // zero but near a totally reflected vertex: what the tracer shows there, interpolated
+#endif
 #if defined(NO_SEEN_POINTS)
   vec4 seen = vec4(0.0);
 #else
@@ -99,7 +101,9 @@ void main() {
   vec4 seen = texture(u_seen_map, mapST(v_st_seen));
 #endif
   // Nearer a totally reflected vertex than the others: its traced seen point (relative to this camera).
+#if !defined(REFINE_P2)
   if (v_tir.a > 0.5) seen = vec4(v_tir_seen / v_tir.a - u_seen_offset, 1.0);
+#endif
 #endif
   o_color = vec4(weight * c, 1.0);
   o_seen = vec4(seen.xyz + u_seen_offset, seen.w);

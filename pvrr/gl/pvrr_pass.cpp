@@ -65,6 +65,8 @@ PvrrPass::~PvrrPass() {
   if (refine_counters) glDeleteBuffers(1, &refine_counters);
   if (refine_sampler) glDeleteSamplers(1, &refine_sampler);
   if (!refine_queries.empty()) glDeleteQueries(GLsizei(refine_queries.size()), refine_queries.data());
+  for (auto& views : refine_split)
+    for (RefineSplitMesh& m : views) m.quadratic.release(), m.searched.release();
   if (mask_vbo) glDeleteBuffers(1, &mask_vbo);
   if (mask_vao) glDeleteVertexArrays(1, &mask_vao);
 }
@@ -85,8 +87,7 @@ void PvrrPass::prepare(RenderMode, FrameStages& stages, FrameCache* cache) {
   // The quadratic split's nodes follow the eye, the element and the scene: kept only while nothing moved.
   if (!nothing_moved)
     for (RefineMidpoints& m : refine_mids) m.nodes_fresh = false;
-  refine_quadratic = refine_searched = 0;
-  prepareRefinement();
+  prepareRefinement(cache != nullptr);
   firstPass(stages, cache, nothing_moved, cache && cache->valid);
   // The cache takes this frame whole, once its maps are drawn: the poses, and the elements with the volumes
   // and texture coordinates of the maps now held.
@@ -402,24 +403,8 @@ void PvrrPass::drawPvrrElement(const ElementFrame& f, size_t first_slot, const P
     p.set("u_st_max", (texels - 0.5f) / size);
     if (refined) setRefinementView(p, f.element, pv, map, map_side[first_slot + v]);
     if (split && refineViewSkipReason(pv).empty()) {
-      MeshBuffers& qmb = ctx.meshes.slot();
-      std::vector<uint32_t> searched;
-      const size_t n = uploadQuadraticPatch(qmb, &searched, f, pv, anchor);
-      refine_quadratic += n;
-      refine_searched += searched.size();
-      if (n > 0) {
-        quadratic->use();
-        quadratic->set("u_seen_offset", glm::vec3(pv.volume.eye - cam.origin));
-        quadratic->set("u_st_scale", texels / size);
-        quadratic->set("u_st_max", (texels - 0.5f) / size);
-        draw(qmb);
-        p.use();
-      }
-      if (!searched.empty()) {
-        MeshBuffers& mb = ctx.meshes.slot();
-        uploadRefinedPatch(mb, f, pv, anchor, &searched);
-        draw(mb);
-      }
+      drawRefinedSplit(p, *quadratic, f, v, anchor, glm::vec3(pv.volume.eye - cam.origin), texels / size,
+                       (texels - 0.5f) / size);
       unsetRefinement();
       continue;
     }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 #include <unordered_map>
@@ -56,21 +57,42 @@ class PvrrPass : public ModePass {
   CullCount renderPasses(size_t whole_slots, int64_t* skipped, int64_t* texels);
   // Per-fragment refinement (render.refine; pvrr/gl/pvrr_refine.cpp): which elements refine (refine_skip), their surface maps, the
   // fragment counters zeroed; and what the counters say once the frame's draws are done.
-  void prepareRefinement();
+  // cached: the frame continues a FrameCache's (else every frame is computed whole, and split at once).
+  void prepareRefinement(bool cached);
   void setRefinement(const Program& p, const ElementFrame& f, size_t seen_channel) const;
   void unsetRefinement() const;
   void setRefinementView(const Program& p, int element, const PatchView& pv, const Framebuffer& map, int side) const;
   std::string refinementSkips(bool* any) const;
-  // tris: the patch's triangles to upload (indices into GridPatch::triangles); null: all of them.
+  // A part of a patch's triangle (index into GridPatch::triangles): the triangle whose corners have the
+  // barycentric coordinates b (of the patch triangle's corners 0, 1, 2); the whole triangle or one of its
+  // subdivisions (uploadQuadraticPatch).
+  struct RefineTri {
+    uint32_t tri = 0;
+    std::array<Vec3, 3> b{Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)};
+  };
+  // tris: the patch's triangles (or their parts) to upload; null: all of them, whole. A part's vertex data are
+  // its triangle's, interpolated at its corners (all affine on the triangle, so its fragments see the same).
   void uploadRefinedPatch(MeshBuffers& mb, const ElementFrame& f, const PatchView& pv, const Vec3& anchor,
-                          const std::vector<uint32_t>* tris = nullptr) const;
+                          const std::vector<RefineTri>* tris = nullptr) const;
   // The quadratic split of a refined mirror's patch in the second pass (docs/method.md "Per-fragment
   // refinement"): the triangles whose exact rays at their edges' midpoints and centre (refineNodes) follow one
   // smooth surface of the map, and whose quadratic interpolant of those rays' coordinates meets the exact one at
-  // the centre within kQuadraticTolRad, go to `quadratic` (uploaded as the REFINE_P2 program reads them); the
-  // others' indices to *searched (uploadRefinedPatch). Returns the number of quadratic triangles.
-  size_t uploadQuadraticPatch(MeshBuffers& quadratic, std::vector<uint32_t>* searched, const ElementFrame& f,
-                              const PatchView& pv, const Vec3& anchor) const;
+  // the centre within kQuadraticTolRad, go to `quadratic` (uploaded as the REFINE_P2 program reads them). The
+  // others are split in four (at their edges' midpoints, in the flat triangle) and their parts tested alike with
+  // their own nodes (refineSubNode), `levels` deep; what still fails goes to *searched
+  // (uploadRefinedPatch). Returns the number of quadratic triangles and parts; *counts: the patch's triangles.
+  struct RefineSplitCounts {
+    size_t whole_quadratic = 0, whole_searched = 0, split = 0;  // triangles drawn whole by each program, split
+    double searched_area = 0;  // the split triangles' parts searched, in triangles (a part of level L: 4^-L)
+  };
+  size_t uploadQuadraticPatch(MeshBuffers& quadratic, std::vector<RefineTri>* searched, RefineSplitCounts* counts,
+                              int levels, const ElementFrame& f, const PatchView& pv, const Vec3& anchor) const;
+  // Draws patch view v of refined mirror f in the second pass, split: its quadratic triangles by `quadratic`,
+  // the others by `search` (in use on entry and on return, its view's uniforms set). The split's meshes are
+  // kept while the nodes are (refine_split): a frame in which nothing moved draws them as they are.
+  void drawRefinedSplit(const Program& search, const Program& quadratic, const ElementFrame& f, size_t v,
+                        const Vec3& anchor, const glm::vec3& seen_offset, const glm::vec2& st_scale,
+                        const glm::vec2& st_max) const;
   // A node of the quadratic split: where the view ray from the element's eye through a point of the flat
   // triangle (an edge's midpoint, or the centre) meets the exact surface, reflected and traced into the scene.
   struct RefineNode {
@@ -81,6 +103,12 @@ class PvrrPass : public ModePass {
   // The nodes of refined mirror f in this frame (edges by edgeKey, centres by triangleKey), computed once per
   // frame in which anything moved.
   const std::unordered_map<uint64_t, RefineNode>& refineNodes(const ElementFrame& f) const;
+  // The node through the flat point at barycentric b of grid triangle (v0, v1, v2) of refined mirror f, for the
+  // split's parts: computed once per frame in which anything moved (RefineMidpoints::sub_nodes).
+  const RefineNode& refineSubNode(const ElementFrame& f, const uint32_t v[3], const Vec3& b) const;
+  // The node through the flat point `flat` (the element's local frame), starting from the exact surface at
+  // parameters uv (point p, derivatives du, dv).
+  RefineNode traceRefineNode(const ElementFrame& f, Vec2 uv, Vec3 p, Vec3 du, Vec3 dv, const Vec3& flat) const;
   static uint64_t triangleKey(uint32_t i, uint32_t j, uint32_t k) {
     const uint32_t a = std::min({i, j, k}), c = std::max({i, j, k}), b = i ^ j ^ k ^ a ^ c;
     return 1ull << 63 | uint64_t(a) << 42 | uint64_t(b) << 21 | c;
@@ -110,7 +138,7 @@ class PvrrPass : public ModePass {
   std::unique_ptr<ImpostorMaps> surface_maps;  // the refined mirrors' surface maps (pvrr/impostor/surface_map.h)
                                                // and lenses' refractor height maps (lens_height_map.h)
   bool refine_counting = false;          // drawing the second pass (counted), not a nested pass
-  mutable size_t refine_quadratic = 0, refine_searched = 0;  // this frame's second-pass triangles of each kind
+  mutable RefineSplitCounts refine_counts;  // this frame's second-pass mirror triangles (uploadQuadraticPatch)
   struct RefineMidpoints {
     cad::SurfacePtr surface;  // what they were computed for (held: never a reused address)
     std::vector<Vec2> params;
@@ -124,8 +152,29 @@ class PvrrPass : public ModePass {
     std::unordered_map<uint64_t, Start> starts;
     std::unordered_map<uint64_t, RefineNode> nodes;  // this frame's (refineNodes)
     bool nodes_fresh = false;
+    // The nodes have lasted a frame: nothing moved since the frame that computed them. Only then, or in
+    // frames not cached (each computed whole: refine_cached), are the failing triangles split: their parts'
+    // nodes cost more than the triangles' own, so a moving frame searches them whole; as the view settles they
+    // split once and stay split.
+    bool settled = false;
+    uint64_t generation = 0;  // the nodes' computation (refine_generation when they were computed)
+    // The split's parts' nodes (refineSubNode), by the grid triangle's vertices in order and the point's
+    // barycentric coordinates in 1/48ths; cleared with the nodes.
+    std::map<std::pair<uint64_t, uint32_t>, RefineNode> sub_nodes;
   };
   mutable std::vector<RefineMidpoints> refine_mids;  // per element (edgeMidpoints)
+  bool refine_cached = false;                        // this frame continues a FrameCache's (prepareRefinement)
+  mutable uint64_t refine_generation = 0;            // the last nodes computed (RefineMidpoints::generation)
+  // A refined mirror's patch view in the second pass, split (drawRefinedSplit): its two meshes and triangle
+  // counts, built from the nodes of `generation` (0: none yet). Released by the pass's destructor.
+  struct RefineSplitMesh {
+    uint64_t generation = 0;
+    bool settled = false;  // built split (RefineMidpoints::settled)
+    MeshBuffers quadratic, searched;
+    size_t n_quadratic = 0, n_searched = 0;  // triangles and parts in each mesh
+    RefineSplitCounts counts;
+  };
+  mutable std::vector<std::vector<RefineSplitMesh>> refine_split;  // per element, per patch view
 };
 
 }  // namespace pvrr::gl

@@ -4,6 +4,8 @@
 // the per-fragment search), the refinement's uniforms, and its part of the stage note. The draws themselves
 // are pvrr_pass.cpp's drawPvrrElement.
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 
 #include "pvrr/gl/gl.h"
 #include "pvrr/gl/impostor_maps.h"
@@ -28,25 +30,27 @@ constexpr int kRefineLensUnit = kRefineDepthUnit + 1;
 // the triangle's P2 deviations: the exact surface point at each edge's midpoint (in the parameter domain) less
 // the edge's mean, in the world frame.
 void PvrrPass::uploadRefinedPatch(MeshBuffers& mb, const ElementFrame& f, const PatchView& pv, const Vec3& anchor,
-                                  const std::vector<uint32_t>* tris) const {
+                                  const std::vector<RefineTri>* tris) const {
   const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
   const Element& el = ctx.scene.elements[size_t(f.element)];
   const EdgeMidpoints& mids = edgeMidpoints(f);
   const cad::ParamDomain domain = el.frontSurface().domain();
   const Mat4 map_vp = relativeViewProj(pv.volume.projection, pv.volume.view, pv.volume.eye);
   const Vec3 weight = channelWeight(f.channels, 0);
-  std::vector<float> data;
+  std::vector<float> data, corner;
   data.reserve(3 * gp.triangles.size() * kElementFloats);
-  auto put = [&](const Vec3& v) { data.insert(data.end(), {float(v.x), float(v.y), float(v.z)}); };
+  corner.reserve(3 * kElementFloats);
+  auto put = [&](const Vec3& v) { corner.insert(corner.end(), {float(v.x), float(v.y), float(v.z)}); };
   const size_t n_tris = tris ? tris->size() : gp.triangles.size();
   for (size_t ti = 0; ti < n_tris; ++ti) {
-    const auto& t = gp.triangles[tris ? (*tris)[ti] : ti];
+    const auto& t = gp.triangles[tris ? (*tris)[ti].tri : ti];
     const uint32_t k[3] = {t.x, t.y, t.z}, vi[3] = {gp.vertices[t.x], gp.vertices[t.y], gp.vertices[t.z]};
     Vec3 dp[3];  // edges (0, 1), (1, 2), (2, 0)
     for (int e = 0; e < 3; ++e) {
       const uint32_t i = vi[e], j = vi[(e + 1) % 3];
       dp[e] = el.toWorldPoint(mids.at(edgeKey(i, j))) - 0.5 * (f.world_pos[i] + f.world_pos[j]);
     }
+    corner.clear();
     for (int c = 0; c < 3; ++c) {
       const VertexRay& r = f.rays[0][vi[c]];
       put(f.world_pos[vi[c]] - anchor);
@@ -64,9 +68,19 @@ void PvrrPass::uploadRefinedPatch(MeshBuffers& mb, const ElementFrame& f, const 
       put(Vec3((uv.x - domain.u0) / (domain.u1 - domain.u0), (uv.y - domain.v0) / (domain.v1 - domain.v0), 0.0));
       const bool traced = usesTraced(pv, r);
       const Vec3 colour = traced ? weight * r.traced_color : Vec3(0.0);
-      data.insert(data.end(), {float(colour.x), float(colour.y), float(colour.z), traced ? 1.0f : 0.0f});
+      corner.insert(corner.end(), {float(colour.x), float(colour.y), float(colour.z), traced ? 1.0f : 0.0f});
       put(traced ? r.traced_seen - anchor : Vec3(0.0));
     }
+    if (!tris) {
+      data.insert(data.end(), corner.begin(), corner.end());
+      continue;
+    }
+    // A part: every attribute is affine on the triangle (the projective coordinate's three components too, as
+    // they are interpolated before the division), so its corners take the triangle's at their barycentric
+    // coordinates (a whole triangle's exactly its own).
+    for (const Vec3& b : (*tris)[ti].b)
+      for (size_t i = 0; i < kElementFloats; ++i)
+        data.push_back(float(b.x * corner[i] + b.y * corner[kElementFloats + i] + b.z * corner[2 * kElementFloats + i]));
   }
   std::vector<uint32_t> idx(data.size() / kElementFloats);
   for (size_t i = 0; i < idx.size(); ++i) idx[i] = uint32_t(i);
@@ -88,6 +102,39 @@ void PvrrPass::uploadRefinedPatch(MeshBuffers& mb, const ElementFrame& f, const 
 // whatever the centre says (a guard: on the car mirror the centre's test catches the same triangles).
 constexpr double kQuadraticTolRad = 0.1 / 60.0 * kPi / 180.0;
 constexpr double kQuadraticDepthTol = 0.3;
+// How many times a triangle that fails is split in four, its parts tested alike (uploadQuadraticPatch).
+constexpr int kQuadraticSplitLevels = 1;
+
+// Two Gauss-Newton steps from the exact surface at parameters uv onto the view ray through the flat triangle's
+// point `flat` (local frame), the exact normal there, and the reflected ray traced.
+PvrrPass::RefineNode PvrrPass::traceRefineNode(const ElementFrame& f, Vec2 uv, Vec3 p, Vec3 du, Vec3 dv,
+                                               const Vec3& flat) const {
+  const Element& el = ctx.scene.elements[size_t(f.element)];
+  const cad::Surface& surface = *el.surface;
+  const cad::ParamDomain dom = surface.domain();
+  const Vec3 eye = el.toLocalPoint(f.eye);
+  RefineNode n;
+  const Vec3 d = glm::normalize(flat - eye);
+  for (int it = 0; it < 2; ++it) {
+    const Vec3 w = p - eye, r = w - glm::dot(w, d) * d;
+    const Vec3 a = du - glm::dot(du, d) * d, b = dv - glm::dot(dv, d) * d;
+    const double aa = glm::dot(a, a), ab = glm::dot(a, b), bb = glm::dot(b, b), det = aa * bb - ab * ab;
+    if (!(det > 1e-24 * aa * bb)) return n;
+    const Vec2 g(glm::dot(a, r), glm::dot(b, r));
+    uv -= Vec2(bb * g.x - ab * g.y, aa * g.y - ab * g.x) / det;
+    if (!(uv.x >= dom.u0 && uv.x <= dom.u1 && uv.y >= dom.v0 && uv.y <= dom.v1)) return n;
+    const cad::SurfaceDerivs e = surface.evaluate(uv.x, uv.y);
+    p = e.p, du = e.du, dv = e.dv;
+  }
+  const Vec3 pw = el.toWorldPoint(p), nw = glm::normalize(el.toWorldDir(glm::cross(du, dv)));
+  if (!isFinite(nw)) return n;
+  const Vec3 view = glm::normalize(pw - f.eye), dir = view - 2.0 * glm::dot(view, nw) * nw;
+  const RayHit h = ctx.rays.intersect(pw, dir, ctx.rays.epsilon());
+  n.valid = true;
+  n.escaped = !h.hit();
+  n.hit = h.hit() ? h.point : pw + ctx.scene.render.far_distance_m * dir;
+  return n;
+}
 
 const std::unordered_map<uint64_t, PvrrPass::RefineNode>& PvrrPass::refineNodes(const ElementFrame& f) const {
   edgeMidpoints(f);  // the cache entry of this surface and grid
@@ -95,7 +142,6 @@ const std::unordered_map<uint64_t, PvrrPass::RefineNode>& PvrrPass::refineNodes(
   if (c.nodes_fresh) return c.nodes;
   const Element& el = ctx.scene.elements[size_t(f.element)];
   const cad::Surface& surface = *el.surface;
-  const cad::ParamDomain dom = surface.domain();
   const std::vector<Vec2>& params = f.grid.params;
   if (c.starts.empty()) {
     auto start = [&](uint64_t key, const Vec2& uv) {
@@ -109,36 +155,11 @@ const std::unordered_map<uint64_t, PvrrPass::RefineNode>& PvrrPass::refineNodes(
       start(triangleKey(v[0], v[1], v[2]), (params[v[0]] + params[v[1]] + params[v[2]]) / 3.0);
     }
   }
-  const Vec3 eye = el.toLocalPoint(f.eye);
-  const double eps = ctx.rays.epsilon(), far = ctx.scene.render.far_distance_m;
-  // Two Gauss-Newton steps from the exact surface at the parameters' midpoint (or centre) onto the view ray
-  // through the flat triangle's point `flat` (local frame), the exact normal there, and the reflected ray traced.
   auto node = [&](const RefineMidpoints::Start& s, const Vec3& flat) {
-    RefineNode n;
-    const Vec3 d = glm::normalize(flat - eye);
-    Vec2 uv = s.uv;
-    Vec3 p = s.p, du = s.du, dv = s.dv;
-    for (int it = 0; it < 2; ++it) {
-      const Vec3 w = p - eye, r = w - glm::dot(w, d) * d;
-      const Vec3 a = du - glm::dot(du, d) * d, b = dv - glm::dot(dv, d) * d;
-      const double aa = glm::dot(a, a), ab = glm::dot(a, b), bb = glm::dot(b, b), det = aa * bb - ab * ab;
-      if (!(det > 1e-24 * aa * bb)) return n;
-      const Vec2 g(glm::dot(a, r), glm::dot(b, r));
-      uv -= Vec2(bb * g.x - ab * g.y, aa * g.y - ab * g.x) / det;
-      if (!(uv.x >= dom.u0 && uv.x <= dom.u1 && uv.y >= dom.v0 && uv.y <= dom.v1)) return n;
-      const cad::SurfaceDerivs e = surface.evaluate(uv.x, uv.y);
-      p = e.p, du = e.du, dv = e.dv;
-    }
-    const Vec3 pw = el.toWorldPoint(p), nw = glm::normalize(el.toWorldDir(glm::cross(du, dv)));
-    if (!isFinite(nw)) return n;
-    const Vec3 view = glm::normalize(pw - f.eye), dir = view - 2.0 * glm::dot(view, nw) * nw;
-    const RayHit h = ctx.rays.intersect(pw, dir, eps);
-    n.valid = true;
-    n.escaped = !h.hit();
-    n.hit = h.hit() ? h.point : pw + far * dir;
-    return n;
+    return traceRefineNode(f, s.uv, s.p, s.du, s.dv, flat);
   };
   c.nodes.clear();
+  c.sub_nodes.clear();
   c.nodes.reserve(c.starts.size());
   const std::vector<Vec3>& pos = f.grid.positions;
   for (const auto& t : f.grid.triangles) {
@@ -151,11 +172,27 @@ const std::unordered_map<uint64_t, PvrrPass::RefineNode>& PvrrPass::refineNodes(
     c.nodes[key] = node(c.starts.at(key), (pos[v[0]] + pos[v[1]] + pos[v[2]]) / 3.0);
   }
   c.nodes_fresh = true;
+  c.generation = ++refine_generation;
   return c.nodes;
 }
 
-size_t PvrrPass::uploadQuadraticPatch(MeshBuffers& mb, std::vector<uint32_t>* searched, const ElementFrame& f,
-                                      const PatchView& pv, const Vec3& anchor) const {
+const PvrrPass::RefineNode& PvrrPass::refineSubNode(const ElementFrame& f, const uint32_t v[3], const Vec3& b) const {
+  RefineMidpoints& c = refine_mids[size_t(f.element)];
+  const uint64_t tri = uint64_t(v[0]) << 42 | uint64_t(v[1]) << 21 | v[2];
+  const uint32_t q = uint32_t(std::lround(b.y * 48.0)) << 8 | uint32_t(std::lround(b.z * 48.0));
+  auto [it, added] = c.sub_nodes.try_emplace({tri, q});
+  if (added) {
+    const Vec2 uv = b.x * f.grid.params[v[0]] + b.y * f.grid.params[v[1]] + b.z * f.grid.params[v[2]];
+    const Vec3 flat = b.x * f.grid.positions[v[0]] + b.y * f.grid.positions[v[1]] + b.z * f.grid.positions[v[2]];
+    const cad::SurfaceDerivs d = ctx.scene.elements[size_t(f.element)].surface->evaluate(uv.x, uv.y);
+    it->second = traceRefineNode(f, uv, d.p, d.du, d.dv, flat);
+  }
+  return it->second;
+}
+
+size_t PvrrPass::uploadQuadraticPatch(MeshBuffers& mb, std::vector<RefineTri>* searched, RefineSplitCounts* counts,
+                                      int levels, const ElementFrame& f, const PatchView& pv,
+                                      const Vec3& anchor) const {
   const cad::GridPatch& gp = f.grid_patches[size_t(pv.patch)];
   const std::unordered_map<uint64_t, RefineNode>& nodes = refineNodes(f);
   const Mat4 map_vp = relativeViewProj(pv.volume.projection, pv.volume.view, pv.volume.eye);
@@ -166,57 +203,104 @@ size_t PvrrPass::uploadQuadraticPatch(MeshBuffers& mb, std::vector<uint32_t>* se
   std::vector<float> data;
   auto put = [&](const Vec3& v) { data.insert(data.end(), {float(v.x), float(v.y), float(v.z)}); };
   searched->clear();
+  *counts = RefineSplitCounts{};
   size_t count = 0;
+  // A corner of a triangle or of a part: a vertex ray or a node, its volume coordinate and depth.
+  struct Corner {
+    bool valid = false, escaped = false;
+    Vec2 st{0};
+    double depth = 0;
+  };
   for (uint32_t ti = 0; ti < gp.triangles.size(); ++ti) {
     const auto& t = gp.triangles[ti];
     const uint32_t k[3] = {t.x, t.y, t.z}, vi[3] = {gp.vertices[t.x], gp.vertices[t.y], gp.vertices[t.z]};
-    bool ok = true, escaped[3];
-    Vec2 st[3];
-    double dep[3];
+    bool vertices_ok = true;
+    Corner vc[3];
     for (int c = 0; c < 3; ++c) {
       const VertexRay& r = f.rays[0][vi[c]];
-      st[c] = pv.st[0][k[c]];
-      dep[c] = depth(r.hit);
-      escaped[c] = r.status == VertexStatus::Escape;
-      ok = ok && r.status != VertexStatus::Tir && !usesTraced(pv, r);
+      vc[c] = {true, r.status == VertexStatus::Escape, pv.st[0][k[c]], depth(r.hit)};
+      vertices_ok = vertices_ok && r.status != VertexStatus::Tir && !usesTraced(pv, r);
     }
-    ok = ok && escaped[0] == escaped[1] && escaped[1] == escaped[2];
-    // A node on the corners' smooth surface: valid, of their kind, and (hits) at a depth near their mean.
-    auto smooth = [&](const RefineNode& n, double mean, double least) {
-      return n.valid && n.escaped == escaped[0] && (escaped[0] || std::abs(depth(n.hit) - mean) <= kQuadraticDepthTol * least);
-    };
-    Vec2 D[3];  // edges (0, 1), (1, 2), (2, 0): the midpoint node's coordinate less the edge's mean
-    for (int e = 0; e < 3 && ok; ++e) {
-      const int e1 = (e + 1) % 3;
-      const RefineNode& n = nodes.at(edgeKey(vi[e], vi[e1]));
-      ok = smooth(n, 0.5 * (dep[e] + dep[e1]), std::min(dep[e], dep[e1]));
-      D[e] = projectToTexture(pv.volume, n.hit) - 0.5 * (st[e] + st[e1]);
-    }
-    if (ok) {
-      const RefineNode& n = nodes.at(triangleKey(vi[0], vi[1], vi[2]));
-      ok = smooth(n, (dep[0] + dep[1] + dep[2]) / 3.0, std::min({dep[0], dep[1], dep[2]}));
-      const Vec2 centre = (st[0] + st[1] + st[2]) / 3.0 + 4.0 / 9.0 * (D[0] + D[1] + D[2]);
-      const double miss = glm::length(centre - projectToTexture(pv.volume, n.hit)) * rad_per_st;
-      ok = ok && miss <= kQuadraticTolRad;  // false for NaN
-    }
-    if (!ok) {
-      searched->push_back(ti);
+    if (!vertices_ok) {
+      searched->push_back({ti});
+      ++counts->whole_searched;
       continue;
     }
-    ++count;
-    for (int c = 0; c < 3; ++c) {
-      const VertexRay& r = f.rays[0][vi[c]];
-      put(f.world_pos[vi[c]] - anchor);
-      put(f.world_normal[vi[c]]);
-      put(Vec3(st[c], 1.0));
-      put(Vec3(c == 1 ? 1.0 : 0.0, c == 2 ? 1.0 : 0.0, 0.0));
-      put(Vec3(D[0], D[1].x));
-      put(pv.draw_traced ? Vec3(0.0) : weight * r.transmittance);
-      put(Vec3(D[1].y, D[2]));
-      put(Vec3(0.0));
-      put(Vec3(st[c], 1.0));
-      data.insert(data.end(), {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f});
-    }
+    // The node at barycentric b (of corners 0, 1, 2): the triangle's own at its edges' midpoints and centre.
+    auto nodeAt = [&](const Vec3& b) -> const RefineNode& {
+      for (int e = 0; e < 3; ++e)
+        if (b[e] == 0.0 && b[(e + 1) % 3] == 0.5) return nodes.at(edgeKey(vi[(e + 1) % 3], vi[(e + 2) % 3]));
+      if (b.x == b.y && b.y == b.z) return nodes.at(triangleKey(vi[0], vi[1], vi[2]));
+      return refineSubNode(f, vi, b);
+    };
+    auto cornerAt = [&](const Vec3& b) {
+      for (int c = 0; c < 3; ++c)
+        if (b[c] == 1.0) return vc[c];
+      const RefineNode& n = nodeAt(b);
+      return Corner{n.valid, n.escaped, projectToTexture(pv.volume, n.hit), depth(n.hit)};
+    };
+    // A part with corners at b, tested; drawn quadratic if it passes, else split again or searched.
+    auto part = [&](auto& self, const std::array<Vec3, 3>& b, int level) -> void {
+      Corner C[3] = {cornerAt(b[0]), cornerAt(b[1]), cornerAt(b[2])};
+      bool ok = C[0].valid && C[1].valid && C[2].valid && C[0].escaped == C[1].escaped && C[1].escaped == C[2].escaped;
+      // A node on the corners' smooth surface: valid, of their kind, and (hits) at a depth near their mean.
+      auto smooth = [&](const RefineNode& n, double mean, double least) {
+        return n.valid && n.escaped == C[0].escaped &&
+               (C[0].escaped || std::abs(depth(n.hit) - mean) <= kQuadraticDepthTol * least);
+      };
+      Vec2 D[3];  // edges (0, 1), (1, 2), (2, 0): the midpoint node's coordinate less the edge's mean
+      Vec3 mid[3];
+      for (int e = 0; e < 3; ++e) mid[e] = 0.5 * (b[e] + b[(e + 1) % 3]);
+      for (int e = 0; e < 3 && ok; ++e) {
+        const int e1 = (e + 1) % 3;
+        const RefineNode& n = nodeAt(mid[e]);
+        ok = smooth(n, 0.5 * (C[e].depth + C[e1].depth), std::min(C[e].depth, C[e1].depth));
+        D[e] = projectToTexture(pv.volume, n.hit) - 0.5 * (C[e].st + C[e1].st);
+      }
+      if (ok) {
+        const RefineNode& n = nodeAt((b[0] + b[1] + b[2]) / 3.0);
+        ok = smooth(n, (C[0].depth + C[1].depth + C[2].depth) / 3.0, std::min({C[0].depth, C[1].depth, C[2].depth}));
+        const Vec2 centre = (C[0].st + C[1].st + C[2].st) / 3.0 + 4.0 / 9.0 * (D[0] + D[1] + D[2]);
+        const double miss = glm::length(centre - projectToTexture(pv.volume, n.hit)) * rad_per_st;
+        ok = ok && miss <= kQuadraticTolRad;  // false for NaN
+      }
+      if (!ok && level < levels) {
+        if (level == 0) ++counts->split;
+        self(self, {b[0], mid[0], mid[2]}, level + 1);
+        self(self, {mid[0], b[1], mid[1]}, level + 1);
+        self(self, {mid[2], mid[1], b[2]}, level + 1);
+        self(self, {mid[1], mid[2], mid[0]}, level + 1);
+        return;
+      }
+      if (!ok) {
+        searched->push_back({ti, b});
+        if (level == 0) ++counts->whole_searched;
+        else counts->searched_area += std::ldexp(1.0, -2 * level);
+        return;
+      }
+      ++count;
+      if (level == 0) ++counts->whole_quadratic;
+      for (int c = 0; c < 3; ++c) {
+        const Vec3& w = b[c];
+        Vec3 pos(0.0), normal(0.0), transmittance(0.0);
+        for (int i = 0; i < 3; ++i) {
+          pos += w[i] * (f.world_pos[vi[i]] - anchor);
+          normal += w[i] * f.world_normal[vi[i]];
+          transmittance += w[i] * f.rays[0][vi[i]].transmittance;
+        }
+        put(pos);
+        put(normal);
+        put(Vec3(C[c].st, 1.0));
+        put(Vec3(c == 1 ? 1.0 : 0.0, c == 2 ? 1.0 : 0.0, 0.0));
+        put(Vec3(D[0], D[1].x));
+        put(pv.draw_traced ? Vec3(0.0) : weight * transmittance);
+        put(Vec3(D[1].y, D[2]));
+        put(Vec3(0.0));
+        put(Vec3(C[c].st, 1.0));
+        data.insert(data.end(), {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f});
+      }
+    };
+    part(part, {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)}, 0);
   }
   if (count == 0) return 0;
   std::vector<uint32_t> idx(data.size() / kElementFloats);
@@ -225,8 +309,48 @@ size_t PvrrPass::uploadQuadraticPatch(MeshBuffers& mb, std::vector<uint32_t>* se
   return count;
 }
 
-void PvrrPass::prepareRefinement() {
+void PvrrPass::drawRefinedSplit(const Program& search, const Program& quadratic, const ElementFrame& f, size_t v,
+                                const Vec3& anchor, const glm::vec3& seen_offset, const glm::vec2& st_scale,
+                                const glm::vec2& st_max) const {
+  refineNodes(f);
+  const uint64_t generation = refine_mids[size_t(f.element)].generation;
+  if (refine_split.size() < ctx.scene.elements.size()) refine_split.resize(ctx.scene.elements.size());
+  std::vector<RefineSplitMesh>& views = refine_split[size_t(f.element)];
+  if (views.size() < f.views.size()) views.resize(f.views.size());
+  RefineSplitMesh& m = views[v];
+  // The nodes are recomputed in every frame in which anything moved (the eye, the element, the scene), and the
+  // meshes' other inputs (the vertex rays, the patch view's volume and coordinates) only change in such frames.
+  const bool settled = refine_mids[size_t(f.element)].settled || !refine_cached;
+  if (m.generation != generation || m.settled != settled) {
+    std::vector<RefineTri> searched;
+    m.n_quadratic =
+        uploadQuadraticPatch(m.quadratic, &searched, &m.counts, settled ? kQuadraticSplitLevels : 0, f, f.views[v], anchor);
+    m.n_searched = searched.size();
+    if (!searched.empty()) uploadRefinedPatch(m.searched, f, f.views[v], anchor, &searched);
+    m.generation = generation;
+    m.settled = settled;
+  }
+  refine_counts.whole_quadratic += m.counts.whole_quadratic;
+  refine_counts.whole_searched += m.counts.whole_searched;
+  refine_counts.split += m.counts.split;
+  refine_counts.searched_area += m.counts.searched_area;
+  if (m.n_quadratic > 0) {
+    quadratic.use();
+    quadratic.set("u_seen_offset", seen_offset);
+    quadratic.set("u_st_scale", st_scale);
+    quadratic.set("u_st_max", st_max);
+    draw(m.quadratic);
+    search.use();
+  }
+  if (m.n_searched > 0) draw(m.searched);
+}
+
+void PvrrPass::prepareRefinement(bool cached) {
   const int steps = ctx.scene.render.refine;
+  refine_counts = RefineSplitCounts{};
+  // Nodes still fresh here (prepare clears them where anything moved) were computed in an earlier frame.
+  for (RefineMidpoints& m : refine_mids) m.settled = m.nodes_fresh;
+  refine_cached = cached;
   refine_skip.assign(frames.size(), "off");
   refine_lens = false;
   if (steps <= 0) return;
@@ -278,6 +402,7 @@ const PvrrPass::EdgeMidpoints& PvrrPass::edgeMidpoints(const ElementFrame& f) co
   c.mids.clear();
   c.starts.clear();
   c.nodes.clear();
+  c.sub_nodes.clear();
   c.nodes_fresh = false;
   for (const auto& t : f.grid.triangles) {
     const uint32_t v[3] = {t.x, t.y, t.z};
@@ -362,9 +487,15 @@ std::string PvrrPass::finishedNote(const std::string& note) const {
               " kept it where the view ray missed the exact surface";
     if (refine_lens)
       refine += ", " + std::to_string(n[2]) + " kept it where a lens's exact path is totally reflected inside";
-    if (refine_quadratic + refine_searched > 0)
-      refine += "; of " + std::to_string(refine_quadratic + refine_searched) + " mirror triangles " +
-                std::to_string(refine_searched) + " searched, the others quadratic (exact rays at their edges' midpoints)";
+    const RefineSplitCounts& sc = refine_counts;
+    if (sc.whole_quadratic + sc.whole_searched + sc.split > 0) {
+      char area[32];
+      std::snprintf(area, sizeof(area), "%.2f", sc.searched_area);
+      refine += "; of " + std::to_string(sc.whole_quadratic + sc.whole_searched + sc.split) + " mirror triangles " +
+                std::to_string(sc.whole_searched) + " searched whole and " + std::to_string(sc.split) +
+                " split in four (parts searched: " + area +
+                " triangles' area), the others quadratic (exact rays at their edges' midpoints)";
+    }
   }
   if (!skipped.empty()) refine += std::string(any ? ";" : "") + " not refined:" + skipped;
   return note.empty() ? refine : note + "; " + refine;
