@@ -87,7 +87,7 @@ void PvrrPass::prepare(RenderMode, FrameStages& stages, FrameCache* cache) {
   // The quadratic split's nodes follow the eye, the element and the scene: kept only while nothing moved.
   if (!nothing_moved)
     for (RefineMidpoints& m : refine_mids) m.nodes_fresh = false;
-  prepareRefinement(cache != nullptr);
+  prepareRefinement(cache && cache->valid);
   firstPass(stages, cache, nothing_moved, cache && cache->valid);
   // The cache takes this frame whole, once its maps are drawn: the poses, and the elements with the volumes
   // and texture coordinates of the maps now held.

@@ -57,8 +57,9 @@ class PvrrPass : public ModePass {
   CullCount renderPasses(size_t whole_slots, int64_t* skipped, int64_t* texels);
   // Per-fragment refinement (render.refine; pvrr/gl/pvrr_refine.cpp): which elements refine (refine_skip), their surface maps, the
   // fragment counters zeroed; and what the counters say once the frame's draws are done.
-  // cached: the frame continues a FrameCache's (else every frame is computed whole, and split at once).
-  void prepareRefinement(bool cached);
+  // continuing: the frame continues an earlier frame's FrameCache (the quadratic split's parts wait for the view
+  // to settle: RefineMidpoints::settled); else it stands alone and splits at once.
+  void prepareRefinement(bool continuing);
   void setRefinement(const Program& p, const ElementFrame& f, size_t seen_channel) const;
   void unsetRefinement() const;
   void setRefinementView(const Program& p, int element, const PatchView& pv, const Framebuffer& map, int side) const;
@@ -152,10 +153,10 @@ class PvrrPass : public ModePass {
     std::unordered_map<uint64_t, Start> starts;
     std::unordered_map<uint64_t, RefineNode> nodes;  // this frame's (refineNodes)
     bool nodes_fresh = false;
-    // The nodes have lasted a frame: nothing moved since the frame that computed them. Only then, or in
-    // frames not cached (each computed whole: refine_cached), are the failing triangles split: their parts'
-    // nodes cost more than the triangles' own, so a moving frame searches them whole; as the view settles they
-    // split once and stay split.
+    // The nodes have lasted a frame: nothing moved since the frame that computed them. Only then, or in a
+    // frame that stands alone (no earlier frame cached: refine_continuing false), are the failing triangles
+    // split: their parts' nodes cost more than the triangles' own, so a moving frame searches them whole; as
+    // the view settles they split once and stay split.
     bool settled = false;
     uint64_t generation = 0;  // the nodes' computation (refine_generation when they were computed)
     // The split's parts' nodes (refineSubNode), by the grid triangle's vertices in order and the point's
@@ -163,7 +164,7 @@ class PvrrPass : public ModePass {
     std::map<std::pair<uint64_t, uint32_t>, RefineNode> sub_nodes;
   };
   mutable std::vector<RefineMidpoints> refine_mids;  // per element (edgeMidpoints)
-  bool refine_cached = false;                        // this frame continues a FrameCache's (prepareRefinement)
+  bool refine_continuing = false;  // this frame continues an earlier frame's FrameCache (prepareRefinement)
   mutable uint64_t refine_generation = 0;            // the last nodes computed (RefineMidpoints::generation)
   // A refined mirror's patch view in the second pass, split (drawRefinedSplit): its two meshes and triangle
   // counts, built from the nodes of `generation` (0: none yet). Released by the pass's destructor.

@@ -320,7 +320,7 @@ void PvrrPass::drawRefinedSplit(const Program& search, const Program& quadratic,
   RefineSplitMesh& m = views[v];
   // The nodes are recomputed in every frame in which anything moved (the eye, the element, the scene), and the
   // meshes' other inputs (the vertex rays, the patch view's volume and coordinates) only change in such frames.
-  const bool settled = refine_mids[size_t(f.element)].settled || !refine_cached;
+  const bool settled = refine_mids[size_t(f.element)].settled || !refine_continuing;
   if (m.generation != generation || m.settled != settled) {
     std::vector<RefineTri> searched;
     m.n_quadratic =
@@ -345,12 +345,12 @@ void PvrrPass::drawRefinedSplit(const Program& search, const Program& quadratic,
   if (m.n_searched > 0) draw(m.searched);
 }
 
-void PvrrPass::prepareRefinement(bool cached) {
+void PvrrPass::prepareRefinement(bool continuing) {
   const int steps = ctx.scene.render.refine;
   refine_counts = RefineSplitCounts{};
   // Nodes still fresh here (prepare clears them where anything moved) were computed in an earlier frame.
   for (RefineMidpoints& m : refine_mids) m.settled = m.nodes_fresh;
-  refine_cached = cached;
+  refine_continuing = continuing;
   refine_skip.assign(frames.size(), "off");
   refine_lens = false;
   if (steps <= 0) return;

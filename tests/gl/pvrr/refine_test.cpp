@@ -211,6 +211,36 @@ TEST_P(RefineTest, CountsAreEachFramesOwn) {
   EXPECT_EQ(notes[2], notes[0]);
 }
 
+// The quadratic split's parts wait for the view to settle: a frame that stands alone (the first of its cache)
+// splits its failing triangles, a frame that moved since the cached one searches them whole (their parts'
+// nodes are not computed while the view moves), and the next frame in which nothing moved splits them again.
+TEST_P(RefineTest, SplitsOnceTheViewSettles) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  const cad::Outline outline = cad::Outline::rectangle(0.5, 0.4, 0.04);
+  Scene s = mirrorScene(cad::makeSphere(1.2, outline), 1);
+  s.render.refine = 2;
+  RayScene rays(s);
+  gl::Renderer r(s, rays, gl::RendererOptions{});
+  gl::FrameCache cache;
+  const Vec3 eye0 = s.observer.eye;
+  std::vector<SplitCounts> counts;
+  std::vector<std::string> notes;
+  for (const double dx : {0.0, 0.01, 0.01}) {  // the first pose, moved 1 cm, the same again
+    s.observer.eye = eye0 + Vec3(dx, 0.0, 0.0);
+    cache.environment_changed = false;
+    notes.push_back(refineNote(r.render(RenderMode::Pvrr, &cache)));
+    counts.push_back(splitCounts(notes.back()));
+    ASSERT_GT(counts.back().triangles, 0) << notes.back();
+  }
+  EXPECT_GT(counts[0].split, 0) << notes[0];
+  EXPECT_EQ(counts[1].split, 0) << notes[1];
+  EXPECT_GT(counts[1].searched_whole, 0) << notes[1];
+  EXPECT_GT(counts[2].split, 0) << notes[2];
+  EXPECT_EQ(counts[2].searched_whole, 0) << notes[2];
+  EXPECT_LT(counts[2].searched_area, double(counts[2].split)) << notes[2];
+}
+
 // Off draws the unrefined pixels (the default, the paper's method), and so does refinement of an element it
 // skips: a plane mirror, whose interpolation is exact already, named with the reason in the note.
 TEST_P(RefineTest, OffAndSkippedElementsDrawTheUnrefinedPixels) {
