@@ -125,6 +125,43 @@ TEST_P(HuntCli, RightOrFlaggedInEveryRasterMode) {
   }
 }
 
+// The hunt's finding 4: the reading lens at render.max_depth 1. Its light needs two refractions, so the reference's
+// path ends at the depth limit on the lens's back surface (drawn black) with no seen point; pvrr mode draws it
+// black too, yet its seen point (the room beyond) read as 198' median against the reference's back-surface point.
+// Those pixels now leave the angular error and are compared by colour only.
+TEST_F(HuntCli, DepthLimitPixelsAreComparedByColourOnly) {
+  const std::string out = (dir_ / "compare").string();
+  const CliResult r = runPvrr("compare models/reading-lens.json --set render.max_depth=1 --modes pvrr --gl osmesa "
+                              "--size 48x36 --frames 1 --out '" + out + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json m = nlohmann::json::parse(pvrr::test::slurp(out + "/metrics.json"));
+  const long limited = m["reference"]["depth_limit_pixels"].get<long>();
+  EXPECT_GT(limited, 100);
+  const nlohmann::json& j = m["modes"]["pvrr"];
+  EXPECT_EQ(j["depth_limit"]["pixels"].get<long>(), limited);
+  EXPECT_EQ(j["depth_limit"]["drawn_lit"].get<long>(), 0);  // pvrr mode draws them black, as the reference
+  EXPECT_GT(j["depth_limit"]["psnr_db"].get<double>(), 40.0);
+  // Hardly a lens pixel is left with a seen point (the rim's, leaving through the edge band), so no 198' median.
+  EXPECT_LT(j["pixels"].get<long>(), limited / 20);
+  EXPECT_LT(j["angular_error_arcmin"]["median"].get<double>(), kRightArcmin);
+  EXPECT_EQ(j["elements"][0]["depth_limit"]["pixels"].get<long>(), limited);
+  EXPECT_NE(r.out.find("pvrr     " + std::to_string(limited) +
+                       " pixels where the reference's path ended at the depth limit (render.max_depth 1): compared "
+                       "by colour only: 0 drawn lit"),
+            std::string::npos)
+      << r.out;
+  // At the scene's own depth (4) no path ends there: the figures are as before.
+  const std::string out4 = (dir_ / "compare4").string();
+  const CliResult r4 = runPvrr("compare models/reading-lens.json --modes pvrr --gl osmesa --size 48x36 --frames 1 --out '" +
+                               out4 + "'");
+  ASSERT_EQ(r4.code, 0) << r4.err;
+  const nlohmann::json m4 = nlohmann::json::parse(pvrr::test::slurp(out4 + "/metrics.json"));
+  EXPECT_EQ(m4["reference"]["depth_limit_pixels"].get<long>(), 0);
+  // The same lens pixels, now all with seen points.
+  EXPECT_EQ(m4["modes"]["pvrr"]["pixels"].get<long>(), limited + j["pixels"].get<long>());
+  EXPECT_EQ(r4.out.find("ended at the depth limit"), std::string::npos) << r4.out;
+}
+
 INSTANTIATE_TEST_SUITE_P(Hunt, HuntCli, ::testing::ValuesIn(huntCases()),
                          [](const ::testing::TestParamInfo<HuntCase>& i) {
                            std::string n;
