@@ -233,6 +233,73 @@ void applyNestedParallax(const Scene& scene, ElementFrame& f) {
                      "' (median) off the directions its rays arrive from (the rays do not meet in one point)";
 }
 
+// Whether segment o + t d, t in (t0, t1), crosses triangle abc (Moller-Trumbore).
+bool segmentCrosses(const Vec3& o, const Vec3& d, double t0, double t1, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 e1 = b - a, e2 = c - a, pv = glm::cross(d, e2);
+  const double det = glm::dot(e1, pv);
+  if (std::abs(det) < 1e-300) return false;
+  const double inv = 1.0 / det;
+  const Vec3 tv = o - a;
+  const double u = glm::dot(tv, pv) * inv;
+  if (u < 0 || u > 1) return false;
+  const Vec3 qv = glm::cross(tv, e1);
+  const double v = glm::dot(d, qv) * inv;
+  if (v < 0 || u + v > 1) return false;
+  const double t = glm::dot(e2, qv) * inv;
+  return t > t0 && t < t1;
+}
+
+// A mirror patch whose near plane could not be placed at the mirror (ViewVolume::mirror_vertices_unclipped: a hit
+// nearer the viewpoint than the farthest mirror vertex) holds, between its near plane and the mirror, what lies
+// behind the mirror: the map shows it in place of the reflection wherever it is there. Found in the hunt
+// (docs/robustness.md, "compare and the quality checks"): two cards 2 and 6 cm before a plane mirror moved its
+// near plane 47 mm towards the viewpoint, and the wall 1 cm behind the mirror covered a triangle of the picture
+// (p95 10800', good). Counted at the seen vertices: the segment from the near plane to the vertex along the
+// viewpoint's line crosses an environment triangle.
+void applyBehindMirror(const Scene& scene, ElementFrame& f) {
+  if (scene.elements[size_t(f.element)].type != ElementType::Mirror) return;
+  int marked = 0, total = 0;
+  for (PatchView& pv : f.views) {
+    const ViewVolume& vv = pv.volume;
+    if (!pv.in_view || vv.backward || vv.mirror_vertices_unclipped == 0) continue;
+    int hidden = 0;
+    for (uint32_t vi : f.grid_patches[size_t(pv.patch)].vertices) {
+      if ((!f.in_view.empty() && f.in_view[vi] != 2) || vi >= f.world_pos.size()) continue;
+      const Vec3 to = f.world_pos[vi] - vv.eye;
+      const double len = glm::length(to);
+      const double along = glm::dot(to, vv.forward);
+      if (!(len > 0) || !(along > vv.near_m)) continue;
+      const Vec3 d = to / len;
+      const double t_near = len * vv.near_m / along, t_end = len * (1 - 1e-9);
+      bool crossed = false;
+      for (const EnvMesh& m : scene.meshes) {
+        for (const glm::u32vec3& t : m.triangles)
+          if (segmentCrosses(vv.eye, d, t_near, t_end, m.anchor + Vec3(m.positions[t.x]),
+                             m.anchor + Vec3(m.positions[t.y]), m.anchor + Vec3(m.positions[t.z]))) {
+            crossed = true;
+            break;
+          }
+        if (crossed) break;
+      }
+      hidden += crossed;
+    }
+    if (hidden == 0) continue;
+    pv.quality.verdict = std::max(pv.quality.verdict, QualityVerdict::kDegraded);
+    pv.quality.reasons += std::string(pv.quality.reasons.empty() ? "" : "; ") + std::to_string(hidden) +
+                          " seen vertices where what lies behind the mirror is inside its map (the near plane "
+                          "could not be placed at the mirror)";
+    if (pv.quality.action == "none") pv.quality.action = "flagged";
+    ++marked;
+    total += hidden;
+  }
+  if (!marked) return;
+  f.quality.verdict = std::max(f.quality.verdict, QualityVerdict::kDegraded);
+  f.quality.action = (f.quality.action == "none" ? "" : f.quality.action + "; ") + std::to_string(marked) +
+                     " patch(es) flagged: at " + std::to_string(total) +
+                     " seen vertices the map shows what lies behind the mirror in place of its reflection (a hit "
+                     "nearer the viewpoint than the mirror moved the near plane off the mirror)";
+}
+
 }  // namespace
 
 void applyEyeSide(const Scene& scene, ElementFrame& f) {
@@ -241,6 +308,7 @@ void applyEyeSide(const Scene& scene, ElementFrame& f) {
   const Element& el = scene.elements[size_t(f.element)];
   applyLensEdgeExits(el, f);
   applyNestedParallax(scene, f);
+  applyBehindMirror(scene, f);
   if (el.type != ElementType::Lens || f.quality.note.empty()) return;
   f.quality.note +=
       ": pvrr mode's vertex rays enter a lens through its front surface, so the patches seen from "
