@@ -79,11 +79,11 @@ bool drawnLit(const Vec3& linear);
 // The colour check of the pixels the angular error leaves out, and its converse. Over the element pixels (ref.element
 // >= 0, equal to `only_element` when that is >= 0):
 struct DepthLimitColour {
-  size_t pixels = 0;        // where the reference's path ended at the depth limit (the reference draws them black)
-  size_t drawn_lit = 0;     // of those, the frame draws lit: it shows something where the reference shows nothing
-  double psnr_db = 0;       // the frame's colour PSNR over `pixels` (0 for none, 99 when all match)
-  size_t reference_lit = 0; // the other element pixels that the reference draws lit
-  size_t drawn_dark = 0;    // of those, the frame draws dark: its path ended (or was cut) where the reference's did not
+  size_t pixels = 0;         // where the reference's path ended at the depth limit (the reference draws them black)
+  size_t drawn_lit = 0;      // of those, the frame draws lit: it shows something where the reference shows nothing
+  double psnr_db = 0;        // the frame's colour PSNR over `pixels` (0 for none, 99 when all match)
+  size_t reference_lit = 0;  // the other element pixels that the reference draws lit
+  size_t drawn_dark = 0;  // of those, the frame draws dark: its path ended (or was cut) where the reference's did not
   size_t disagreements() const { return drawn_lit + drawn_dark; }
 };
 DepthLimitColour depthLimitColour(const Frame& ref, const Frame& frame, int only_element = -1);

@@ -196,7 +196,8 @@ TEST(CubeQuality, EnvmapFlagsALensBeyondTheDepthLimit) {
   ElementFrame f;
   assess(s, rays, 0, RenderMode::Envmap, &f);
   EXPECT_EQ(f.quality.verdict, QualityVerdict::kDegraded);
-  EXPECT_NE(f.quality.action.find("render.max_depth 1: the reference ends every path through the lens"), std::string::npos)
+  EXPECT_NE(f.quality.action.find("render.max_depth 1: the reference ends every path through the lens"),
+            std::string::npos)
       << f.quality.action;
   const Scene s4 = test::shippedScene("spectacle-lens");
   const RayScene rays4(s4);

@@ -134,8 +134,8 @@ TEST(EyeSide, NestedParallaxIsFlaggedOnNurbsMirrors) {
     EXPECT_EQ(f.quality.verdict, QualityVerdict::kGood) << f.quality.action;
   }
   for (const bool concave_nurbs : {false, true}) {
-    Scene s = test::shippedScene("mirror-pair", {"observer.image_size=[96, 72]",
-                                                 R"(elements[0].surface={"type":"sphere","radius":-1.0})"});
+    Scene s = test::shippedScene(
+        "mirror-pair", {"observer.image_size=[96, 72]", R"(elements[0].surface={"type":"sphere","radius":-1.0})"});
     // The wall mirror, 1.2 x 0.9 m: a flat NURBS patch a little larger than its outline.
     s.elements[1].surface = paraboloidNurbs(0.61, 0.46, 0.0);
     if (concave_nurbs) s.elements[0].surface = paraboloidNurbs(0.16, 0.12, 0.5);
@@ -146,7 +146,9 @@ TEST(EyeSide, NestedParallaxIsFlaggedOnNurbsMirrors) {
     EXPECT_NE(f.quality.action.find("patch(es) flagged: the mirrors or lenses its maps show"), std::string::npos)
         << f.quality.action;
     for (const PatchView& pv : f.views)
-      if (!pv.quality.reasons.empty()) std::printf("[ measured ] %s patch %d: %s\n", concave_nurbs ? "NURBS" : "sphere", pv.patch, pv.quality.reasons.c_str());
+      if (!pv.quality.reasons.empty())
+        std::printf("[ measured ] %s patch %d: %s\n", concave_nurbs ? "NURBS" : "sphere", pv.patch,
+                    pv.quality.reasons.c_str());
   }
 }
 
@@ -155,7 +157,8 @@ TEST(EyeSide, NestedParallaxIsFlaggedOnNurbsMirrors) {
 // towards the viewpoint and the wall 1 cm behind the mirror covered a triangle of the picture in pvrr mode (p95
 // 10800', passed as good). Flagged at the seen vertices; no element of the shipped scenes is.
 TEST(EyeSide, WhatLiesBehindAMirrorInsideItsMapIsFlagged) {
-  const Scene s = buildScene(loadScene(std::string(PVRR_SOURCE_DIR) + "/tests/data/stress/hunt-impostor-behind-two-cards.json", {}));
+  const Scene s = buildScene(
+      loadScene(std::string(PVRR_SOURCE_DIR) + "/tests/data/stress/hunt-impostor-behind-two-cards.json", {}));
   const RayScene rays(s);
   const ElementFrame f = frameFromEye(s, rays);
   EXPECT_EQ(f.quality.verdict, QualityVerdict::kDegraded) << f.quality.action;
@@ -173,7 +176,8 @@ TEST(EyeSide, WhatLiesBehindAMirrorInsideItsMapIsFlagged) {
       ElementFrame fe = prepareElement(sh, int(e));
       traceVertexRays(r, fe, sh.observer.eye, o);
       fitPatchViews(sh, fe, o);
-      EXPECT_EQ(fe.quality.action.find("behind the mirror"), std::string::npos) << name << " " << e << ": " << fe.quality.action;
+      EXPECT_EQ(fe.quality.action.find("behind the mirror"), std::string::npos)
+          << name << " " << e << ": " << fe.quality.action;
     }
   }
 }
