@@ -169,8 +169,8 @@ TEST_F(HuntCli, DepthLimitPixelsAreComparedByColourOnly) {
       << r.out;
   // At the scene's own depth (4) no path ends there: the figures are as before.
   const std::string out4 = (dir_ / "compare4").string();
-  const CliResult r4 = runPvrr("compare models/reading-lens.json --modes pvrr --gl osmesa --size 48x36 --frames 1 --out '" +
-                               out4 + "'");
+  const CliResult r4 =
+      runPvrr("compare models/reading-lens.json --modes pvrr --gl osmesa --size 48x36 --frames 1 --out '" + out4 + "'");
   ASSERT_EQ(r4.code, 0) << r4.err;
   const nlohmann::json m4 = nlohmann::json::parse(pvrr::test::slurp(out4 + "/metrics.json"));
   EXPECT_EQ(m4["reference"]["depth_limit_pixels"].get<long>(), 0);
