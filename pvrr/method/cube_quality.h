@@ -20,7 +20,8 @@
 //    lookup draws the scene through it (measured: 6902 of 6912 such pixels lit, the spectacle lens at 96 x 72).
 //  - Impostor mode, surfaces the layers cannot hold: a seen vertex's ray meets a surface that lies, as seen from
 //    the cube's centre, behind as many drawn surfaces as the distance maps have layers (render.impostor_layers);
-//    the search finds no surface behind every layer and shows the sky there. Counted with the exact rays.
+//    the search finds no surface behind every layer and shows the sky there. Counted with the exact rays, against
+//    the scene's layer count (a renderer short of texture units holds fewer: then it undercounts).
 //  - Impostor mode: fragments whose search ended off every layer of the distance maps (the second pass counts
 //    them, noteUnresolvedSearches).
 #pragma once
