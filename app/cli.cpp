@@ -102,7 +102,8 @@ const std::map<std::string, Command>& commands() {
         "  Writes DIR/reference.png, DIR/MODE.png, DIR/MODE-error.png and DIR/metrics.json: per mode the frame\n"
         "  time, stages and angular error (median, p95, max), split into the zooming region and the rest\n"
         "  (\"regions\"); with rgb dispersion also per colour channel (\"channels\") and the fringes' sign\n"
-        "  (\"fringe\"). metrics.json's \"definitions\" says how each figure is measured.\n"
+        "  (\"fringe\"). Pixels whose reference path ended at render.max_depth have no seen point: they are\n"
+        "  compared by colour only (\"depth_limit\"). metrics.json's \"definitions\" says how each figure is measured.\n"
         "  --time T: the scene's animation posed at T seconds. --fps F: over time, --frames N instants T + i / F;\n"
         "  metrics.json's \"over_time\" holds each frame's error per mode and each mode's worst frame (largest\n"
         "  p95), DIR/frames.csv the rows frame,time_s,mode,pixels,median_arcmin,p95_arcmin,max_arcmin,psnr_db."}},

@@ -155,6 +155,11 @@ const char* kDefinitions[][2] = {
                  "ray-traced frame"},
     {"angular_error", "per pixel where the reference sees a mirror or lens: the angle, at the reference's surface point, "
                       "between the directions to the mode's seen point and to the reference's"},
+    {"depth_limit", "element pixels where the reference's path ended at the depth limit (render.max_depth): it has no "
+                    "seen point there (the reference draws them black), so they are left out of angular_error and "
+                    "compared by colour only: drawn_lit counts those the mode draws lit (an sRGB channel above 0.15), "
+                    "psnr_db is the mode's colour PSNR over them; drawn_dark_where_reference_lit counts the other "
+                    "element pixels the reference draws lit and the mode draws dark (every sRGB channel below 0.05)"},
     {"zooming_region", "pixels whose reference seen point lies behind the fitted virtual viewpoint of the pvrr patch under "
                        "the pixel (the patch of the nearest element vertex), along the patch's forward direction (the "
                        "normalised mean of its outgoing rays, the axis of its forward view volume): (seen - viewpoint) . "
@@ -290,6 +295,11 @@ int cmdCompare(const std::vector<std::string>& argv) {
   writeLinearPng(*out_dir + "/reference.png", w, h, ref.color);
   const std::vector<Vec3> ref_ss = supersampledReference(ls, gl_name);
   metrics["reference"]["psnr_supersampled_db"] = elementPsnr(ref, ref_ss, ref.color);
+  {
+    size_t limited = 0;
+    for (size_t i = 0; i < ref.element.size(); ++i) limited += ref.element[i] >= 0 && depthLimited(ref, i);
+    metrics["reference"]["depth_limit_pixels"] = limited;
+  }
   progress.update(5);
 
   // The zooming region (issue 5), from the CPU vertex stages of every element: the same patches, viewpoints
@@ -332,9 +342,13 @@ int cmdCompare(const std::vector<std::string>& argv) {
     json per_element = json::array();
     for (size_t e = 0; e < ls.scene.elements.size(); ++e) {
       const ErrorStats es = compareToReference(ref, f, nullptr, int(e));
+      const DepthLimitColour ed = depthLimitColour(ref, f, int(e));
       per_element.push_back({{"name", ls.scene.elements[e].name}, {"pixels", es.pixels},
-                             {"angular_error_arcmin", {{"median", es.median_arcmin}, {"p95", es.p95_arcmin}, {"max", es.max_arcmin}}}});
+                             {"angular_error_arcmin", {{"median", es.median_arcmin}, {"p95", es.p95_arcmin}, {"max", es.max_arcmin}}},
+                             {"depth_limit", {{"pixels", ed.pixels}, {"drawn_lit", ed.drawn_lit}}},
+                             {"drawn_dark_where_reference_lit", ed.drawn_dark}});
     }
+    const DepthLimitColour dl = depthLimitColour(ref, f);
     const ErrorStats zs = summarizeErrors(err, &zooming, 1), os = summarizeErrors(err, &zooming, 0),
                      ns = summarizeErrors(err, &zooming, 2);
     jm[m] = {{"frame_ms", frame_ms},
@@ -343,6 +357,9 @@ int cmdCompare(const std::vector<std::string>& argv) {
              {"pixels", st.pixels},
              {"angular_error_arcmin", {{"median", st.median_arcmin}, {"p95", st.p95_arcmin}, {"max", st.max_arcmin}}},
              {"regions", {{"zooming", statsJson(zs)}, {"outside_zooming", statsJson(os)}, {"not_classified", statsJson(ns)}}},
+             {"depth_limit", {{"pixels", dl.pixels}, {"drawn_lit", dl.drawn_lit}, {"psnr_db", dl.psnr_db}}},
+             {"drawn_dark_where_reference_lit", dl.drawn_dark},
+             {"reference_lit_pixels", dl.reference_lit},
              {"heat_map_scale_arcmin", scale},
              {"psnr_db", st.psnr_db},
              {"psnr_supersampled_db", elementPsnr(ref, ref_ss, f.color)},
@@ -352,6 +369,13 @@ int cmdCompare(const std::vector<std::string>& argv) {
     std::printf("%-8s %8.2f ms  median %.4f' p95 %.4f' max %.3f'  PSNR %.2f dB (%.2f dB against 2x2)  (%zu px)\n",
                 m.c_str(), frame_ms, st.median_arcmin, st.p95_arcmin, st.max_arcmin, st.psnr_db,
                 jm[m]["psnr_supersampled_db"].get<double>(), st.pixels);
+    if (dl.pixels > 0)
+      std::printf("%-8s %zu pixels where the reference's path ended at the depth limit (render.max_depth %d): compared "
+                  "by colour only: %zu drawn lit where the reference draws them black, PSNR %.2f dB\n",
+                  m.c_str(), dl.pixels, ls.scene.render.max_depth, dl.drawn_lit, dl.psnr_db);
+    if (dl.drawn_dark > 0)
+      std::printf("%-8s %zu of %zu element pixels the reference draws lit are drawn dark\n", m.c_str(), dl.drawn_dark,
+                  dl.reference_lit);
     printQuality(f.elements, m + std::string(m.size() < 8 ? 8 - m.size() : 0, ' ') + " ");
     if (zs.pixels > 0)
       std::printf("%-8s zooming region: median %.4f' p95 %.4f' (%zu px); outside: median %.4f' (%zu px)\n", m.c_str(),

@@ -23,7 +23,7 @@ std::vector<double> angularErrors(const Frame& ref, const std::vector<Vec3>& ref
   std::vector<double> e(n, std::nan(""));
   if (ref_seen.size() != n || seen.size() != n || ref.element_point.size() != n) return e;
   for (size_t i = 0; i < n; ++i) {
-    if (ref.element[i] < 0 || (only_element >= 0 && ref.element[i] != only_element)) continue;
+    if (ref.element[i] < 0 || (only_element >= 0 && ref.element[i] != only_element) || depthLimited(ref, i)) continue;
     const double a = arcminutes(seenAngle(ref.element_point[i], ref_seen[i], seen[i]));
     if (std::isfinite(a)) e[i] = a;
   }
@@ -56,6 +56,39 @@ ErrorStats compareToReference(const Frame& ref, const Frame& frame, std::vector<
   s.rmse = colourRmse(se, s.pixels);
   s.psnr_db = psnrDb(s.rmse);
   return s;
+}
+
+namespace {
+
+double maxSrgb(const Vec3& c) {
+  double m = 0;
+  for (int k = 0; k < 3; ++k) m = std::max(m, linearToSrgb(std::clamp(c[k], 0.0, 1.0)));
+  return m;
+}
+
+}  // namespace
+
+bool drawnDark(const Vec3& linear) { return maxSrgb(linear) < kDarkSrgb; }
+bool drawnLit(const Vec3& linear) { return maxSrgb(linear) > kLitSrgb; }
+
+DepthLimitColour depthLimitColour(const Frame& ref, const Frame& frame, int only_element) {
+  DepthLimitColour d;
+  const size_t n = ref.element.size();
+  if (ref.color.size() != n || frame.color.size() != n) return d;
+  double se = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (ref.element[i] < 0 || (only_element >= 0 && ref.element[i] != only_element)) continue;
+    if (depthLimited(ref, i)) {
+      ++d.pixels;
+      d.drawn_lit += drawnLit(frame.color[i]);
+      se += srgbSquaredError(ref.color[i], frame.color[i]);
+    } else if (drawnLit(ref.color[i])) {
+      ++d.reference_lit;
+      d.drawn_dark += drawnDark(frame.color[i]);
+    }
+  }
+  if (d.pixels > 0) d.psnr_db = psnrDb(colourRmse(se, d.pixels));
+  return d;
 }
 
 double srgbSquaredError(const Vec3& a, const Vec3& b) {

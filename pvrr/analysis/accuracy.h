@@ -7,6 +7,10 @@
 // reflected or refracted ray's direction where the eye's ray meets the element, not an angle at the eye.
 // Summaries over the finite errors: median, p95 (quantile), max.
 //
+// Pixels where the reference's path ended at the depth limit (Frame::depth_limited: render.max_depth reached on an
+// element, drawn black) have no seen point, so they have no angular error: they are left out of it and compared
+// by colour only (depthLimitColour), counted apart.
+//
 // Known-hard regions are reported separately, never left out: the zooming region of a pvrr patch
 // (zoomingRegion) and, with rgb dispersion, the colour fringes (fringeStats).
 //
@@ -43,8 +47,9 @@ struct ErrorStats {
 };
 
 // The per-pixel angular error (arcmin) of `seen` against `ref_seen`, both measured at ref.element_point, over
-// the pixels where ref.element >= 0 (and equals `only_element` when that is >= 0). NaN at the other pixels and
-// where the angle is not finite; all NaN when a buffer's size is not ref.element's. `ref_seen` is ref.seen,
+// the pixels where ref.element >= 0 (and equals `only_element` when that is >= 0) and the reference's path did
+// not end at the depth limit (ref.depth_limited, when filled). NaN at the other pixels and where the angle is
+// not finite; all NaN when a buffer's size is not ref.element's. `ref_seen` is ref.seen,
 // or one channel's ref.channel_seen.
 std::vector<double> angularErrors(const Frame& ref, const std::vector<Vec3>& ref_seen, const std::vector<Vec3>& seen,
                                   int only_element = -1);
@@ -58,6 +63,30 @@ ErrorStats summarizeErrors(const std::vector<double>& errors_arcmin, const std::
 // `errors_arcmin` (optional) receives the per-pixel errors.
 ErrorStats compareToReference(const Frame& ref, const Frame& frame, std::vector<double>* errors_arcmin = nullptr,
                               int only_element = -1);
+
+// Whether the reference's path at pixel i ended at the depth limit (false where ref.depth_limited is empty).
+inline bool depthLimited(const Frame& ref, size_t i) {
+  return ref.depth_limited.size() == ref.element.size() && i < ref.depth_limited.size() && ref.depth_limited[i] != 0;
+}
+
+// A colour is drawn dark when every channel's sRGB value (clamped to [0, 1]) is below kDarkSrgb, lit when one is
+// above kLitSrgb. The gap between them keeps dim but seen colours (a dark wall, a tinted lens's edge) out of both
+// counts: 0.05 is 13 of 255, darker than any lit surface of the shipped scenes' rooms; 0.15 is 38 of 255.
+inline constexpr double kDarkSrgb = 0.05, kLitSrgb = 0.15;
+bool drawnDark(const Vec3& linear);
+bool drawnLit(const Vec3& linear);
+
+// The colour check of the pixels the angular error leaves out, and its converse. Over the element pixels (ref.element
+// >= 0, equal to `only_element` when that is >= 0):
+struct DepthLimitColour {
+  size_t pixels = 0;         // where the reference's path ended at the depth limit (the reference draws them black)
+  size_t drawn_lit = 0;      // of those, the frame draws lit: it shows something where the reference shows nothing
+  double psnr_db = 0;        // the frame's colour PSNR over `pixels` (0 for none, 99 when all match)
+  size_t reference_lit = 0;  // the other element pixels that the reference draws lit
+  size_t drawn_dark = 0;  // of those, the frame draws dark: its path ended (or was cut) where the reference's did not
+  size_t disagreements() const { return drawn_lit + drawn_dark; }
+};
+DepthLimitColour depthLimitColour(const Frame& ref, const Frame& frame, int only_element = -1);
 
 // The error heat maps' colour of x in [0, 1] (clamped): a perceptually ordered black-body-like ramp, black -> red
 // -> yellow -> white, linear in each third. What `pvrr compare` writes (MODE-error.png) and `pvrr view` overlays.

@@ -8,6 +8,7 @@
 #pragma once
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "pvrr/base/math.h"
@@ -31,6 +32,10 @@ struct Frame {
   std::vector<Vec3> element_point;
   // The reference only: specular events (reflections, refractions, TIRs) of each pixel's path; empty otherwise.
   std::vector<int> bounces;
+  // The reference only: 1 where the pixel's path ended at the depth limit (render.max_depth) on an element, 0
+  // elsewhere; empty otherwise. Such a path has no seen point: `seen` is the element point where it stopped and
+  // the colour black, so the accuracy figures compare those pixels by colour only (pvrr/analysis/accuracy.h).
+  std::vector<uint8_t> depth_limited;
   // The reference with rgb dispersion only (empty otherwise): the seen point of each channel's own ray per
   // pixel (R = C line, G = d line, B = F line; pvrr/optics/spectrum.h). Equal to `seen` for all three where the path
   // crosses no lens.

@@ -65,6 +65,32 @@ Vec3 cubeShows(const RayScene& rays, int e, const std::vector<char>& in_cube, co
   return c + far_m * d;
 }
 
+// Impostor mode: how many layers of element e's cube (centre c) lie in front of point p as seen from c: the drawn
+// surfaces (the environment, the elements of in_cube other than e) the segment c -> p crosses before p. A closed
+// convex mesh's back faces may be culled in the cube (RendererOptions::cull_back_faces), so only its faces turned
+// to c count; any other surface is drawn from both sides. Up to 16 crossings.
+int layersInFront(const RayScene& rays, int e, const std::vector<char>& in_cube, const Vec3& c, const Vec3& p) {
+  const Scene& scene = rays.scene();
+  const double len = glm::length(p - c);
+  if (!(len > 0)) return 0;
+  const Vec3 d = (p - c) / len;
+  double t0 = 0;
+  int n = 0;
+  for (int k = 0; k < 16; ++k) {
+    const RayHit h = rays.intersect(c, d, t0);
+    if (!h.hit() || h.t >= len - 2 * rays.epsilon()) break;
+    const bool drawn = h.kind != HitKind::Element ||
+                       (h.element != e && size_t(h.element) < in_cube.size() && in_cube[size_t(h.element)]);
+    if (drawn) {
+      const bool culled_side = h.kind == HitKind::Environment && size_t(h.mesh) < scene.meshes.size() &&
+                               scene.meshes[size_t(h.mesh)].closed_convex && glm::dot(h.normal, d) > 0;
+      n += !culled_side;
+    }
+    t0 = h.t + rays.epsilon();
+  }
+  return n;
+}
+
 void flag(ElementFrame& f, const std::string& reasons) {
   f.quality.verdict = std::max(f.quality.verdict, QualityVerdict::kDegraded);
   std::string a = f.quality.action == "none" ? "" : f.quality.action;
@@ -119,6 +145,7 @@ CubeQuality assessCubeQuality(const RayScene& rays, ElementFrame& f, RenderMode 
   }
   const Vec3 centre = Vec3(el.local_to_world[3]);
   const std::vector<VertexRay>& vr = f.rays[f.rays.size() / 2];
+  const int layers = std::max(1, scene.render.impostor_layers);
   const bool lens = el.type == ElementType::Lens;
   std::vector<double> parallax;
   // The vertices the observer sees (in its clip volume, with a margin for the triangles it sees in part).
@@ -138,6 +165,10 @@ CubeQuality assessCubeQuality(const RayScene& rays, ElementFrame& f, RenderMode 
     const VertexRay& r = vr[i];
     if (r.status == VertexStatus::Tir) continue;
     if (r.status == VertexStatus::Hit) q.max_hit_distance_m = std::max(q.max_hit_distance_m, glm::length(r.hit - centre));
+    if (mode == RenderMode::Impostor && r.status == VertexStatus::Hit) {
+      ++q.hit_vertices;
+      q.behind_layers_vertices += layersInFront(rays, f.element, in_cube, centre, r.hit) >= layers;
+    }
     if (mode != RenderMode::Envmap) continue;
     const Vec3 shown = cubeShows(rays, f.element, in_cube, centre, r.dir, far_m);
     parallax.push_back(arcminutes(angleBetween(r.hit - r.origin, shown - r.origin)));
@@ -178,6 +209,18 @@ CubeQuality assessCubeQuality(const RayScene& rays, ElementFrame& f, RenderMode 
     addReason(reasons, "the eye is behind the lens's front surface at " + std::to_string(q.lens_back_vertices) +
                            " vertices: envmap mode's rays enter a lens through its front surface, so the lens is "
                            "drawn wrong there; impostor or pvrr mode draws it");
+  if (mode == RenderMode::Envmap && lens && scene.render.max_depth < 2)
+    addReason(reasons, "render.max_depth " + std::to_string(scene.render.max_depth) +
+                           ": the reference ends every path through the lens at its back surface and draws it black, "
+                           "envmap mode draws the scene through it; pvrr and impostor modes keep the depth limit");
+  if (mode == RenderMode::Impostor && q.hit_vertices > 0 &&
+      double(q.behind_layers_vertices) / double(q.hit_vertices) > limits.max_behind_layers_share)
+    addReason(reasons, std::to_string(q.behind_layers_vertices) + " of " + std::to_string(q.hit_vertices) +
+                           " seen vertex rays meet a surface that lies behind " + std::to_string(layers) +
+                           " or more surfaces as seen from the cube's centre (limit " +
+                           fixed(100 * limits.max_behind_layers_share, 0) + " %): the " + std::to_string(layers) +
+                           " layer(s) of the distance maps (render.impostor_layers) do not hold it, and impostor "
+                           "mode shows the sky there; pvrr mode or the reference traces those rays");
   f.eye = eye;
   if (mode == RenderMode::Envmap && lens) {
     // As pvrr mode's vertices (eye_side.h lensEdgeExits): envmap mode looks the cube up in the exit direction

@@ -16,6 +16,12 @@
 //    the surface's normals reflects far from the exact direction inside it (pvrr mode's same limit).
 //  - Envmap mode, a lens seen from behind: its vertex rays enter the lens through its front surface (as pvrr
 //    mode's did), so the picture is wrong there; flagged.
+//  - Envmap mode, a lens at render.max_depth 1: the reference's paths end at its back surface (black); the cube
+//    lookup draws the scene through it (measured: 6902 of 6912 such pixels lit, the spectacle lens at 96 x 72).
+//  - Impostor mode, surfaces the layers cannot hold: a seen vertex's ray meets a surface that lies, as seen from
+//    the cube's centre, behind as many drawn surfaces as the distance maps have layers (render.impostor_layers);
+//    the search finds no surface behind every layer and shows the sky there. Counted with the exact rays, against
+//    the scene's layer count (a renderer short of texture units holds fewer: then it undercounts).
 //  - Impostor mode: fragments whose search ended off every layer of the distance maps (the second pass counts
 //    them, noteUnresolvedSearches).
 #pragma once
@@ -58,6 +64,10 @@ struct CubeQualityLimits {
   double max_depth_relative = 1e-3;
   // Impostor mode: a share of the element's pixels whose search ended off the distance maps above this.
   double max_unresolved_share = 0.01;
+  // Impostor mode: a share of the seen vertex rays that hit something above this, hitting it behind as many
+  // surfaces as the maps have layers (from the cube's centre), is flagged. 5 %: one vertex in 20, a band of the
+  // picture, where one vertex alone is an edge the pixels around it mostly resolve.
+  double max_behind_layers_share = 0.05;
 };
 
 struct CubeQuality {
@@ -67,6 +77,8 @@ struct CubeQuality {
   double max_hit_distance_m = 0;   // the farthest finite hit from the cube's centre
   double depth_relative = 0;       // relativeDepthResolution at that distance
   int lens_back_vertices = 0;      // a lens's seen vertices whose front faces away from the eye
+  int hit_vertices = 0;            // impostor mode: seen vertices whose ray hits a surface
+  int behind_layers_vertices = 0;  // of those, hitting it behind render.impostor_layers surfaces from the centre
 };
 
 // Assesses element f's cube (centre: the element's anchor) for `mode` (envmap or impostor) with near and far

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <vector>
 
 #include "cad/sag.h"
@@ -106,15 +107,82 @@ void applyLensEdgeExits(const Element& el, ElementFrame& f) {
                      "edge dark; impostor mode traces the edge";
 }
 
-// Whether world point h lies on element e's front surface within its outline (sag surfaces only; a CAD or
-// subdivision surface is not checked).
-bool onElement(const Element& e, const Vec3& h) {
-  const auto* sag = dynamic_cast<const cad::SagSurface*>(&e.frontSurface());
-  if (!sag || !e.has_outline) return false;
+// Whether world point h lies on element e's front surface within its outline. A sag surface is solved
+// directly; any other (a CAD face, a subdivision surface) through a SurfaceProbe.
+bool onSagElement(const Element& e, const cad::SagSurface& sag, const Vec3& h) {
+  if (!e.has_outline) return false;
   const Vec3 q = e.toLocalPoint(h);
   const double size = std::max(e.outline.width(), e.outline.height());
-  if (!e.outline.contains(Vec2(q.x, q.y), 1e-6 * size) || !sag->defined(q.x, q.y)) return false;
-  return std::abs(q.z - (sag->zVertex() - sag->sag(q.x, q.y).z)) < 1e-6 * size + 1e-9;
+  if (!e.outline.contains(Vec2(q.x, q.y), 1e-6 * size) || !sag.defined(q.x, q.y)) return false;
+  return std::abs(q.z - (sag.zVertex() - sag.sag(q.x, q.y).z)) < 1e-6 * size + 1e-9;
+}
+
+// A front surface that is not a sag surface, sampled on a kProbeGrid x kProbeGrid grid over its parameter domain
+// (local points): a point is on it when it lies in the samples' bounding box (padded by a tenth of its size, for
+// the bulge between samples), and the closest surface point, found by Gauss-Newton from the nearest sample, is
+// within `tol` of it and inside the outline (in the parameter plane, as Element::outline is for such surfaces).
+constexpr int kProbeGrid = 16;
+struct SurfaceProbe {
+  const Element* el = nullptr;
+  const cad::Surface* surface = nullptr;  // null: a sag surface (onSagElement)
+  std::vector<Vec3> points;
+  std::vector<Vec2> params;
+  Vec3 lo{0}, hi{0};
+  double tol = 0;
+};
+
+SurfaceProbe makeProbe(const Element& e) {
+  SurfaceProbe p;
+  p.el = &e;
+  const cad::Surface& s = e.frontSurface();
+  if (dynamic_cast<const cad::SagSurface*>(&s)) return p;
+  p.surface = &s;
+  const cad::ParamDomain d = s.domain();
+  p.lo = Vec3(std::numeric_limits<double>::infinity());
+  p.hi = -p.lo;
+  for (int i = 0; i < kProbeGrid; ++i)
+    for (int j = 0; j < kProbeGrid; ++j) {
+      const Vec2 uv(d.u0 + (d.u1 - d.u0) * i / (kProbeGrid - 1), d.v0 + (d.v1 - d.v0) * j / (kProbeGrid - 1));
+      const Vec3 q = s.evaluate(uv.x, uv.y).p;
+      if (!std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z)) continue;
+      p.points.push_back(q);
+      p.params.push_back(uv);
+      p.lo = glm::min(p.lo, q);
+      p.hi = glm::max(p.hi, q);
+    }
+  const double size = p.points.empty() ? 0.0 : glm::length(p.hi - p.lo);
+  p.lo -= Vec3(0.1 * size);
+  p.hi += Vec3(0.1 * size);
+  p.tol = 1e-6 * size + 1e-9;  // as the sag test's: the tracer's hits are exact to far less
+  return p;
+}
+
+bool onElement(const SurfaceProbe& p, const Vec3& h) {
+  const Element& e = *p.el;
+  if (!p.surface) return onSagElement(e, static_cast<const cad::SagSurface&>(e.frontSurface()), h);
+  if (p.points.empty()) return false;
+  const Vec3 q = e.toLocalPoint(h);
+  if (q.x < p.lo.x || q.y < p.lo.y || q.z < p.lo.z || q.x > p.hi.x || q.y > p.hi.y || q.z > p.hi.z) return false;
+  size_t best = 0;
+  for (size_t k = 1; k < p.points.size(); ++k)
+    if (glm::length(p.points[k] - q) < glm::length(p.points[best] - q)) best = k;
+  const cad::ParamDomain d = p.surface->domain();
+  Vec2 uv = p.params[best];
+  for (int it = 0; it < 30; ++it) {
+    const cad::SurfaceDerivs sd = p.surface->evaluate(uv.x, uv.y);
+    const Vec3 r = q - sd.p;
+    const double a = glm::dot(sd.du, sd.du), b = glm::dot(sd.du, sd.dv), c = glm::dot(sd.dv, sd.dv);
+    const double det = a * c - b * b;
+    if (!(std::abs(det) > 0)) break;
+    const double ru = glm::dot(r, sd.du), rv = glm::dot(r, sd.dv);
+    const Vec2 step((c * ru - b * rv) / det, (a * rv - b * ru) / det);
+    const Vec2 next(std::clamp(uv.x + step.x, d.u0, d.u1), std::clamp(uv.y + step.y, d.v0, d.v1));
+    const bool done = glm::length(next - uv) <= 1e-12 * (std::abs(d.u1 - d.u0) + std::abs(d.v1 - d.v0));
+    uv = next;
+    if (done) break;
+  }
+  if (!(glm::length(q - p.surface->evaluate(uv.x, uv.y).p) < p.tol)) return false;
+  return !e.has_outline || e.outline.contains(uv, 1e-6 * std::max(e.outline.width(), e.outline.height()));
 }
 
 // A patch's map shows another mirror or lens as seen from the patch's viewpoint; a vertex ray that misses the
@@ -126,6 +194,10 @@ bool onElement(const Element& e, const Vec3& h) {
 void applyNestedParallax(const Scene& scene, ElementFrame& f) {
   if (f.rays.empty()) return;
   const std::vector<VertexRay>& rays = f.rays[f.rays.size() / 2];
+  std::vector<SurfaceProbe> others;
+  for (size_t e = 0; e < scene.elements.size(); ++e)
+    if (int(e) != f.element) others.push_back(makeProbe(scene.elements[e]));
+  if (others.empty()) return;
   int marked = 0;
   for (PatchView& pv : f.views) {
     if (!pv.in_view || pv.volume.backward) continue;
@@ -135,8 +207,7 @@ void applyNestedParallax(const Scene& scene, ElementFrame& f) {
       const VertexRay& r = rays[vi];
       if (r.status != VertexStatus::Hit) continue;
       bool nested = false;
-      for (size_t e = 0; e < scene.elements.size() && !nested; ++e)
-        nested = int(e) != f.element && onElement(scene.elements[e], r.hit);
+      for (size_t k = 0; k < others.size() && !nested; ++k) nested = onElement(others[k], r.hit);
       if (!nested) continue;
       const Vec3 from_viewpoint = r.hit - pv.fit.eye;
       if (!(glm::length(from_viewpoint) > 0)) continue;
@@ -162,6 +233,73 @@ void applyNestedParallax(const Scene& scene, ElementFrame& f) {
                      "' (median) off the directions its rays arrive from (the rays do not meet in one point)";
 }
 
+// Whether segment o + t d, t in (t0, t1), crosses triangle abc (Moller-Trumbore).
+bool segmentCrosses(const Vec3& o, const Vec3& d, double t0, double t1, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 e1 = b - a, e2 = c - a, pv = glm::cross(d, e2);
+  const double det = glm::dot(e1, pv);
+  if (std::abs(det) < 1e-300) return false;
+  const double inv = 1.0 / det;
+  const Vec3 tv = o - a;
+  const double u = glm::dot(tv, pv) * inv;
+  if (u < 0 || u > 1) return false;
+  const Vec3 qv = glm::cross(tv, e1);
+  const double v = glm::dot(d, qv) * inv;
+  if (v < 0 || u + v > 1) return false;
+  const double t = glm::dot(e2, qv) * inv;
+  return t > t0 && t < t1;
+}
+
+// A mirror patch whose near plane could not be placed at the mirror (ViewVolume::mirror_vertices_unclipped: a hit
+// nearer the viewpoint than the farthest mirror vertex) holds, between its near plane and the mirror, what lies
+// behind the mirror: the map shows it in place of the reflection wherever it is there. Found in the hunt
+// (docs/robustness.md, "compare and the quality checks"): two cards 2 and 6 cm before a plane mirror moved its
+// near plane 47 mm towards the viewpoint, and the wall 1 cm behind the mirror covered a triangle of the picture
+// (p95 10800', good). Counted at the seen vertices: the segment from the near plane to the vertex along the
+// viewpoint's line crosses an environment triangle.
+void applyBehindMirror(const Scene& scene, ElementFrame& f) {
+  if (scene.elements[size_t(f.element)].type != ElementType::Mirror) return;
+  int marked = 0, total = 0;
+  for (PatchView& pv : f.views) {
+    const ViewVolume& vv = pv.volume;
+    if (!pv.in_view || vv.backward || vv.mirror_vertices_unclipped == 0) continue;
+    int hidden = 0;
+    for (uint32_t vi : f.grid_patches[size_t(pv.patch)].vertices) {
+      if ((!f.in_view.empty() && f.in_view[vi] != 2) || vi >= f.world_pos.size()) continue;
+      const Vec3 to = f.world_pos[vi] - vv.eye;
+      const double len = glm::length(to);
+      const double along = glm::dot(to, vv.forward);
+      if (!(len > 0) || !(along > vv.near_m)) continue;
+      const Vec3 d = to / len;
+      const double t_near = len * vv.near_m / along, t_end = len * (1 - 1e-9);
+      bool crossed = false;
+      for (const EnvMesh& m : scene.meshes) {
+        for (const glm::u32vec3& t : m.triangles)
+          if (segmentCrosses(vv.eye, d, t_near, t_end, m.anchor + Vec3(m.positions[t.x]),
+                             m.anchor + Vec3(m.positions[t.y]), m.anchor + Vec3(m.positions[t.z]))) {
+            crossed = true;
+            break;
+          }
+        if (crossed) break;
+      }
+      hidden += crossed;
+    }
+    if (hidden == 0) continue;
+    pv.quality.verdict = std::max(pv.quality.verdict, QualityVerdict::kDegraded);
+    pv.quality.reasons += std::string(pv.quality.reasons.empty() ? "" : "; ") + std::to_string(hidden) +
+                          " seen vertices where what lies behind the mirror is inside its map (the near plane "
+                          "could not be placed at the mirror)";
+    if (pv.quality.action == "none") pv.quality.action = "flagged";
+    ++marked;
+    total += hidden;
+  }
+  if (!marked) return;
+  f.quality.verdict = std::max(f.quality.verdict, QualityVerdict::kDegraded);
+  f.quality.action = (f.quality.action == "none" ? "" : f.quality.action + "; ") + std::to_string(marked) +
+                     " patch(es) flagged: at " + std::to_string(total) +
+                     " seen vertices the map shows what lies behind the mirror in place of its reflection (a hit "
+                     "nearer the viewpoint than the mirror moved the near plane off the mirror)";
+}
+
 }  // namespace
 
 void applyEyeSide(const Scene& scene, ElementFrame& f) {
@@ -170,6 +308,7 @@ void applyEyeSide(const Scene& scene, ElementFrame& f) {
   const Element& el = scene.elements[size_t(f.element)];
   applyLensEdgeExits(el, f);
   applyNestedParallax(scene, f);
+  applyBehindMirror(scene, f);
   if (el.type != ElementType::Lens || f.quality.note.empty()) return;
   f.quality.note +=
       ": pvrr mode's vertex rays enter a lens through its front surface, so the patches seen from "

@@ -50,9 +50,11 @@ LensEdgeExits lensEdgeExits(const Element& el, const ElementFrame& f, const cad:
 
 // A seen patch whose vertex rays land on another element (its map shows that element as seen from the patch's
 // viewpoint) is flagged when the angle at the hit between the ray and the direction from the viewpoint is over
-// this (median over the patch's such vertices). Measured on the mirror pair at 96 x 72: 3.4' with its convex
-// mirror (pixels 0.84' median), 14' and 27' with the mirror turned concave (R -1 m; pixels 39' median, p95
-// 2489', and 63'): the pixels' error ran 2.3 to 2.7 times this measure, so 10' flags what nears the 60' line.
+// this (median over the patch's such vertices). The other element is recognised on any front surface: a sag
+// surface solved directly, a CAD or subdivision surface by its closest point (eye_side.cpp, SurfaceProbe). Measured on
+// the mirror pair at 96 x 72: 3.4' with its convex mirror (pixels 0.84' median), 14' and 27' with the mirror turned
+// concave (R -1 m; pixels 39' median, p95 2489', and 63'): the pixels' error ran 2.3 to 2.7 times this measure, so 10'
+// flags what nears the 60' line.
 inline constexpr double kNestedParallaxLimitArcmin = 10.0;
 
 // Whether f's vertex i is a lens vertex whose front surface faces away from f.eye.

@@ -109,6 +109,7 @@ TraceResult Tracer::traceImpl(const Vec3& o_in, const Vec3& d_in, double wavelen
       if (path) path->push_back(seg);
       r.color = Vec3(0);
       r.seen = hit.point;
+      r.depth_limited = true;
       return r;
     }
     const double n_glass = el.type == ElementType::Lens ? lensIndex(el, wavelength_nm) : 1.0;
@@ -205,6 +206,7 @@ Frame Tracer::render(const std::function<void(double)>& progress) const {
   f.element.resize(n);
   f.element_point.resize(n);
   f.bounces.resize(n);
+  f.depth_limited.resize(n);
   const bool rgb = options_.dispersion == DispersionMode::Rgb;
   if (rgb)
     for (auto& c : f.channel_seen) c.resize(n);
@@ -249,6 +251,7 @@ Frame Tracer::render(const std::function<void(double)>& progress) const {
           f.element[i] = r.first_element;
           f.element_point[i] = r.element_point;
           f.bounces[i] = r.bounces;
+          f.depth_limited[i] = r.depth_limited ? 1 : 0;
           if (rgb)
             for (size_t c = 0; c < 3; ++c) f.channel_seen[c][i] = cs[c];
         }

@@ -56,6 +56,7 @@ struct TraceResult {
   int first_element = -1;  // the first optical element the path met
   Vec3 element_point{0};   // where it met it
   int bounces = 0;         // specular events (reflections, refractions, TIRs)
+  bool depth_limited = false;  // the path ended at the depth limit on an element (no seen point; black)
   bool hit_lens = false;   // the path crossed a lens (the wavelength changes the path)
   bool hit_metal = false;  // the path reflected off a mirror with a metal table (the wavelength changes
                            // its spectral-mode colour, not its path)

@@ -14,8 +14,9 @@
 namespace pvrr::test {
 
 // The median angular error (arcmin; pvrr/analysis/accuracy.h: for an even count the mean of the two middle errors) over
-// the pixels where the reference sees an element. Every such pixel must have a finite error (a test failure
-// names each that does not). 1e9 when no pixel has one or the frame has no seen points (a failure); `pixels` (optional) gets the count of finite errors.
+// the pixels where the reference sees an element (and its path did not end at the depth limit). Every such pixel must
+// have a finite error (a test failure names each that does not). 1e9 when no pixel has one or the frame has no seen
+// points (a failure); `pixels` (optional) gets the count of finite errors.
 inline double medianArcmin(const Frame& ref, const Frame& f, size_t* pixels = nullptr) {
   if (f.seen.size() != ref.seen.size()) {
     ADD_FAILURE() << "the frame has " << f.seen.size() << " seen points, the reference " << ref.seen.size();
@@ -23,7 +24,7 @@ inline double medianArcmin(const Frame& ref, const Frame& f, size_t* pixels = nu
   }
   const std::vector<double> e = angularErrors(ref, ref.seen, f.seen);
   for (size_t i = 0; i < e.size(); ++i) {
-    if (ref.element[i] < 0) continue;
+    if (ref.element[i] < 0 || depthLimited(ref, i)) continue;  // no seen point: no angular error
     EXPECT_TRUE(std::isfinite(e[i])) << "pixel " << i;
   }
   const ErrorStats s = summarizeErrors(e);

@@ -142,6 +142,41 @@ TEST(CompareToReference, SummarisesTheAnglesAndTheColourOverElementPixels) {
   EXPECT_EQ(compareToReference(p.ref, p.frame, nullptr, 0).pixels, 2u);
 }
 
+// Pixels where the reference's path ended at the depth limit have no seen point: no angular error (the median
+// leaves them out), counted and compared by colour only, with the converse (drawn dark where the reference is lit).
+TEST(DepthLimit, PixelsWithoutASeenPointAreComparedByColourOnly) {
+  // Six element pixels with errors 1 .. 6 arcmin and one without an element; pixels 3, 4 and 5 (errors 4, 5, 6)
+  // ended at the depth limit: the reference draws them black.
+  Pair p = rotatedSeenPoints({0, 0, 0, 0, 0, 0, -1}, {1, 2, 3, 4, 5, 6, 7});
+  p.ref.depth_limited = {0, 0, 0, 1, 1, 1, 0};
+  for (size_t i = 3; i < 6; ++i) p.ref.color[i] = Vec3(0);
+  p.frame.color[3] = Vec3(0);      // black as well
+  p.frame.color[4] = Vec3(0.002);  // sRGB 0.026: dark, not lit
+  p.frame.color[5] = Vec3(0.5);    // lit where the reference shows nothing: a disagreement
+  p.frame.color[1] = Vec3(0);      // dark where the reference (0.5: sRGB 0.735) is lit: the converse
+  std::vector<double> errors;
+  const ErrorStats s = compareToReference(p.ref, p.frame, &errors);
+  EXPECT_EQ(s.pixels, 3u);
+  EXPECT_NEAR(s.median_arcmin, 2, kAngleTol_arcmin);  // 1 [2] 3; without the exclusion 3.5
+  EXPECT_NEAR(s.max_arcmin, 3, kAngleTol_arcmin);
+  for (size_t i = 3; i < 6; ++i) EXPECT_TRUE(std::isnan(errors[i])) << i;
+  const DepthLimitColour d = depthLimitColour(p.ref, p.frame);
+  EXPECT_EQ(d.pixels, 3u);
+  EXPECT_EQ(d.drawn_lit, 1u);
+  EXPECT_EQ(d.reference_lit, 3u);  // pixels 0, 1 and 2
+  EXPECT_EQ(d.drawn_dark, 1u);
+  EXPECT_EQ(d.disagreements(), 2u);
+  // PSNR over the three: squared sRGB differences 0, 3 x 0.02585^2 (linear 0.002 is 12.92 x 0.002 in sRGB) and
+  // 3 x 0.7354^2 (linear 0.5).
+  const double a = 12.92 * 0.002, b = linearToSrgb(0.5);
+  EXPECT_NEAR(d.psnr_db, psnrDb(std::sqrt((3 * a * a + 3 * b * b) / 9.0)), 1e-9);
+  // Per element, and without the flag (a raster frame, the viewer's tiles): every element pixel counts.
+  EXPECT_EQ(depthLimitColour(p.ref, p.frame, 1).pixels, 0u);
+  p.ref.depth_limited.clear();
+  EXPECT_EQ(compareToReference(p.ref, p.frame).pixels, 6u);
+  EXPECT_EQ(depthLimitColour(p.ref, p.frame).pixels, 0u);
+}
+
 TEST(ColourError, PsnrOfKnownRmse) {
   EXPECT_NEAR(psnrDb(0.1), 20, kExact);
   EXPECT_NEAR(psnrDb(1), 0, kExact);

@@ -142,6 +142,70 @@ TEST(CubeQuality, EnvmapFlagsALensSeenFromBehind) {
   EXPECT_NE(f.quality.note.find("the eye is behind lens 'reading-lens'"), std::string::npos) << f.quality.note;
 }
 
+// Impostor mode's search escapes to the sky where it finds no surface behind every layer of the maps: a surface
+// hidden behind two occluders from the cube's centre. The wall mirror with two cards stacked 2 and 6 cm in front
+// of its centre (tests/data/stress/hunt-impostor-behind-two-cards.json): from the centre most of the room its rays
+// reach lies behind both cards, with the default two layers; with four layers nothing is beyond them. The
+// shipped plane mirror sees nothing behind two surfaces.
+TEST(CubeQuality, ImpostorFlagsSurfacesBehindEveryLayer) {
+  {
+    const Scene s = stressScene("hunt-impostor-behind-two-cards");
+    const RayScene rays(s);
+    ElementFrame f;
+    const CubeQuality q = assess(s, rays, 0, RenderMode::Impostor, &f);
+    EXPECT_GT(q.hit_vertices, 20);
+    EXPECT_GT(double(q.behind_layers_vertices), 0.05 * q.hit_vertices);
+    std::printf("[ measured ] two cards, 2 layers: %d of %d seen vertex rays hit behind every layer\n",
+                q.behind_layers_vertices, q.hit_vertices);
+    EXPECT_EQ(f.quality.verdict, QualityVerdict::kDegraded);
+    EXPECT_NE(f.quality.action.find("surfaces as seen from the cube's centre"), std::string::npos) << f.quality.action;
+    // Envmap mode has no layers: not this flag (its parallax flag is its own).
+    ElementFrame fe;
+    assess(s, rays, 0, RenderMode::Envmap, &fe);
+    EXPECT_EQ(fe.quality.action.find("surfaces as seen from the cube's centre"), std::string::npos);
+  }
+  {
+    // The far card shrunk to 1 mm: one card in front, which the second layer holds.
+    const Scene s = stressScene("hunt-impostor-behind-two-cards", {"environment[11].size=[0.001, 0.001]"});
+    const RayScene rays(s);
+    ElementFrame f2;
+    const CubeQuality q2 = assess(s, rays, 0, RenderMode::Impostor, &f2);
+    EXPECT_LE(q2.behind_layers_vertices, 1);  // 1 of 49 measured: under the 5 % line
+    EXPECT_EQ(f2.quality.verdict, QualityVerdict::kGood) << f2.quality.action;
+    // With one layer the near card alone hides them.
+    const Scene s1 = stressScene("hunt-impostor-behind-two-cards",
+                                 {"environment[11].size=[0.001, 0.001]", "render.impostor_layers=1"});
+    const RayScene rays1(s1);
+    EXPECT_GT(assess(s1, rays1, 0, RenderMode::Impostor).behind_layers_vertices, 20);
+  }
+  const Scene s = test::shippedScene("plane-mirror");
+  const RayScene rays(s);
+  ElementFrame f;
+  const CubeQuality q = assess(s, rays, 0, RenderMode::Impostor, &f);
+  EXPECT_GT(q.hit_vertices, 20);
+  EXPECT_EQ(q.behind_layers_vertices, 0);
+  EXPECT_EQ(f.quality.verdict, QualityVerdict::kGood) << f.quality.action;
+}
+
+// A lens at render.max_depth 1: the reference ends its paths at the back surface (black); envmap mode's cube lookup
+// draws the room through it (pvrr compare, 96 x 72: 6902 of the spectacle lens's 6912 such pixels lit), so it is
+// flagged; at the scene's own depth it is not.
+TEST(CubeQuality, EnvmapFlagsALensBeyondTheDepthLimit) {
+  const Scene s = test::shippedScene("spectacle-lens", {"render.max_depth=1"});
+  const RayScene rays(s);
+  ElementFrame f;
+  assess(s, rays, 0, RenderMode::Envmap, &f);
+  EXPECT_EQ(f.quality.verdict, QualityVerdict::kDegraded);
+  EXPECT_NE(f.quality.action.find("render.max_depth 1: the reference ends every path through the lens"),
+            std::string::npos)
+      << f.quality.action;
+  const Scene s4 = test::shippedScene("spectacle-lens");
+  const RayScene rays4(s4);
+  ElementFrame f4;
+  assess(s4, rays4, 0, RenderMode::Envmap, &f4);
+  EXPECT_EQ(f4.quality.action.find("render.max_depth"), std::string::npos) << f4.quality.action;
+}
+
 TEST(CubeQuality, UnresolvedSearchesAboveOnePercentAreFlagged) {
   ElementFrame f;
   f.quality.action = "none";
