@@ -176,15 +176,16 @@ bool PvrrPass::cpuStages(FrameStages& stages, FrameCache* cache) {
 
 // Adaptive refinement (issue 26 item 2): an element whose triangles span too much curvature for their rays
 // to interpolate well is refined, traced and fitted again; the grid cache keeps the refinement for the
-// following frames. Locally by default (VertexStageOptions::refine_locally): the base quads over the limit,
-// each to its own level (chooseLocalSplit); else the whole grid (refinedGridSize).
+// following frames. The whole grid (refinedGridSize), or with VertexStageOptions::refine_locally the base quads
+// whose maps err, each to its own level (chooseLocalSplitByMapError), unless the grid is refined uniformly
+// already.
 void PvrrPass::refineElement(size_t e) {
   ElementFrame& f = frames[e];
   const Element& el = ctx.scene.elements[e];
   bool again = false;
   std::string budget;
-  if (opts[e].refine_max_vertices > 0 && opts[e].refine_locally) {
-    const LocalSplit ls = chooseLocalSplit(f, opts[e].refine_max_vertices);
+  if (opts[e].refine_max_vertices > 0 && opts[e].refine_locally && ctx.grid_cache.refined(int(e))[0] == 0) {
+    const LocalSplit ls = chooseLocalSplitByMapError(ctx.rays, f, opts[e].refine_max_vertices);
     if (ls.changed) {
       ctx.grid_cache.refineLocally(ctx.scene, int(e), ls.levels);
       again = true;
@@ -208,7 +209,7 @@ void PvrrPass::refineElement(size_t e) {
     f.quality.action = std::to_string(split) + " of the " + std::to_string(f.grid.quad_levels.size()) + " quads of the " +
                        std::to_string(f.grid.grid_u) + "x" + std::to_string(f.grid.grid_v) +
                        " grid split locally to level " + std::to_string(level) + ", " +
-                       std::to_string(f.grid.vertexCount()) + " vertices, where its triangles spanned too much curvature" +
+                       std::to_string(f.grid.vertexCount()) + " vertices, where the map's interpolation erred" +
                        budget + "; " + f.quality.action;
   } else if (ctx.grid_cache.refined(int(e))[0] > 0) {
     f.quality.action = "grid refined from " + std::to_string(el.tess_u) + "x" + std::to_string(el.tess_v) + " to " +
