@@ -176,27 +176,36 @@ bool PvrrPass::cpuStages(FrameStages& stages, FrameCache* cache) {
 
 // Adaptive refinement (issue 26 item 2): an element whose triangles span too much curvature for their rays
 // to interpolate well is refined, traced and fitted again; the grid cache keeps the refinement for the
-// following frames. The whole grid (refinedGridSize), or with VertexStageOptions::refine_locally the base quads
-// whose maps err, each to its own level (chooseLocalSplitByMapError), unless the grid is refined uniformly
-// already.
+// following frames. The whole grid first (refinedGridSize); then, with VertexStageOptions::refine_locally, the
+// base quads of that grid whose maps still err, each to its own level (chooseLocalSplitByMapError), within the
+// same vertex budget.
 void PvrrPass::refineElement(size_t e) {
   ElementFrame& f = frames[e];
   const Element& el = ctx.scene.elements[e];
   bool again = false;
   std::string budget;
-  if (opts[e].refine_max_vertices > 0 && opts[e].refine_locally && ctx.grid_cache.refined(int(e))[0] == 0) {
-    const LocalSplit ls = chooseLocalSplitByMapError(ctx.rays, f, opts[e].refine_max_vertices);
+  const int max_vertices = opts[e].refine_max_vertices;
+  if (max_vertices > 0 && !f.grid.locallyRefined()) {
+    const std::array<int, 2> size = refinedGridSize(f, max_vertices);
+    if (size[0] != f.grid.grid_u || size[1] != f.grid.grid_v) {
+      ctx.grid_cache.refine(ctx.scene, int(e), size[0], size[1]);
+      if (opts[e].refine_locally) {  // the local split measures the refined grid's maps
+        f = prepareElement(ctx.scene, int(e), &ctx.grid_cache.get(ctx.scene, int(e)));
+        traceVertexRays(ctx.rays, f, ctx.scene.observer.eye, opts[e]);
+        fitPatchViews(ctx.scene, f, opts[e]);
+      } else {
+        again = true;
+      }
+    }
+  }
+  if (max_vertices > 0 && opts[e].refine_locally) {
+    const LocalSplit ls =
+        chooseLocalSplitByMapError(ctx.rays, f, max_vertices, {}, 0.9, ctx.grid_cache.refined(int(e))[0] > 0);
     if (ls.changed) {
       ctx.grid_cache.refineLocally(ctx.scene, int(e), ls.levels);
       again = true;
     }
-    if (ls.budget_limited) budget = " (vertex budget " + std::to_string(opts[e].refine_max_vertices) + " reached)";
-  } else if (opts[e].refine_max_vertices > 0) {
-    const std::array<int, 2> size = refinedGridSize(f, opts[e].refine_max_vertices);
-    if (size[0] != f.grid.grid_u || size[1] != f.grid.grid_v) {
-      ctx.grid_cache.refine(ctx.scene, int(e), size[0], size[1]);
-      again = true;
-    }
+    if (ls.budget_limited) budget = " (vertex budget " + std::to_string(max_vertices) + " reached)";
   }
   if (again) {
     f = prepareElement(ctx.scene, int(e), &ctx.grid_cache.get(ctx.scene, int(e)));
@@ -211,7 +220,8 @@ void PvrrPass::refineElement(size_t e) {
                        " grid split locally to level " + std::to_string(level) + ", " +
                        std::to_string(f.grid.vertexCount()) + " vertices, where the map's interpolation erred" +
                        budget + "; " + f.quality.action;
-  } else if (ctx.grid_cache.refined(int(e))[0] > 0) {
+  }
+  if (ctx.grid_cache.refined(int(e))[0] > 0) {
     f.quality.action = "grid refined from " + std::to_string(el.tess_u) + "x" + std::to_string(el.tess_v) + " to " +
                        std::to_string(f.grid.grid_u) + "x" + std::to_string(f.grid.grid_v) +
                        " where its triangles spanned too much curvature; " + f.quality.action;

@@ -222,9 +222,9 @@ std::vector<double> quadMapErrors(const RayScene& rays, const ElementFrame& f) {
 }
 
 LocalSplit chooseLocalSplitByMapError(const RayScene& rays, const ElementFrame& f, int max_vertices,
-                                      const FrameQualityLimits& limits, double target) {
+                                      const FrameQualityLimits& limits, double target, bool refined) {
   const std::vector<double> spread = quadSpreadRatios(f, limits);
-  const bool trigger = std::any_of(spread.begin(), spread.end(), [](double r) { return r > 1.0; });
+  const bool trigger = refined || std::any_of(spread.begin(), spread.end(), [](double r) { return r > 1.0; });
   if (!trigger) return chooseLevels(f, spread, false, max_vertices, target);
   const std::vector<double> err = quadMapErrors(rays, f);
   // As a ratio that halves with each level (the map error falls 4 x): sqrt. Quads without a map error (TIR

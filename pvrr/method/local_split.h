@@ -57,7 +57,9 @@ inline constexpr double kLocalSplitMapErrorArcmin = 6.0;
 // chooseLocalSplit and refinedGridSize, so an element neither refines keeps its grid), each quad is refined
 // until its map error, falling 4 x a level, is below target^2 x kLocalSplitMapErrorArcmin, or for a triangle with
 // a totally reflected corner its traced spread below target x its limit; worst first within max_vertices.
+// `refined`: the element's grid was refined already (uniformly), which triggers it too.
 LocalSplit chooseLocalSplitByMapError(const RayScene& rays, const ElementFrame& f, int max_vertices,
-                                      const FrameQualityLimits& limits = {}, double target = 0.9);
+                                      const FrameQualityLimits& limits = {}, double target = 0.9,
+                                      bool refined = false);
 
 }  // namespace pvrr

@@ -120,11 +120,11 @@ struct VertexStageOptions {
   // Adaptive refinement (applied by the renderer, PvrrPass::refineElement): the most vertices a refined grid
   // may have; 0: none. 4096 holds the 63 x 63 grid at which the 50 mm toric mirror renders within 0.8' median.
   int refine_max_vertices = 4096;
-  // true: refine only the base quads whose maps err (chooseLocalSplitByMapError, pvrr/method/local_split.h;
-  // conforming, cad/local_refine.h), each to its own level; false: the whole grid (refinedGridSize). Off by
-  // default: at equal vertex counts the local split measured better on the -30 D toric lens (1.27' median at
-  // 1258 vertices against 2.97' at 1225) but worse on the toric mirror (1.16' against 0.74' at 4096) and the
-  // thick lens with TIR (8.9' against 3.5'), docs/robustness.md.
+  // true: after the whole grid's refinement (refinedGridSize), split the base quads whose maps still err, each
+  // to its own level, within the same budget (chooseLocalSplitByMapError, pvrr/method/local_split.h; conforming,
+  // cad/local_refine.h). Off by default: at equal vertex counts it measured better on the -30 D toric lens
+  // (1.05' median at 1677 vertices against 1.76' at 2025 uniformly) but not on the toric mirror (1.23' median,
+  // p95 4.2', at 3428 against 0.85', p95 4.4', at 3364 uniformly), docs/robustness.md.
   bool refine_locally = false;
   int max_patch_splits = 4;      // doublings per direction for the automatic split
   // World -> clip of the camera that draws the element (the observer's, or the map camera of the element
