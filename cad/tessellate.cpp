@@ -347,7 +347,10 @@ Tessellation tessellateAdaptive(const Surface& s, double chordal_tol, double ang
 // so the winding and diagonal are the grid's own.
 std::vector<GridPatch> splitGrid(const Tessellation& grid, int patches_u, int patches_v) {
   const int gu = grid.grid_u, gv = grid.grid_v;
-  if (gu < 2 || gv < 2 || grid.positions.size() != size_t(gu) * size_t(gv))
+  const size_t n_grid = size_t(gu) * size_t(gv);
+  const bool local = grid.locallyRefined();
+  if (gu < 2 || gv < 2 || (local ? grid.positions.size() < n_grid : grid.positions.size() != n_grid) ||
+      (local && grid.triangle_quads.size() != grid.triangles.size()))
     throw Error("splitGrid: not a grid tessellation (grid " + std::to_string(gu) + " x " + std::to_string(gv) +
                 ", " + std::to_string(grid.positions.size()) + " vertices)");
   if (patches_u < 1 || patches_v < 1 || patches_u > gu - 1 || patches_v > gv - 1)
@@ -382,21 +385,59 @@ std::vector<GridPatch> splitGrid(const Tessellation& grid, int patches_u, int pa
   // Each vertex's grid row and column, once (two integer divisions per triangle corner were most of the
   // split's time).
   const size_t n = grid.positions.size();
-  std::vector<int> row(n), col(n);
-  for (size_t k = 0; k < n; ++k) row[k] = int(k) / gv, col[k] = int(k) % gv;
-  for (const Triangle& tri : grid.triangles) {
-    const uint32_t idx[3] = {tri.x, tri.y, tri.z};
-    int qi = gu, qj = gv;
-    for (uint32_t k : idx) {
-      if (k >= n) throw Error("splitGrid: a triangle refers to vertex " + std::to_string(k) + " of " + std::to_string(n));
-      qi = std::min(qi, row[k]);
-      qj = std::min(qj, col[k]);
+  std::vector<int> row(n_grid), col(n_grid);
+  for (size_t k = 0; k < n_grid; ++k) row[k] = int(k) / gv, col[k] = int(k) % gv;
+  if (!local) {
+    for (const Triangle& tri : grid.triangles) {
+      const uint32_t idx[3] = {tri.x, tri.y, tri.z};
+      int qi = gu, qj = gv;
+      for (uint32_t k : idx) {
+        if (k >= n) throw Error("splitGrid: a triangle refers to vertex " + std::to_string(k) + " of " + std::to_string(n));
+        qi = std::min(qi, row[k]);
+        qj = std::min(qj, col[k]);
+      }
+      if (qi >= gu - 1 || qj >= gv - 1) throw Error("splitGrid: a triangle does not lie in a grid quad");
+      GridPatch& p = patches[size_t(patch_of_qu[size_t(qi)] * patches_v + patch_of_qv[size_t(qj)])];
+      const int w = p.j1 - p.j0 + 1;
+      auto local_index = [&](uint32_t k) { return uint32_t((row[k] - p.i0) * w + (col[k] - p.j0)); };
+      p.triangles.emplace_back(local_index(tri.x), local_index(tri.y), local_index(tri.z));
     }
-    if (qi >= gu - 1 || qj >= gv - 1) throw Error("splitGrid: a triangle does not lie in a grid quad");
-    GridPatch& p = patches[size_t(patch_of_qu[size_t(qi)] * patches_v + patch_of_qv[size_t(qj)])];
+    return patches;
+  }
+  // Locally refined: each triangle goes to the patch of its base quad; the appended vertices a patch uses
+  // follow its grid block, in ascending order.
+  std::vector<std::vector<size_t>> tris_of(patches.size());
+  for (size_t t = 0; t < grid.triangles.size(); ++t) {
+    const uint32_t q = grid.triangle_quads[t];
+    const int qi = int(q) / (gv - 1), qj = int(q) % (gv - 1);
+    if (qi >= gu - 1) throw Error("splitGrid: a triangle's base quad " + std::to_string(q) + " is not in the grid");
+    tris_of[size_t(patch_of_qu[size_t(qi)] * patches_v + patch_of_qv[size_t(qj)])].push_back(t);
+  }
+  std::vector<uint32_t> extra;
+  for (size_t pi = 0; pi < patches.size(); ++pi) {
+    GridPatch& p = patches[pi];
+    extra.clear();
+    for (size_t t : tris_of[pi])
+      for (uint32_t k : {grid.triangles[t].x, grid.triangles[t].y, grid.triangles[t].z}) {
+        if (k >= n) throw Error("splitGrid: a triangle refers to vertex " + std::to_string(k) + " of " + std::to_string(n));
+        if (k >= n_grid) extra.push_back(k);
+      }
+    std::sort(extra.begin(), extra.end());
+    extra.erase(std::unique(extra.begin(), extra.end()), extra.end());
     const int w = p.j1 - p.j0 + 1;
-    auto local = [&](uint32_t k) { return uint32_t((row[k] - p.i0) * w + (col[k] - p.j0)); };
-    p.triangles.emplace_back(local(tri.x), local(tri.y), local(tri.z));
+    const uint32_t block = uint32_t(p.vertices.size());
+    auto local_index = [&](uint32_t k) {
+      if (k >= n_grid)
+        return block + uint32_t(std::lower_bound(extra.begin(), extra.end(), k) - extra.begin());
+      if (row[k] < p.i0 || row[k] > p.i1 || col[k] < p.j0 || col[k] > p.j1)
+        throw Error("splitGrid: a triangle of a patch refers to a grid vertex outside it");
+      return uint32_t((row[k] - p.i0) * w + (col[k] - p.j0));
+    };
+    p.vertices.insert(p.vertices.end(), extra.begin(), extra.end());
+    for (size_t t : tris_of[pi]) {
+      const Triangle& tri = grid.triangles[t];
+      p.triangles.emplace_back(local_index(tri.x), local_index(tri.y), local_index(tri.z));
+    }
   }
   return patches;
 }

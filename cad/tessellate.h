@@ -21,7 +21,14 @@ struct Tessellation {
   std::vector<Triangle> triangles;  // counter-clockwise seen from the normal side
   // Grid tessellations: vertex (i, j), i along u (0..grid_u-1), j along v, is at index i * grid_v + j.
   int grid_u = 0, grid_v = 0;
+  // A grid refined locally (cad/local_refine.h): the first grid_u * grid_v vertices are the grid's, the
+  // others appended. quad_levels: each base quad's subdivision level ((grid_u - 1) x (grid_v - 1), quad
+  // (i, j) at i * (grid_v - 1) + j); triangle_quads: the base quad of each triangle. Both empty for a plain
+  // grid.
+  std::vector<uint8_t> quad_levels;
+  std::vector<uint32_t> triangle_quads;
   size_t vertexCount() const { return positions.size(); }
+  bool locallyRefined() const { return !triangle_quads.empty(); }
 };
 
 struct TessellationOptions {
@@ -46,7 +53,9 @@ Tessellation tessellateAdaptive(const Surface& s, double chordal_tol, double ang
                                 const Outline* outline = nullptr, TessellationOptions opt = {});
 
 // A block of a grid tessellation. Adjacent patches share their boundary vertices: the same indices into the
-// grid, hence bit-identical positions and normals.
+// grid, hence bit-identical positions and normals. A locally refined grid's block holds the triangles of its
+// base quads and, after the block's grid vertices (in their order), the appended vertices they use (ascending);
+// an appended vertex on a patch boundary belongs to both patches.
 struct GridPatch {
   int i0 = 0, i1 = 0, j0 = 0, j1 = 0;  // inclusive vertex ranges in the grid
   std::vector<uint32_t> vertices;      // indices into the grid tessellation

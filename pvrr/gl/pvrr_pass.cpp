@@ -6,6 +6,7 @@
 #include "pvrr/base/error.h"
 #include "pvrr/gl/gl.h"
 #include "pvrr/gl/impostor_maps.h"
+#include "pvrr/method/local_split.h"
 #include "pvrr/method/map_footprint.h"
 #include "pvrr/method/refine_plan.h"
 #include "pvrr/optics/spectrum.h"
@@ -175,24 +176,57 @@ bool PvrrPass::cpuStages(FrameStages& stages, FrameCache* cache) {
 }
 
 // Adaptive refinement (issue 26 item 2): an element whose triangles span too much curvature for their rays
-// to interpolate well is tessellated finer, traced and fitted again; the grid cache keeps the finer grid for
-// the following frames.
+// to interpolate well is refined, traced and fitted again; the grid cache keeps the refinement for the
+// following frames. The whole grid first (refinedGridSize); then, with VertexStageOptions::refine_locally, the
+// base quads of that grid whose maps still err, each to its own level (chooseLocalSplitByMapError), within the
+// same vertex budget.
 void PvrrPass::refineElement(size_t e) {
   ElementFrame& f = frames[e];
   const Element& el = ctx.scene.elements[e];
-  if (opts[e].refine_max_vertices > 0) {
-    const std::array<int, 2> size = refinedGridSize(f, opts[e].refine_max_vertices);
+  bool again = false;
+  std::string budget;
+  const int max_vertices = opts[e].refine_max_vertices;
+  if (max_vertices > 0 && !f.grid.locallyRefined()) {
+    const std::array<int, 2> size = refinedGridSize(f, max_vertices);
     if (size[0] != f.grid.grid_u || size[1] != f.grid.grid_v) {
       ctx.grid_cache.refine(ctx.scene, int(e), size[0], size[1]);
-      f = prepareElement(ctx.scene, int(e), &ctx.grid_cache.get(ctx.scene, int(e)));
-      traceVertexRays(ctx.rays, f, ctx.scene.observer.eye, opts[e]);
-      fitPatchViews(ctx.scene, f, opts[e]);
+      if (opts[e].refine_locally) {  // the local split measures the refined grid's maps
+        f = prepareElement(ctx.scene, int(e), &ctx.grid_cache.get(ctx.scene, int(e)));
+        traceVertexRays(ctx.rays, f, ctx.scene.observer.eye, opts[e]);
+        fitPatchViews(ctx.scene, f, opts[e]);
+      } else {
+        again = true;
+      }
     }
   }
-  if (ctx.grid_cache.refined(int(e))[0] > 0)
+  if (max_vertices > 0 && opts[e].refine_locally) {
+    const LocalSplit ls =
+        chooseLocalSplitByMapError(ctx.rays, f, max_vertices, {}, 0.9, ctx.grid_cache.refined(int(e))[0] > 0);
+    if (ls.changed) {
+      ctx.grid_cache.refineLocally(ctx.scene, int(e), ls.levels);
+      again = true;
+    }
+    if (ls.budget_limited) budget = " (vertex budget " + std::to_string(max_vertices) + " reached)";
+  }
+  if (again) {
+    f = prepareElement(ctx.scene, int(e), &ctx.grid_cache.get(ctx.scene, int(e)));
+    traceVertexRays(ctx.rays, f, ctx.scene.observer.eye, opts[e]);
+    fitPatchViews(ctx.scene, f, opts[e]);
+  }
+  if (f.grid.locallyRefined()) {
+    int split = 0, level = 0;
+    for (uint8_t l : f.grid.quad_levels) split += l > 0, level = std::max(level, int(l));
+    f.quality.action = std::to_string(split) + " of the " + std::to_string(f.grid.quad_levels.size()) + " quads of the " +
+                       std::to_string(f.grid.grid_u) + "x" + std::to_string(f.grid.grid_v) +
+                       " grid split locally to level " + std::to_string(level) + ", " +
+                       std::to_string(f.grid.vertexCount()) + " vertices, where the map's interpolation erred" +
+                       budget + "; " + f.quality.action;
+  }
+  if (ctx.grid_cache.refined(int(e))[0] > 0) {
     f.quality.action = "grid refined from " + std::to_string(el.tess_u) + "x" + std::to_string(el.tess_v) + " to " +
                        std::to_string(f.grid.grid_u) + "x" + std::to_string(f.grid.grid_v) +
                        " where its triangles spanned too much curvature; " + f.quality.action;
+  }
 }
 
 void PvrrPass::firstPass(FrameStages& stages, FrameCache* cache, bool skip_first_pass, bool continuing) {

@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
+#include "cad/local_refine.h"
 #include "pvrr/base/error.h"
 #include "pvrr/base/format.h"
 #include "pvrr/method/eye_side.h"
@@ -98,6 +100,7 @@ const cad::Tessellation& ElementGridCache::get(const Scene& scene, int element) 
     e.surface = surface;
     e.tess_u = el.tess_u, e.tess_v = el.tess_v;
     e.refined_u = e.refined_v = 0;
+    e.base = {};
     e.has_outline = el.has_outline;
     e.outline = el.outline;
   }
@@ -107,9 +110,30 @@ const cad::Tessellation& ElementGridCache::get(const Scene& scene, int element) 
 void ElementGridCache::refine(const Scene& scene, int element, int tess_u, int tess_v) {
   get(scene, element);  // the entry is current
   Entry& e = entries_[size_t(element)];
-  if (tess_u == e.grid.grid_u && tess_v == e.grid.grid_v) return;
+  if (tess_u == e.grid.grid_u && tess_v == e.grid.grid_v && !e.grid.locallyRefined()) return;
   e.grid = tessellateElement(scene.elements[size_t(element)], tess_u, tess_v);
+  e.base = {};
   e.refined_u = tess_u, e.refined_v = tess_v;
+}
+
+void ElementGridCache::refineLocally(const Scene& scene, int element, const std::vector<uint8_t>& quad_levels) {
+  get(scene, element);  // the entry is current
+  Entry& e = entries_[size_t(element)];
+  const cad::Tessellation& base = e.grid.locallyRefined() ? e.base : e.grid;
+  const std::vector<uint8_t> levels = cad::balanceQuadLevels(base.grid_u, base.grid_v, quad_levels);
+  if (e.grid.locallyRefined() ? levels == e.grid.quad_levels
+                              : std::all_of(levels.begin(), levels.end(), [](uint8_t l) { return l == 0; }))
+    return;
+  if (std::all_of(levels.begin(), levels.end(), [](uint8_t l) { return l == 0; })) {
+    e.grid = std::move(e.base);
+    e.base = {};
+    return;
+  }
+  const Element& el = scene.elements[size_t(element)];
+  cad::Tessellation refined =
+      cad::refineGridLocally(el.frontSurface(), base, levels, el.has_outline ? &el.outline : nullptr);
+  if (!e.grid.locallyRefined()) e.base = std::move(e.grid);
+  e.grid = std::move(refined);
 }
 
 ElementFrame prepareElement(const Scene& scene, int element, const cad::Tessellation* grid) {
@@ -491,8 +515,14 @@ void fitPatchViews(const Scene& scene, ElementFrame& f, const VertexStageOptions
     // Split along the grid directions whose patches still have room: every patch keeps at least
     // kMinPatchQuads quads a side (a patch of one or two quads fits its viewpoint to a handful of rays and
     // costs a first pass of its own).
-    const int max_u = std::max(pu, (f.grid.grid_u - 1) / kMinPatchQuads),
-              max_v = std::max(pv, (f.grid.grid_v - 1) / kMinPatchQuads);
+    // A locally refined grid counts as the uniform grid of its vertex count (its patches hold that many rays),
+    // within one base quad a patch.
+    const double density =
+        f.grid.locallyRefined()
+            ? std::sqrt(double(f.grid.vertexCount()) / (double(f.grid.grid_u) * double(f.grid.grid_v)))
+            : 1.0;
+    const int max_u = std::max(pu, std::min(f.grid.grid_u - 1, int(double(f.grid.grid_u - 1) * density) / kMinPatchQuads)),
+              max_v = std::max(pv, std::min(f.grid.grid_v - 1, int(double(f.grid.grid_v - 1) * density) / kMinPatchQuads));
     const int next_u = std::min(pu * 2, max_u), next_v = std::min(pv * 2, max_v);
     if (next_u == pu && next_v == pv) {
       f.split_note = "patch field of view still above " + std::to_string(int(std::lround(degrees(max_fov)))) +

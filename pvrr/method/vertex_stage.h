@@ -117,9 +117,15 @@ struct VertexStageOptions {
     return o;
   }();
   double max_patch_fov_rad = 0;  // overrides the element's when > 0
-  // Adaptive refinement (refinedGridSize, applied by the renderer): the most vertices a refined grid may
-  // have; 0: none. 4096 holds the 63 x 63 grid at which the 50 mm toric mirror renders within 0.8' median.
+  // Adaptive refinement (applied by the renderer, PvrrPass::refineElement): the most vertices a refined grid
+  // may have; 0: none. 4096 holds the 63 x 63 grid at which the 50 mm toric mirror renders within 0.8' median.
   int refine_max_vertices = 4096;
+  // true: after the whole grid's refinement (refinedGridSize), split the base quads whose maps still err, each
+  // to its own level, within the same budget (chooseLocalSplitByMapError, pvrr/method/local_split.h; conforming,
+  // cad/local_refine.h). Off by default: at equal vertex counts it measured better on the -30 D toric lens
+  // (1.05' median at 1677 vertices against 1.76' at 2025 uniformly) but not on the toric mirror (1.23' median,
+  // p95 4.2', at 3428 against 0.85', p95 4.4', at 3364 uniformly), docs/robustness.md.
+  bool refine_locally = false;
   int max_patch_splits = 4;      // doublings per direction for the automatic split
   // World -> clip of the camera that draws the element (the observer's, or the map camera of the element
   // that shows it). When set, each patch's view volume holds only what that camera sees (ElementFrame::
@@ -178,6 +184,9 @@ class ElementGridCache {
   const cad::Tessellation& get(const Scene& scene, int element);
   // Tessellates the element at tess_u x tess_v from now on (adaptive refinement, refinedGridSize).
   void refine(const Scene& scene, int element, int tess_u, int tess_v);
+  // Refines the element's grid (its own, or the one refine() chose) locally from now on: each base quad to its
+  // level (cad::refineGridLocally; chooseLocalSplit). The same levels again change nothing; all 0: the grid.
+  void refineLocally(const Scene& scene, int element, const std::vector<uint8_t>& quad_levels);
   // The grid size refine() set and get() still returns; {0, 0} when none.
   std::array<int, 2> refined(int element) const {
     if (size_t(element) >= entries_.size()) return {0, 0};
@@ -192,6 +201,7 @@ class ElementGridCache {
     bool has_outline = false;
     cad::Outline outline;
     cad::Tessellation grid;
+    cad::Tessellation base;  // the grid before local refinement (empty while there is none)
   };
   std::vector<Entry> entries_;
 };
