@@ -161,12 +161,28 @@ vec3 layeredHit(samplerCube seen0, samplerCube seen1, vec3 x, vec3 R, out int la
   float rR1 = envDistance(seen1, R);
   vec3 p_last = p0;   // the last finite sample
   vec2 r_last = r_prev;
-  for (int i = 1; i <= LAYER_STEPS; ++i) {
-    bool at_end = i == LAYER_STEPS;
-    if (at_end) p_last = x + R * d_prev, r_last = r_prev;
-    float t = float(i) / float(LAYER_STEPS), d = at_end ? 0.0 : a * t / (1.0 - t);
-    vec3 p = x + R * d;
-    vec2 r = at_end ? vec2(2.0) : vec2(rayRatio(seen0, p), rayRatio(seen1, p));
+  // The steps run in an inner loop that only looks for the next bracket (two cube reads a step); its
+  // refinement runs after it, once per bracket. A renderer that runs a branch's code for a whole SIMD group of
+  // pixels whether or not any of them takes it (llvmpipe: it masks lanes, it does not jump) paid for both
+  // layers' refinements and surface tests at every step when they sat in the step loop: 10 cube reads a step
+  // where 2 are needed. The brackets found and their order are those of one loop.
+  int i = 1;
+  for (int bracket = 0; bracket < LAYER_STEPS && i <= LAYER_STEPS; ++bracket) {
+    bool at_end = false;
+    float d = 0.0;
+    vec2 r = vec2(0.0);
+    for (; i <= LAYER_STEPS; ++i) {
+      at_end = i == LAYER_STEPS;
+      if (at_end) p_last = x + R * d_prev, r_last = r_prev;
+      float t = float(i) / float(LAYER_STEPS);
+      d = at_end ? 0.0 : a * t / (1.0 - t);
+      vec3 p = x + R * d;
+      r = at_end ? vec2(2.0) : vec2(rayRatio(seen0, p), rayRatio(seen1, p));
+      if ((r_prev.x < 1.0 && r.x >= 1.0) || (r_prev.y < 1.0 && r.y >= 1.0)) break;
+      d_prev = d;
+      r_prev = r;
+    }
+    if (i > LAYER_STEPS) break;  // no bracket left
     vec3 l, best = l0;
     float d_best = -1.0;
     if (r_prev.x < 1.0 && r.x >= 1.0 && layerCrossing(seen0, x, R, rR0, d_prev, r_prev.x, d, r.x, at_end, l))
@@ -179,6 +195,7 @@ vec3 layeredHit(samplerCube seen0, samplerCube seen1, vec3 x, vec3 R, out int la
     if (d_best >= 0.0) return best;
     d_prev = d;
     r_prev = r;
+    ++i;
   }
   if ((r_last.x >= 1.0 || texture(seen0, p_last).w < 0.5) && (r_last.y >= 1.0 || texture(seen1, p_last).w < 0.5)) {
     g_escaped = true;
