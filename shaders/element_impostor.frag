@@ -49,8 +49,9 @@ void envHit(vec3 x, vec3 R, out vec3 colour, out vec4 seen) {
   seen = layer == 1 ? texture(u_seen_cube1, l) : texture(u_seen_cube, l);
   if (g_escaped) colour = u_background, seen = vec4(x + R * u_far, 0.0);  // past an occluder to the sky
 #else
-  vec3 l = impostorHit(u_seen_cube, x, R);
-  checkResolved(u_seen_cube, l);
+  float d_at;
+  vec3 l = impostorHit(u_seen_cube, x, R, d_at);
+  checkResolved(l, d_at);
   colour = texture(u_cube, l).rgb;
   seen = texture(u_seen_cube, l);
 #endif

@@ -8,9 +8,9 @@ float envDistance(samplerCube seen, vec3 dir) { return length(texture(seen, dir)
 // its ray meets (a surface hidden from the cube's origin, or the search ran out of steps). The second pass
 // marks its seen point (w + 2), and the renderer counts those pixels (pvrr/method/cube_quality.h).
 bool g_unresolved = false;
-// The first layer's search ended within 1e-3 of the distance the cube holds there (onSurface's tolerance).
-void checkResolved(samplerCube seen, vec3 l) {
-  float d = envDistance(seen, l);
+// The first layer's search ended within 1e-3 of the distance the cube holds there (onSurface's tolerance);
+// d: that distance (impostorHit's d_at).
+void checkResolved(vec3 l, float d) {
   if (!(abs(length(l) - d) <= 1e-3 * d)) g_unresolved = true;
 }
 
@@ -21,15 +21,19 @@ void checkResolved(samplerCube seen, vec3 l) {
 // R itself, at infinity, stands in for a missing overshoot, as in the paper).
 // falsePosition: that search from parameter dl, with the last undershooting (dun, ratio |l| / distance pun) and
 // overshooting (dov, pov) parameters so far (0: none); r1 the distance the impostor holds along R. d_at: the
-// distance the impostor holds at the point returned where the search read it there (it stopped on a ratio
-// within 1e-6 of 1), else -1: onSurface then need not read it again.
+// distance the impostor holds at the point returned, which the search reads there (it stopped on a ratio
+// within 1e-6 of 1, or its steps ran out and it read the point of the last), so that the caller's test of
+// the result (onSurface, checkResolved) need not read it again. That read is the loop's last pass: a renderer
+// that runs a branch's code for a whole SIMD group of pixels (llvmpipe masks lanes; it does not jump) paid for
+// the caller's read after the loop in every pixel, and pays for this pass only in groups where some pixel's
+// search ran out of steps.
 vec3 falsePosition(samplerCube seen, vec3 x, vec3 R, float r1, float dl, float dun, float pun, float dov, float pov,
                    out float d_at) {
   vec3 l = x + R * dl;
   d_at = -1.0;
-  for (int i = 0; i < IMPOSTOR_ITERATIONS; ++i) {
+  for (int i = 0; i <= IMPOSTOR_ITERATIONS; ++i) {
     float d = envDistance(seen, l), llp = length(l) / d;
-    if (abs(1.0 - llp) < 1e-6) {  // as close as float distances resolve
+    if (abs(1.0 - llp) < 1e-6 || i == IMPOSTOR_ITERATIONS) {  // as close as float distances resolve, or the last
       d_at = d;
       break;
     }
@@ -45,7 +49,7 @@ vec3 falsePosition(samplerCube seen, vec3 x, vec3 R, float r1, float dl, float d
     l = x + R * dl;
   }
   if (dot(l, l) > 0.0) return l;
-  d_at = -1.0;
+  d_at = r1;
   return R;  // x at the cube's origin and d = 0: the direction itself
 }
 // r1: the distance the impostor holds along R; d_at as falsePosition's.
@@ -59,8 +63,8 @@ vec3 impostorHit(samplerCube seen, vec3 x, vec3 R, out float r1, out float d_at)
   float dl = max(dp + r1 * (1.0 - ppp), 0.0);
   return falsePosition(seen, x, R, r1, dl, dun, pun, dov, pov, d_at);
 }
-vec3 impostorHit(samplerCube seen, vec3 x, vec3 R) {
-  float r1, d_at;
+vec3 impostorHit(samplerCube seen, vec3 x, vec3 R, out float d_at) {
+  float r1;
   return impostorHit(seen, x, R, r1, d_at);
 }
 
@@ -74,10 +78,9 @@ vec3 impostorHit(samplerCube seen, vec3 x, vec3 R) {
 // distance jumps (1.5 texels to either side, across the ray's sweep, the farther more than 1.5 x the nearer),
 // the filtered distance blends the two surfaces, and the search ends between them, at a point on neither:
 // more than 1.25 x the nearer's distance and less than 0.8 x the farther's.
-// d_at: the distance the layer holds at l if the search read it there, else -1.
-bool onSurface(samplerCube seen, vec3 l, vec3 R, float d_at) {
-  float len = length(l), d = d_at;
-  if (d < 0.0) d = envDistance(seen, l);
+// d: the distance the layer holds at l (falsePosition's d_at).
+bool onSurface(samplerCube seen, vec3 l, vec3 R, float d) {
+  float len = length(l);
   if (!(abs(len - d) <= 1e-3 * d)) return false;
   vec3 u = l / len, t = R - dot(R, u) * u;
   float tl = length(t);
