@@ -91,11 +91,13 @@ bool onSurface(samplerCube seen, vec3 l, vec3 R, float d) {
   return !(df > 1.5 * dn && len > 1.25 * dn && len < 0.8 * df);
 }
 
-// |p| / the layer's distance in p's direction: below 1 in front of the layer, above behind it.
-float rayRatio(samplerCube seen, vec3 p) {
+// |p| / the layer's distance in p's direction (s: the layer's texel there): below 1 in front of the layer,
+// above behind it.
+float sampleRatio(vec3 p, vec4 s) {
   float len = length(p);
-  return len > 0.0 ? len / envDistance(seen, p) : 0.0;
+  return len > 0.0 ? len / length(s.xyz) : 0.0;
 }
+float rayRatio(samplerCube seen, vec3 p) { return sampleRatio(p, texture(seen, p)); }
 
 // A crossing of a layer between the march's parameters d0 (ratio r0 < 1) and d1 (ratio r1 >= 1; at_end: the
 // ray's end at infinity), refined by false position; whether it lies on the layer's surface. rR: the distance
@@ -160,10 +162,11 @@ vec3 layeredHit(samplerCube seen0, samplerCube seen1, vec3 x, vec3 R, out int la
 #else
   float a = length(x), t0 = 0.25 / float(LAYER_STEPS), d_prev = a * t0 / (1.0 - t0);
   vec3 p0 = x + R * d_prev;
-  vec2 r_prev = vec2(rayRatio(seen0, p0), rayRatio(seen1, p0));
+  vec4 s0 = texture(seen0, p0), s1 = texture(seen1, p0);
+  // Each sample's ratios (rayRatio) and texels' w (0: the sky) in the two layers.
+  vec2 r_prev = vec2(sampleRatio(p0, s0), sampleRatio(p0, s1)), w_prev = vec2(s0.w, s1.w);
   float rR1 = envDistance(seen1, R);
-  vec3 p_last = p0;   // the last finite sample
-  vec2 r_last = r_prev;
+  vec2 r_last = r_prev, w_last = w_prev;  // at the last finite sample
   // The steps run in an inner loop that only looks for the next bracket (two cube reads a step); its
   // refinement runs after it, once per bracket. A renderer that runs a branch's code for a whole SIMD group of
   // pixels whether or not any of them takes it (llvmpipe: it masks lanes, it does not jump) paid for both
@@ -173,17 +176,18 @@ vec3 layeredHit(samplerCube seen0, samplerCube seen1, vec3 x, vec3 R, out int la
   for (int bracket = 0; bracket < LAYER_STEPS && i <= LAYER_STEPS; ++bracket) {
     bool at_end = false;
     float d = 0.0;
-    vec2 r = vec2(0.0);
+    vec2 r = vec2(0.0), w = vec2(0.0);
     for (; i <= LAYER_STEPS; ++i) {
       at_end = i == LAYER_STEPS;
-      if (at_end) p_last = x + R * d_prev, r_last = r_prev;
+      if (at_end) r_last = r_prev, w_last = w_prev;
       float t = float(i) / float(LAYER_STEPS);
       d = at_end ? 0.0 : a * t / (1.0 - t);
       vec3 p = x + R * d;
-      r = at_end ? vec2(2.0) : vec2(rayRatio(seen0, p), rayRatio(seen1, p));
+      vec4 s0 = texture(seen0, p), s1 = texture(seen1, p);
+      r = at_end ? vec2(2.0) : vec2(sampleRatio(p, s0), sampleRatio(p, s1));
+      w = vec2(s0.w, s1.w);
       if ((r_prev.x < 1.0 && r.x >= 1.0) || (r_prev.y < 1.0 && r.y >= 1.0)) break;
-      d_prev = d;
-      r_prev = r;
+      d_prev = d, r_prev = r, w_prev = w;
     }
     if (i > LAYER_STEPS) break;  // no bracket left
     vec3 l, best = l0;
@@ -196,11 +200,10 @@ vec3 layeredHit(samplerCube seen0, samplerCube seen1, vec3 x, vec3 R, out int la
       return l;
     }
     if (d_best >= 0.0) return best;
-    d_prev = d;
-    r_prev = r;
+    d_prev = d, r_prev = r, w_prev = w;
     ++i;
   }
-  if ((r_last.x >= 1.0 || texture(seen0, p_last).w < 0.5) && (r_last.y >= 1.0 || texture(seen1, p_last).w < 0.5)) {
+  if ((r_last.x >= 1.0 || w_last.x < 0.5) && (r_last.y >= 1.0 || w_last.y < 0.5)) {
     g_escaped = true;
     return R;
   }
