@@ -134,8 +134,8 @@ void main() {
   // and the environment drawn after the elements fills the pixel. So is one whose search did not come within
   // 1e-5 of its distance (counted by the tests as holes: none in the shipped mirrors).
   vec3 e = u_to_local * (u_view_origin - u_seen_offset), vl = u_to_local * view;
-  vec2 st = surfaceHit(v_st1.xy, e, vl) * u_sm.x + u_sm.y;
-  vec4 sp = bilinear(u_surf_p, st);  // w: 1 inside the outline
+  vec4 sp;  // the position map there; w: 1 inside the outline
+  vec2 st = surfaceHit(v_st1.xy, e, vl, sp) * u_sm.x + u_sm.y;
   vec3 w = sp.xyz - e;
   if (sp.w < 0.5 || length(w - dot(w, vl) * vl) > 1e-5 * length(w)) discard;
 #if defined(LAYER_PROBE)
