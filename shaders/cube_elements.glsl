@@ -56,8 +56,8 @@ uniform mat3 u_lens_to_local;     // world directions -> the lens's local frame 
 #define CUBE_LOOKUP(k)                                                                                              \
   if (cur == k) {                                                                                                  \
     centre = u_cube_centre[k];                                                                                     \
-    l = impostorHit(u_seen_cubes[k], x - centre, R);                                                               \
-    checkResolved(u_seen_cubes[k], l);                                                                             \
+    l = impostorHit(u_seen_cubes[k], x - centre, R, d_at);                                                         \
+    checkResolved(l, d_at);                                                                                        \
     c = texture(u_cubes[k], l).rgb;                                                                                \
     s = texture(u_seen_cubes[k], l);                                                                               \
     nid = texture(u_normal_cubes[k], l);                                                                           \
@@ -71,6 +71,7 @@ vec3 followCubes(int cur, vec3 x, vec3 R, int depth, int channel, out vec4 seen,
   for (int bounce = 0; bounce < MAX_DEPTH_LIMIT; ++bounce) {
     vec3 centre = vec3(0.0), l = R, c = vec3(0.0);
     vec4 s = vec4(0.0), nid = vec4(0.0);
+    float d_at;  // (one layer) the distance the cube holds at l
     CUBE_LOOKUP(0)
     CUBE_LOOKUP(1)
 #if CUBE_ELEMENTS > 2

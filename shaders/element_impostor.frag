@@ -49,8 +49,9 @@ void envHit(vec3 x, vec3 R, out vec3 colour, out vec4 seen) {
   seen = layer == 1 ? texture(u_seen_cube1, l) : texture(u_seen_cube, l);
   if (g_escaped) colour = u_background, seen = vec4(x + R * u_far, 0.0);  // past an occluder to the sky
 #else
-  vec3 l = impostorHit(u_seen_cube, x, R);
-  checkResolved(u_seen_cube, l);
+  float d_at;
+  vec3 l = impostorHit(u_seen_cube, x, R, d_at);
+  checkResolved(l, d_at);
   colour = texture(u_cube, l).rgb;
   seen = texture(u_seen_cube, l);
 #endif
@@ -133,8 +134,8 @@ void main() {
   // and the environment drawn after the elements fills the pixel. So is one whose search did not come within
   // 1e-5 of its distance (counted by the tests as holes: none in the shipped mirrors).
   vec3 e = u_to_local * (u_view_origin - u_seen_offset), vl = u_to_local * view;
-  vec2 st = surfaceHit(v_st1.xy, e, vl) * u_sm.x + u_sm.y;
-  vec4 sp = bilinear(u_surf_p, st);  // w: 1 inside the outline
+  vec4 sp;  // the position map there; w: 1 inside the outline
+  vec2 st = surfaceHit(v_st1.xy, e, vl, sp) * u_sm.x + u_sm.y;
   vec3 w = sp.xyz - e;
   if (sp.w < 0.5 || length(w - dot(w, vl) * vl) > 1e-5 * length(w)) discard;
 #if defined(LAYER_PROBE)

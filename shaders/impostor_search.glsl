@@ -8,9 +8,9 @@ float envDistance(samplerCube seen, vec3 dir) { return length(texture(seen, dir)
 // its ray meets (a surface hidden from the cube's origin, or the search ran out of steps). The second pass
 // marks its seen point (w + 2), and the renderer counts those pixels (pvrr/method/cube_quality.h).
 bool g_unresolved = false;
-// The first layer's search ended within 1e-3 of the distance the cube holds there (onSurface's tolerance).
-void checkResolved(samplerCube seen, vec3 l) {
-  float d = envDistance(seen, l);
+// The first layer's search ended within 1e-3 of the distance the cube holds there (onSurface's tolerance);
+// d: that distance (impostorHit's d_at).
+void checkResolved(vec3 l, float d) {
   if (!(abs(length(l) - d) <= 1e-3 * d)) g_unresolved = true;
 }
 
@@ -21,15 +21,19 @@ void checkResolved(samplerCube seen, vec3 l) {
 // R itself, at infinity, stands in for a missing overshoot, as in the paper).
 // falsePosition: that search from parameter dl, with the last undershooting (dun, ratio |l| / distance pun) and
 // overshooting (dov, pov) parameters so far (0: none); r1 the distance the impostor holds along R. d_at: the
-// distance the impostor holds at the point returned where the search read it there (it stopped on a ratio
-// within 1e-6 of 1), else -1: onSurface then need not read it again.
+// distance the impostor holds at the point returned, which the search reads there (it stopped on a ratio
+// within 1e-6 of 1, or its steps ran out and it read the point of the last), so that the caller's test of
+// the result (onSurface, checkResolved) need not read it again. That read is the loop's last pass: a renderer
+// that runs a branch's code for a whole SIMD group of pixels (llvmpipe masks lanes; it does not jump) paid for
+// the caller's read after the loop in every pixel, and pays for this pass only in groups where some pixel's
+// search ran out of steps.
 vec3 falsePosition(samplerCube seen, vec3 x, vec3 R, float r1, float dl, float dun, float pun, float dov, float pov,
                    out float d_at) {
   vec3 l = x + R * dl;
   d_at = -1.0;
-  for (int i = 0; i < IMPOSTOR_ITERATIONS; ++i) {
+  for (int i = 0; i <= IMPOSTOR_ITERATIONS; ++i) {
     float d = envDistance(seen, l), llp = length(l) / d;
-    if (abs(1.0 - llp) < 1e-6) {  // as close as float distances resolve
+    if (abs(1.0 - llp) < 1e-6 || i == IMPOSTOR_ITERATIONS) {  // as close as float distances resolve, or the last
       d_at = d;
       break;
     }
@@ -45,7 +49,7 @@ vec3 falsePosition(samplerCube seen, vec3 x, vec3 R, float r1, float dl, float d
     l = x + R * dl;
   }
   if (dot(l, l) > 0.0) return l;
-  d_at = -1.0;
+  d_at = r1;
   return R;  // x at the cube's origin and d = 0: the direction itself
 }
 // r1: the distance the impostor holds along R; d_at as falsePosition's.
@@ -59,8 +63,8 @@ vec3 impostorHit(samplerCube seen, vec3 x, vec3 R, out float r1, out float d_at)
   float dl = max(dp + r1 * (1.0 - ppp), 0.0);
   return falsePosition(seen, x, R, r1, dl, dun, pun, dov, pov, d_at);
 }
-vec3 impostorHit(samplerCube seen, vec3 x, vec3 R) {
-  float r1, d_at;
+vec3 impostorHit(samplerCube seen, vec3 x, vec3 R, out float d_at) {
+  float r1;
   return impostorHit(seen, x, R, r1, d_at);
 }
 
@@ -74,10 +78,9 @@ vec3 impostorHit(samplerCube seen, vec3 x, vec3 R) {
 // distance jumps (1.5 texels to either side, across the ray's sweep, the farther more than 1.5 x the nearer),
 // the filtered distance blends the two surfaces, and the search ends between them, at a point on neither:
 // more than 1.25 x the nearer's distance and less than 0.8 x the farther's.
-// d_at: the distance the layer holds at l if the search read it there, else -1.
-bool onSurface(samplerCube seen, vec3 l, vec3 R, float d_at) {
-  float len = length(l), d = d_at;
-  if (d < 0.0) d = envDistance(seen, l);
+// d: the distance the layer holds at l (falsePosition's d_at).
+bool onSurface(samplerCube seen, vec3 l, vec3 R, float d) {
+  float len = length(l);
   if (!(abs(len - d) <= 1e-3 * d)) return false;
   vec3 u = l / len, t = R - dot(R, u) * u;
   float tl = length(t);
@@ -88,11 +91,13 @@ bool onSurface(samplerCube seen, vec3 l, vec3 R, float d_at) {
   return !(df > 1.5 * dn && len > 1.25 * dn && len < 0.8 * df);
 }
 
-// |p| / the layer's distance in p's direction: below 1 in front of the layer, above behind it.
-float rayRatio(samplerCube seen, vec3 p) {
+// |p| / the layer's distance in p's direction (s: the layer's texel there): below 1 in front of the layer,
+// above behind it.
+float sampleRatio(vec3 p, vec4 s) {
   float len = length(p);
-  return len > 0.0 ? len / envDistance(seen, p) : 0.0;
+  return len > 0.0 ? len / length(s.xyz) : 0.0;
 }
+float rayRatio(samplerCube seen, vec3 p) { return sampleRatio(p, texture(seen, p)); }
 
 // A crossing of a layer between the march's parameters d0 (ratio r0 < 1) and d1 (ratio r1 >= 1; at_end: the
 // ray's end at infinity), refined by false position; whether it lies on the layer's surface. rR: the distance
@@ -157,16 +162,34 @@ vec3 layeredHit(samplerCube seen0, samplerCube seen1, vec3 x, vec3 R, out int la
 #else
   float a = length(x), t0 = 0.25 / float(LAYER_STEPS), d_prev = a * t0 / (1.0 - t0);
   vec3 p0 = x + R * d_prev;
-  vec2 r_prev = vec2(rayRatio(seen0, p0), rayRatio(seen1, p0));
+  vec4 s0 = texture(seen0, p0), s1 = texture(seen1, p0);
+  // Each sample's ratios (rayRatio) and texels' w (0: the sky) in the two layers.
+  vec2 r_prev = vec2(sampleRatio(p0, s0), sampleRatio(p0, s1)), w_prev = vec2(s0.w, s1.w);
   float rR1 = envDistance(seen1, R);
-  vec3 p_last = p0;   // the last finite sample
-  vec2 r_last = r_prev;
-  for (int i = 1; i <= LAYER_STEPS; ++i) {
-    bool at_end = i == LAYER_STEPS;
-    if (at_end) p_last = x + R * d_prev, r_last = r_prev;
-    float t = float(i) / float(LAYER_STEPS), d = at_end ? 0.0 : a * t / (1.0 - t);
-    vec3 p = x + R * d;
-    vec2 r = at_end ? vec2(2.0) : vec2(rayRatio(seen0, p), rayRatio(seen1, p));
+  vec2 r_last = r_prev, w_last = w_prev;  // at the last finite sample
+  // The steps run in an inner loop that only looks for the next bracket (two cube reads a step); its
+  // refinement runs after it, once per bracket. A renderer that runs a branch's code for a whole SIMD group of
+  // pixels whether or not any of them takes it (llvmpipe: it masks lanes, it does not jump) paid for both
+  // layers' refinements and surface tests at every step when they sat in the step loop: 10 cube reads a step
+  // where 2 are needed. The brackets found and their order are those of one loop.
+  int i = 1;
+  for (int bracket = 0; bracket < LAYER_STEPS && i <= LAYER_STEPS; ++bracket) {
+    bool at_end = false;
+    float d = 0.0;
+    vec2 r = vec2(0.0), w = vec2(0.0);
+    for (; i <= LAYER_STEPS; ++i) {
+      at_end = i == LAYER_STEPS;
+      if (at_end) r_last = r_prev, w_last = w_prev;
+      float t = float(i) / float(LAYER_STEPS);
+      d = at_end ? 0.0 : a * t / (1.0 - t);
+      vec3 p = x + R * d;
+      vec4 s0 = texture(seen0, p), s1 = texture(seen1, p);
+      r = at_end ? vec2(2.0) : vec2(sampleRatio(p, s0), sampleRatio(p, s1));
+      w = vec2(s0.w, s1.w);
+      if ((r_prev.x < 1.0 && r.x >= 1.0) || (r_prev.y < 1.0 && r.y >= 1.0)) break;
+      d_prev = d, r_prev = r, w_prev = w;
+    }
+    if (i > LAYER_STEPS) break;  // no bracket left
     vec3 l, best = l0;
     float d_best = -1.0;
     if (r_prev.x < 1.0 && r.x >= 1.0 && layerCrossing(seen0, x, R, rR0, d_prev, r_prev.x, d, r.x, at_end, l))
@@ -177,10 +200,10 @@ vec3 layeredHit(samplerCube seen0, samplerCube seen1, vec3 x, vec3 R, out int la
       return l;
     }
     if (d_best >= 0.0) return best;
-    d_prev = d;
-    r_prev = r;
+    d_prev = d, r_prev = r, w_prev = w;
+    ++i;
   }
-  if ((r_last.x >= 1.0 || texture(seen0, p_last).w < 0.5) && (r_last.y >= 1.0 || texture(seen1, p_last).w < 0.5)) {
+  if ((r_last.x >= 1.0 || w_last.x < 0.5) && (r_last.y >= 1.0 || w_last.y < 0.5)) {
     g_escaped = true;
     return R;
   }

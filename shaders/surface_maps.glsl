@@ -14,10 +14,13 @@ uniform vec2 u_sm;                // texture coordinate = (s, t) * u_sm.x + u_sm
 // step is below 1e-6 of the domain (the rest is float noise: about half the fragments never reach 1e-7), or
 // the ray runs along the surface. The derivatives are read once, at the start: the steps are a few texels
 // long, so the first Jacobian steers them as well (one surface-map read a step instead of three). The caller
-// tests the distance left.
-vec2 surfaceHit(vec2 uv, vec3 e, vec3 v) {
+// tests the distance left. sp: the position map at the parameters returned (bilinear(u_surf_p, ...)), read
+// by each step after its move, so that the caller need not read it again (a renderer that runs every path for
+// a whole SIMD group of pixels, llvmpipe, paid for that read in every pixel).
+vec2 surfaceHit(vec2 uv, vec3 e, vec3 v, out vec4 sp) {
   vec2 st = uv * u_sm.x + u_sm.y;
-  vec3 w = bilinear(u_surf_p, st).xyz - e;
+  sp = bilinear(u_surf_p, st);
+  vec3 w = sp.xyz - e;
   vec3 r = w - dot(w, v) * v;
   if (length(r) <= 1e-7 * length(w)) return uv;
   vec3 su = bilinear(u_surf_du, st).xyz, sv = bilinear(u_surf_dv, st).xyz;
@@ -32,9 +35,10 @@ vec2 surfaceHit(vec2 uv, vec3 e, vec3 v) {
     float len = length(delta);
     if (len > 0.1) delta *= 0.1 / len;
     uv = clamp(uv + delta, vec2(0.0), vec2(1.0));
-    if (i == 5 || len < 1e-6) break;
     st = uv * u_sm.x + u_sm.y;
-    w = bilinear(u_surf_p, st).xyz - e;
+    sp = bilinear(u_surf_p, st);
+    if (i == 5 || len < 1e-6) break;
+    w = sp.xyz - e;
     r = w - dot(w, v) * v;
     if (length(r) <= 1e-7 * length(w)) break;
   }
