@@ -96,7 +96,16 @@ CausticVertex vertexOf(const Traced& t, double x, double y) {
 // Landed power per receiving mesh: (landing point, weight) of each vertex photon that meets a mesh.
 using Landings = std::vector<std::vector<std::pair<Vec3, double>>>;
 
-CausticMesh tracePair(const PairTracer& tr, const CausticPlanOptions& o, Landings& landed, long long& traced) {
+// A kept cell on a curved receiver is refined as well when the photon at its centre does not land where its
+// corners' landings predict (their mean) within kJumpFraction of their spread: the receiver shadows itself
+// along the photons' paths (a bump hiding what lies behind it), a jump in the landing distance that the texels'
+// interpolation would smear across the cell. A smooth surface's deviation is second order in the cell's size.
+constexpr double kJumpFraction = 0.25;
+
+Vec3 landing(const Traced& t) { return t.p.origin + t.p.t_hit * t.p.direction; }
+
+CausticMesh tracePair(const PairTracer& tr, const CausticPlanOptions& o, const std::vector<bool>& curved,
+                      Landings& landed, long long& traced) {
   const CausticAperture& ap = tr.ap;
   const int g = o.grid, s = o.refine;
   const double dx = (ap.x1 - ap.x0) / g, dy = (ap.y1 - ap.y0) / g;
@@ -120,11 +129,35 @@ CausticMesh tracePair(const PairTracer& tr, const CausticPlanOptions& o, Landing
     }
   std::vector<std::pair<int, int>> to_refine;
   double kept_area = 0;
+  // Consistent cells on a curved receiver: their centres traced (in parallel) before they are kept.
+  std::vector<char> jump(size_t(g) * size_t(g), 0);
+  if (s > 1) {
+    std::vector<std::pair<int, int>> check;
+    for (int j = 0; j < g; ++j)
+      for (int i = 0; i < g; ++i) {
+        const uint32_t a = uint32_t(j * (g + 1) + i), b = a + 1, c = a + uint32_t(g) + 2, d = a + uint32_t(g) + 1;
+        const Traced* corners[4] = {&grid[a], &grid[b], &grid[c], &grid[d]};
+        const int mesh = corners[0]->p.mesh;
+        if (consistent(corners) && mesh >= 0 && curved[size_t(mesh)]) check.push_back({i, j});
+      }
+    tbb::parallel_for(size_t(0), check.size(), [&](size_t k) {
+      const auto [i, j] = check[k];
+      const uint32_t a = uint32_t(j * (g + 1) + i), b = a + 1, c = a + uint32_t(g) + 2, d = a + uint32_t(g) + 1;
+      const Traced centre = tr.at(ap.x0 + (i + 0.5) * dx, ap.y0 + (j + 0.5) * dy);
+      const Vec3 mean = 0.25 * (landing(grid[a]) + landing(grid[b]) + landing(grid[c]) + landing(grid[d]));
+      double spread = 0;
+      for (uint32_t v : {a, b, c, d}) spread = std::max(spread, glm::length(landing(grid[v]) - mean));
+      jump[size_t(j) * size_t(g) + size_t(i)] =
+          !centre.left || centre.p.mesh != grid[a].p.mesh || centre.p.bounces != grid[a].p.bounces ||
+          glm::length(landing(centre) - mean) > kJumpFraction * spread;
+    });
+    traced += (long long)check.size();
+  }
   for (int j = 0; j < g; ++j)
     for (int i = 0; i < g; ++i) {
       const uint32_t a = uint32_t(j * (g + 1) + i), b = a + 1, c = a + uint32_t(g) + 2, d = a + uint32_t(g) + 1;
       const Traced* corners[4] = {&grid[a], &grid[b], &grid[c], &grid[d]};
-      if (consistent(corners)) {
+      if (consistent(corners) && !jump[size_t(j) * size_t(g) + size_t(i)]) {
         addQuad(m.triangles, a, b, c, d);
         kept_area += dx * dy;
       } else if (s > 1 && (corners[0]->left || corners[1]->left || corners[2]->left || corners[3]->left)) {
@@ -389,6 +422,12 @@ CausticPlan planCaustics(const RayScene& rays, const CausticPlanOptions& o) {
   const std::vector<SpectralSample> samples = causticSamples(scene, co);
   const bool spectral = o.dispersion == DispersionMode::Spectral;
   Landings landed(scene.meshes.size());
+  std::vector<CausticReceiver> candidates = planarReceivers(scene);
+  std::vector<bool> curved_mesh(scene.meshes.size(), false);
+  for (CausticReceiver& r : heightFieldReceivers(scene)) {
+    curved_mesh[size_t(r.mesh)] = true;
+    candidates.push_back(std::move(r));
+  }
   for (const int li : causticLights(scene)) {
     const Light& light = scene.lights[size_t(li)];
     for (size_t ei = 0; ei < scene.elements.size(); ++ei) {
@@ -401,7 +440,7 @@ CausticPlan planCaustics(const RayScene& rays, const CausticPlanOptions& o) {
       }
       for (size_t si = 0; si < samples.size(); ++si) {
         const PairTracer tr{rays, light, ap, samples[si], int(ei), spectral, o.max_depth};
-        CausticMesh m = tracePair(tr, o, landed, plan.traced);
+        CausticMesh m = tracePair(tr, o, curved_mesh, landed, plan.traced);
         if (m.triangles.empty()) {
           if (si == 0)
             plan.notes.push_back("light " + std::to_string(li) + ", element \"" + scene.elements[ei].name +
@@ -416,8 +455,6 @@ CausticPlan planCaustics(const RayScene& rays, const CausticPlanOptions& o) {
       }
     }
   }
-  std::vector<CausticReceiver> candidates = planarReceivers(scene);
-  for (CausticReceiver& r : heightFieldReceivers(scene)) candidates.push_back(std::move(r));
   std::vector<bool> is_receiver(scene.meshes.size(), false);
   for (CausticReceiver& r : candidates) {
     is_receiver[size_t(r.mesh)] = true;

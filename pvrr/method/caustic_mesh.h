@@ -6,8 +6,9 @@
 // vertices of a grid over the aperture instead of at jittered points: a "photon mesh". A cell whose four
 // corners took the same path (all left the element, after as many specular events, towards the same receiver)
 // is kept as two triangles; a cell whose corners differ (the element's rim, a shadow's edge, total internal
-// reflection setting in) is traced again on a finer sub-grid and its consistent sub-cells kept. The GPU
-// rasterizes the mesh into a caustic map over the aperture (one photon per texel, its exit ray and power
+// reflection setting in) is traced again on a finer sub-grid and its consistent sub-cells kept; so is a cell on a
+// curved receiver whose centre photon lands away from where its corners predict (the receiver shadowing itself).
+// The GPU rasterizes the mesh into a caustic map over the aperture (one photon per texel, its exit ray and power
 // interpolated between exact vertices) and splats the photons into the receivers' light maps.
 //
 // Receivers: the environment meshes that are planar (quads, grounds, flat meshes: every triangle in one

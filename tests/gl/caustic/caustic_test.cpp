@@ -332,6 +332,59 @@ TEST_P(CausticTest, BeamOnABowlMapAndPicture) {
   EXPECT_LE(diff / total, 0.10);
 }
 
+// A receiver that shadows itself: the plane mirror's beam grazes a wavy surface (its plane 70 deg from the beam,
+// waves 20 mm long and 2 mm high: slopes up to 0.63, steeper than the beam's 0.36), so each crest hides part of
+// the trough behind it and the landing distance jumps there. The photon mesh refines the cells whose centre
+// photon does not land where their corners predict (pvrr/method/caustic_mesh.cpp kJumpFraction), so the texels
+// do not smear light into the shadows: raster against reference over the whole map (relative L1 of all cells)
+// and in the spot, the 10 %.
+TEST_P(CausticTest, ASelfShadowingReceiverKeepsItsShadows) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  const Vec3 n = glm::normalize(Vec3(-0.342, 0, 0.940));
+  const Vec3 beam(1, 0, 0);
+  test::HeightField f;
+  f.base = Vec3(0.4, 0, 0), f.n = n, f.u = glm::normalize(beam - glm::dot(beam, n) * n);
+  f.half_x = 0.12, f.half_y = 0.06;
+  constexpr double kA = 0.002, kK = 2 * kPi / 0.02;
+  f.height = [=](double x, double) { return kA * std::sin(kK * x); };
+  f.gradient = [=](double x, double) { return Vec2(kA * kK * std::cos(kK * x), 0.0); };
+  Scene s;
+  s.name = "grazing-waves";
+  s.observer.eye = Vec3(0.3, 0.3, 0.3);
+  s.observer.target = Vec3(0.4, 0, 0);
+  s.meshes.push_back(test::heightFieldMesh(f, 240, 60, "waves"));
+  s.materials.push_back(DiffuseMaterial{});
+  Light sun;
+  sun.direction = Vec3(0, 0, -1);
+  sun.caustics = true;
+  s.lights = {sun};
+  const cad::Outline disc = cad::Outline::circle(0.1);
+  test::addMirror(s, cad::makePlane(disc), disc, test::pose(Vec3(0), glm::normalize(Vec3(1, 0, 1))), 7, 0.9);
+  s.updateBounds();
+  RayScene rays(s);
+  gl::Renderer renderer(s, rays, gl::RendererOptions{});
+  const gl::RasterFrame frame = renderer.render(RenderMode::Raster);
+  const StageTiming* stage = frame.stages.find(gl::kCausticMapsStage);
+  ASSERT_TRUE(stage && stage->ran);
+  std::printf("[ caustic ] stage: %s\n", stage->note.c_str());
+  const std::vector<gl::CausticMap> maps = renderer.causticMaps();
+  const gl::CausticMap* map = mapOf(maps, s, "waves");
+  ASSERT_TRUE(map);
+  const IrradianceGrid ref = referenceOn(rays, *map);
+  const IrradianceComparison cmp = compareIrradiance(map->grid, ref);
+  print("beam grazing waves", cmp);
+  double diff = 0, total = 0;
+  for (size_t k = 0; k < ref.irradiance.size(); ++k) {
+    diff += std::abs(map->grid.irradiance[k].x - ref.irradiance[k].x);
+    total += ref.irradiance[k].x;
+  }
+  std::printf("[ caustic ] beam grazing waves: relative L1 over the whole map %.4f\n", diff / total);
+  EXPECT_LE(cmp.relative_l1_in_spot, kSpotL1Tol);
+  EXPECT_LE(diff / total, kSpotL1Tol);
+  EXPECT_NEAR(cmp.power_ratio, 1, 0.02);
+}
+
 // Off unless a light turns it on: no stage work and no caustic defines (so no existing pixel changes).
 TEST_P(CausticTest, OffUnlessALightTurnsItOn) {
   const auto ctx = test::glContextOrFail(GetParam());
