@@ -149,10 +149,12 @@ const std::map<std::string, Command>& commands() {
         "         [--element NAME] [--set PATH=VALUE]... --out DIR\n"
         "  Light tracing from the directional and point lights through the elements (N x N photons per light,\n"
         "  element and wavelength sample, default 512, at most 2048; render.dispersion sets the samples) onto the\n"
-        "  receiver: a quad or ground of the scene (default: the one receiving the most caustic power). The map\n"
-        "  covers the window (receiver coordinates in metres about its centre; default: around the light that\n"
-        "  lands) in N cells along its longer side (default 160). Writes DIR/caustic.png (false colour, colour bar\n"
-        "  in W/m^2), DIR/caustic-colour.png (the irradiance in colour), DIR/caustic.csv (per cell:\n"
+        "  receiver: a quad or ground of the scene, or a mesh that is a height field over a plane (a bowl, a\n"
+        "  cylinder segment: mapped over that plane, per unit area of its surface) (default: the one receiving the\n"
+        "  most caustic power). The map covers the window (receiver coordinates in metres about its centre;\n"
+        "  default: around the light that lands) in N cells along its longer side (default 160). Writes\n"
+        "  DIR/caustic.png (false colour, colour bar in W/m^2), DIR/caustic-colour.png (the irradiance in colour),\n"
+        "  DIR/caustic.csv (per cell:\n"
         "  i,j,u_m,v_m,x_m,y_m,z_m,irradiance_r,irradiance_g,irradiance_b,irradiance,stderr) and DIR/caustic.json\n"
         "  (peak, spot, power, photon counts). Method and accuracy: docs/caustics.md."}},
       {"mesh",

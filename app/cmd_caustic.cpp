@@ -15,6 +15,7 @@
 #include "pvrr/analysis/caustic_metrics.h"
 #include "pvrr/base/error.h"
 #include "pvrr/base/format.h"
+#include "pvrr/method/caustic_mesh.h"
 #include "pvrr/trace/light_tracer.h"
 
 namespace fs = std::filesystem;
@@ -44,12 +45,22 @@ json vec3(const Vec3& v) { return json::array({v.x, v.y, v.z}); }
 json vec2(const Vec2& v) { return json::array({v.x, v.y}); }
 double mean3(const Vec3& v) { return (v.x + v.y + v.z) / 3.0; }
 
-// A receiver: a quad or ground of the scene (their rectangles are the scene's own).
+// A receiver: a quad or ground of the scene (their rectangles are the scene's own), or a curved mesh that is a
+// height field over its best-fit plane (pvrr/method/caustic_mesh.h heightFieldReceivers: the rectangle in that
+// plane; the map holds the irradiance per unit area of the surface).
 struct Receiver {
-  int index = -1;  // environment object = mesh index
+  int index = -1;  // environment object = mesh index (a curved receiver: its mesh index)
   std::string name;
   ReceiverRect rect;
+  bool curved = false;
 };
+
+// The height-field receiver of mesh `mesh`, if it is one.
+std::optional<Receiver> curvedReceiver(const Scene& scene, int mesh) {
+  for (const CausticReceiver& c : heightFieldReceivers(scene))
+    if (c.mesh == mesh) return Receiver{mesh, scene.meshes[size_t(mesh)].name, c.full, true};
+  return std::nullopt;
+}
 
 Receiver receiverOf(const SceneDesc& desc, int index) {
   const EnvObjectDesc& o = desc.environment[size_t(index)];
@@ -68,8 +79,9 @@ bool isPlanar(const EnvObjectDesc& o) {
   return o.type == EnvObjectDesc::Type::Quad || o.type == EnvObjectDesc::Type::Ground;
 }
 
-// --receiver NAME, else the quad or ground that receives the most caustic power.
-Receiver chooseReceiver(const SceneDesc& desc, const PhotonBundle& b, const Args& a, const std::string& path) {
+// --receiver NAME, else the quad, ground or height-field mesh that receives the most caustic power.
+Receiver chooseReceiver(const SceneDesc& desc, const Scene& scene, const PhotonBundle& b, const Args& a,
+                        const std::string& path) {
   const std::optional<std::string> asked = a.get("receiver");
   if (asked) {
     std::vector<std::string> names;
@@ -79,24 +91,32 @@ Receiver chooseReceiver(const SceneDesc& desc, const PhotonBundle& b, const Args
         names.push_back(o.name);
         continue;
       }
-      if (!isPlanar(o))
-        throw Error(path + ": environment[" + std::to_string(i) + "] (" + o.name + "): a receiver must be a quad or " +
-                    "ground, not a " + std::string(nameOf(o.type)));
-      return receiverOf(desc, int(i));
+      if (isPlanar(o)) return receiverOf(desc, int(i));
+      for (size_t m = 0; m < scene.meshes.size(); ++m)
+        if (scene.meshes[m].name == *asked)
+          if (const std::optional<Receiver> c = curvedReceiver(scene, int(m))) return *c;
+      throw Error(path + ": environment[" + std::to_string(i) + "] (" + o.name + "): a receiver must be a quad, a " +
+                  "ground or a mesh that is a height field over a plane, not this " + std::string(nameOf(o.type)));
     }
     const std::string hint = nearest(*asked, names);
     throw Error(path + ": environment: no object named \"" + *asked + "\"" +
                 (hint.empty() ? "" : "; did you mean \"" + hint + "\"?"));
   }
-  std::vector<double> power(desc.environment.size(), 0.0);
+  std::vector<double> power(std::max(desc.environment.size(), scene.meshes.size()), 0.0);
   for (const CausticPhoton& p : b.photons)
     if (p.mesh >= 0 && size_t(p.mesh) < power.size()) power[size_t(p.mesh)] += mean3(p.power);
   int best = -1;
-  for (size_t i = 0; i < power.size(); ++i)
+  for (size_t i = 0; i < desc.environment.size(); ++i)
     if (isPlanar(desc.environment[i]) && power[i] > 0 && (best < 0 || power[i] > power[size_t(best)])) best = int(i);
+  std::optional<Receiver> curved;
+  for (const CausticReceiver& c : heightFieldReceivers(scene))
+    if (power[size_t(c.mesh)] > 0 && power[size_t(c.mesh)] > (best < 0 ? 0.0 : power[size_t(best)]) &&
+        (!curved || power[size_t(c.mesh)] > power[size_t(curved->index)]))
+      curved = Receiver{c.mesh, scene.meshes[size_t(c.mesh)].name, c.full, true};
+  if (curved) return *curved;
   if (best < 0)
-    throw Error(path + ": environment: no quad or ground receives caustic light (" + std::to_string(b.photons.size()) +
-                " photons left the elements); name a receiver with --receiver");
+    throw Error(path + ": environment: no quad, ground or height-field mesh receives caustic light (" +
+                std::to_string(b.photons.size()) + " photons left the elements); name a receiver with --receiver");
   return receiverOf(desc, best);
 }
 
@@ -234,6 +254,7 @@ json resultJson(const std::string& scene_path, const Scene& scene, const Receive
   json j;
   j["scene"] = scene_path;
   j["receiver"] = {{"name", rec.name},
+                   {"curved", rec.curved},
                    {"centre", vec3(full.centre)},
                    {"u_axis", vec3(full.u_axis)},
                    {"v_axis", vec3(full.v_axis)},
@@ -248,7 +269,10 @@ json resultJson(const std::string& scene_path, const Scene& scene, const Receive
                  {"dispersion", nameOf(o.dispersion)},
                  {"seed", o.seed},
                  {"max_depth", o.max_depth},
-                 {"kernel", "tent (bilinear) one cell wide; irradiance per unit area of the receiver"},
+                 {"kernel", rec.curved ? "tent (bilinear) one cell wide over the receiver's best-fit plane; irradiance "
+                                         "per unit area of the curved surface (each photon weighed by cos between "
+                                         "the surface's normal and the plane's)"
+                                       : "tent (bilinear) one cell wide; irradiance per unit area of the receiver"},
                  {"paths", "light -> mirrors/lenses (specular only) -> receiver; direct light not included"}};
   j["photons"] = {{"emitted", b.emitted},
                   {"entered_elements", b.entered},
@@ -261,6 +285,9 @@ json resultJson(const std::string& scene_path, const Scene& scene, const Receive
                   {"on_window", mean3(res.landed_power)},
                   {"on_grid", mean3(res.grid.power())},
                   {"on_grid_rgb", vec3(res.grid.power())}};
+  if (rec.curved)
+    j["power_w"]["on_grid_meaning"] = "sum of irradiance x cell area of the plane; the curved surface over a cell is "
+                                      "larger (cell area / cos), so this is under the surface's power (on_window)";
   j["peak"] = {{"irradiance_w_m2", s.peak_irradiance},
                {"uv_m", vec2(full.toReceiver(s.peak_world))},
                {"world", vec3(s.peak_world)},
@@ -311,7 +338,7 @@ int cmdCaustic(const std::vector<std::string>& argv) {
     throw Error(scene_path + ": lights: no photon from a directional or point light leaves an element (" +
                 std::to_string(b.emitted) + " shot, " + std::to_string(b.entered) + " met an element, " +
                 std::to_string(b.absorbed) + " absorbed)");
-  Receiver rec = chooseReceiver(ls.desc, b, a, scene_path);
+  Receiver rec = chooseReceiver(ls.desc, scene, b, a, scene_path);
   const ReceiverRect full = rec.rect;
   chooseWindow(rec, b, a, scene_path);
   const double cell = std::max(rec.rect.width_m, rec.rect.height_m) / cells;
@@ -320,6 +347,7 @@ int cmdCaustic(const std::vector<std::string>& argv) {
   DepositOptions dep;
   dep.mesh = rec.index;
   dep.slab_m = kSlab_m;
+  dep.height_field = rec.curved;
   const CausticResult res = depositPhotons(b, rec.rect, dep);
   const SpotMetrics s = spotMetrics(res.grid);
   if (!s.found) throw Error(scene_path + ": environment (" + rec.name + "): no caustic light inside the window");

@@ -73,6 +73,7 @@ nlohmann::json compareCaustics(LoadedScene& ls, const std::string& gl_name, cons
     const std::string name = ls.scene.meshes[size_t(m.mesh)].name;
     DepositOptions d;
     d.mesh = m.mesh;
+    d.height_field = !m.height.empty();  // a curved receiver: irradiance per unit area of its surface
     const IrradianceGrid ref = depositPhotons(bundle, m.grid.rect, d).grid;
     json j = {{"receiver", name},
               {"cells", {m.grid.rect.cells_u, m.grid.rect.cells_v}},

@@ -1,5 +1,7 @@
 // The caustic light on the environment (pvrr/gl/caustic_pass.h): the receivers' light maps, irradiance per
-// unit area of a planar receiver (W/m^2 in the scene's light units), added to the diffuse light as
+// unit area of the receiving surface (W/m^2 in the scene's light units), looked up at the point's projection
+// onto the receiver's plane where the point's height over that plane is the map's (its alpha: the surface's
+// height, bilinear between cell centres; 0 for a planar receiver), added to the diffuse light as
 // albedo * E (the shading model of shading.glsl, where a directional light of intensity 1 facing the surface
 // gives albedo * 1). CAUSTICS: a light has caustics on; the maps are the layers of one RGBA32F array, each
 // receiver's cells in its lower-left corner, filtered bilinearly between cell centres (the texel centres).
@@ -19,10 +21,12 @@ vec3 causticIrradiance(vec3 p) {
   for (int r = 0; r < CAUSTIC_RECEIVERS; ++r) {
     if (r >= u_caustic_count) break;
     vec3 x = p - u_caustic_centre[r];
-    if (abs(dot(x, cross(u_caustic_u[r], u_caustic_v[r]))) > CAUSTIC_SLAB_M) continue;
     vec2 c = vec2(dot(x, u_caustic_u[r]), dot(x, u_caustic_v[r])) * u_caustic_scale[r].xy + u_caustic_scale[r].zw;
     if (any(lessThan(c, vec2(0.0))) || any(greaterThan(c, u_caustic_extent[r]))) continue;
-    e += texture(u_caustic_map, vec3(c, float(r))).rgb;
+    vec4 m = texture(u_caustic_map, vec3(c, float(r)));
+    // The point lies on the receiver where its height over the plane is the map's (alpha: 0 for a planar one).
+    if (!(abs(dot(x, cross(u_caustic_u[r], u_caustic_v[r])) - m.a) <= CAUSTIC_SLAB_M)) continue;
+    e += m.rgb;
   }
   return e;
 }

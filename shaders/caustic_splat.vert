@@ -1,7 +1,7 @@
 #version 330 core
 // Splats the caustic map's photons into one receiver's light map (pvrr/gl/caustic_pass.h): one point per
-// texel (gl_VertexID), drawn where its exit ray first meets a mapped receiver's plane inside that receiver's
-// rectangle, if that receiver is this map's and the mesh the photon's exit ray meets first (the caustic map's
+// texel (gl_VertexID), drawn where its exit ray first meets a mapped receiver's plane (a curved receiver: the
+// receiver itself, projected onto its plane) inside that receiver's rectangle, if that receiver is this map's and the mesh the photon's exit ray meets first (the caustic map's
 // direction w): light stopped by anything else lands on no map. Positions are relative to the photon mesh's anchor.
 #define CAUSTIC_RECEIVERS 4
 uniform sampler2D u_origin;
@@ -16,6 +16,7 @@ uniform vec3 u_axis_u[CAUSTIC_RECEIVERS];
 uniform vec3 u_axis_v[CAUSTIC_RECEIVERS];
 uniform vec2 u_half[CAUSTIC_RECEIVERS];
 uniform int u_mesh[CAUSTIC_RECEIVERS];             // each receiver's Scene::meshes index
+uniform int u_curved[CAUSTIC_RECEIVERS];           // 1: curved (a height field over its rectangle's plane)
 uniform vec2 u_window_centre;                      // the drawn map's window, receiver coordinates (m)
 uniform vec2 u_window_size;
 uniform vec2 u_cells;
@@ -38,6 +39,19 @@ void main() {
   for (int r = 0; r < CAUSTIC_RECEIVERS; ++r) {
     if (r >= u_receivers) break;
     if (u_mesh[r] != mesh) continue;
+    if (u_curved[r] != 0) {
+      // The ray's first hit on the mesh itself, at the texel's distance (the power map's w, interpolated between
+      // the exact hits at the photon mesh's vertices), projected onto the receiver's plane.
+      float s_hit = texelFetch(u_power, t, 0).w;
+      if (!(s_hit > 0.0) || s_hit >= best) continue;
+      vec3 x_hit = o.xyz + s_hit * d - u_centre[r];
+      vec2 uv_curved = vec2(dot(x_hit, u_axis_u[r]), dot(x_hit, u_axis_v[r]));
+      if (any(greaterThan(abs(uv_curved), u_half[r]))) continue;
+      best = s_hit;
+      hit = r;
+      uv_hit = uv_curved;
+      continue;
+    }
     vec3 n = cross(u_axis_u[r], u_axis_v[r]);
     float dn = dot(d, n);
     if (dn == 0.0) continue;

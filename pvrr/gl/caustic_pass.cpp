@@ -84,7 +84,7 @@ void CausticPass::update(FrameStages& stages) {
   rendered_mesh_motion_ = scene_.mesh_motion;
   rendered_ = true;
   if (plan_.receivers.empty()) {
-    std::string why = "no caustic light lands on a planar receiver";
+    std::string why = "no caustic light lands on a planar or height-field receiver";
     for (const std::string& n : plan_.notes) why += "; " + n;
     stages.skipped(kCausticMapsStage, why);
     return;
@@ -118,6 +118,22 @@ void CausticPass::render() {
     glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, maps_, 0, GLint(r));
     glClear(GL_COLOR_BUFFER_BIT);
   }
+  // A curved receiver's layer holds the surface's height over its plane in alpha (the lookup's test of whether a
+  // point lies on it); the splat adds 0 there. Cells beyond its window: kNoHeight.
+  for (size_t r = 0; r < plan_.receivers.size(); ++r) {
+    const CausticReceiver& rec = plan_.receivers[r];
+    if (!rec.curved) continue;
+    std::vector<float> texels(size_t(cells_side_) * size_t(cells_side_) * 4, 0.0f);
+    for (int j = 0; j < cells_side_; ++j)
+      for (int i = 0; i < cells_side_; ++i)
+        texels[(size_t(j) * size_t(cells_side_) + size_t(i)) * 4 + 3] =
+            i < rec.window.cells_u && j < rec.window.cells_v ? rec.height[size_t(j) * size_t(rec.window.cells_u) + size_t(i)]
+                                                             : kNoHeight;
+    glBindTexture(GL_TEXTURE_2D_ARRAY, maps_);
+    glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, GLint(r), cells_side_, cells_side_, 1, GL_RGBA, GL_FLOAT,
+                    texels.data());
+    glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
+  }
   // The photon maps: exit origin, direction and power per texel.
   if (!photon_fbo_) {
     glGenFramebuffers(1, &photon_fbo_);
@@ -145,17 +161,24 @@ void CausticPass::render() {
 // One photon mesh: its caustic map, then its photons into each receiver's light map.
 void CausticPass::splat(const CausticMesh& m) {
   const CausticAperture& ap = m.aperture;
+  // A curved receiver's plane normal per mesh: its photons' power is weighed by cos(theta) between the hit's
+  // normal and that plane's (irradiance per unit area of the surface, as DepositOptions::height_field).
+  std::vector<const ReceiverRect*> curved(scene_.meshes.size(), nullptr);
+  for (const CausticReceiver& r : plan_.receivers)
+    if (r.curved) curved[size_t(r.mesh)] = &r.full;
   std::vector<float> data;
-  data.reserve(m.vertices.size() * 12);
+  data.reserve(m.vertices.size() * 13);
   for (const CausticVertex& v : m.vertices) {
     const Vec3 o = v.origin - m.anchor;
+    const ReceiverRect* c = v.mesh >= 0 ? curved[size_t(v.mesh)] : nullptr;
+    const Vec3 power = c ? v.power_density * std::abs(glm::dot(v.hit_normal, c->normal())) : v.power_density;
     data.insert(data.end(),
                 {float(2 * (v.xy.x - ap.x0) / (ap.x1 - ap.x0) - 1), float(2 * (v.xy.y - ap.y0) / (ap.y1 - ap.y0) - 1),
                  float(o.x), float(o.y), float(o.z), float(v.direction.x), float(v.direction.y), float(v.direction.z),
-                 float(v.power_density.x), float(v.power_density.y), float(v.power_density.z), float(v.mesh)});
+                 float(power.x), float(power.y), float(power.z), float(v.mesh), float(v.t_hit)});
   }
   MeshBuffers mesh;
-  uploadMesh(mesh, data, {2, 3, 3, 3, 1}, m.triangles);
+  uploadMesh(mesh, data, {2, 3, 3, 3, 1, 1}, m.triangles);
   glBindFramebuffer(GL_FRAMEBUFFER, photon_fbo_);
   const GLenum buffers[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
   glDrawBuffers(3, buffers);
@@ -188,6 +211,7 @@ void CausticPass::splat(const CausticMesh& m) {
     p.set("u_axis_v" + k, glm::vec3(full.v_axis));
     p.set("u_half" + k, glm::vec2(0.5 * full.width_m, 0.5 * full.height_m));
     p.set("u_mesh" + k, plan_.receivers[r].mesh);
+    p.set("u_curved" + k, plan_.receivers[r].curved ? 1 : 0);
   }
   glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
   glDrawBuffer(GL_COLOR_ATTACHMENT0);
@@ -242,6 +266,7 @@ std::vector<CausticMap> CausticPass::readMaps() const {
     CausticMap m;
     m.mesh = plan_.receivers[r].mesh;
     m.grid = IrradianceGrid::zeros(plan_.receivers[r].window);
+    m.height = plan_.receivers[r].height;
     for (int j = 0; j < m.grid.rect.cells_v; ++j)
       for (int i = 0; i < m.grid.rect.cells_u; ++i) {
         const float* t = &all[r * layer + (size_t(j) * size_t(cells_side_) + size_t(i)) * 4];

@@ -1,6 +1,6 @@
 // Caustic maps (stage "caustic-maps"; issue 23 item 2, docs/caustics.md "Raster caustics"): the light that a
-// light with caustics on (Light::caustics) sends through the mirrors and lenses onto the planar receivers,
-// which the environment's shading adds in every pass (shaders/caustic_lookup.glsl).
+// light with caustics on (Light::caustics) sends through the mirrors and lenses onto the planar and height-field
+// receivers, which the environment's shading adds in every pass (shaders/caustic_lookup.glsl).
 //
 // Per photon mesh of the plan (pvrr/method/caustic_mesh.h: exact photons at the vertices of a grid over each
 // (light, element) aperture, per wavelength sample):
@@ -12,9 +12,14 @@
 //    blending in RGBA32F (shaders/caustic_splat.*). Each photon carries its texel's measure of the light's
 //    power (irradiance x area, or intensity x solid angle), times the element's reflectance or the Fresnel
 //    transmittances of its interfaces and the wavelength sample's colour weight.
-// What is not drawn: light landing on non-planar meshes, other occluders between the element and the
-// receiver, photons beyond a map's window (it holds 99 % of the landed power), the light reflected by a lens's
-// surfaces; the stage's note says what the plan left out.
+//    A curved receiver (a height field over its plane, pvrr/method/caustic_mesh.h heightFieldReceivers): the
+//    photon lands at its ray's first hit on the mesh, the texel's distance interpolated between the vertices'
+//    exact hits, projected onto the plane, its power weighed by cos(theta) between the hit's normal and the
+//    plane's (the irradiance per unit area of the surface); the layer's alpha holds the surface's height over
+//    the plane per cell, which the lookup compares with the shaded point's.
+// What is not drawn: light landing on meshes that are neither planar nor height fields, photons beyond a map's
+// window (it holds 99 % of the landed power), the light reflected by a lens's surfaces; the stage's note says
+// what the plan left out.
 // The maps are made when the renderer's first frame needs them and again only when an element moved (the
 // environment and the lights stand still for a renderer, as for the shadow maps).
 #pragma once
@@ -38,6 +43,9 @@ std::vector<std::string> causticDefines(const Scene& scene);
 struct CausticMap {
   int mesh = -1;        // Scene::meshes index
   IrradianceGrid grid;  // irradiance per cell (no variance: not a Monte Carlo estimate)
+  // A curved receiver: the surface's height over grid.rect's plane per cell (CausticReceiverMap::height); the
+  // reference to compare with deposits with DepositOptions::height_field. Empty: planar.
+  std::vector<float> height;
 };
 
 class CausticPass {

@@ -86,13 +86,26 @@ CausticVertex vertexOf(const Traced& t, double x, double y) {
   v.direction = t.p.direction;
   v.power_density = t.p.power;
   v.mesh = t.left ? t.p.mesh : -1;
+  if (v.mesh >= 0 && std::isfinite(t.p.t_hit)) {
+    v.t_hit = t.p.t_hit;
+    v.hit_normal = t.p.hit_normal;
+  }
   return v;
 }
 
 // Landed power per receiving mesh: (landing point, weight) of each vertex photon that meets a mesh.
 using Landings = std::vector<std::vector<std::pair<Vec3, double>>>;
 
-CausticMesh tracePair(const PairTracer& tr, const CausticPlanOptions& o, Landings& landed, long long& traced) {
+// A kept cell on a curved receiver is refined as well when the photon at its centre does not land where its
+// corners' landings predict (their mean) within kJumpFraction of their spread: the receiver shadows itself
+// along the photons' paths (a bump hiding what lies behind it), a jump in the landing distance that the texels'
+// interpolation would smear across the cell. A smooth surface's deviation is second order in the cell's size.
+constexpr double kJumpFraction = 0.25;
+
+Vec3 landing(const Traced& t) { return t.p.origin + t.p.t_hit * t.p.direction; }
+
+CausticMesh tracePair(const PairTracer& tr, const CausticPlanOptions& o, const std::vector<bool>& curved,
+                      Landings& landed, long long& traced) {
   const CausticAperture& ap = tr.ap;
   const int g = o.grid, s = o.refine;
   const double dx = (ap.x1 - ap.x0) / g, dy = (ap.y1 - ap.y0) / g;
@@ -116,11 +129,35 @@ CausticMesh tracePair(const PairTracer& tr, const CausticPlanOptions& o, Landing
     }
   std::vector<std::pair<int, int>> to_refine;
   double kept_area = 0;
+  // Consistent cells on a curved receiver: their centres traced (in parallel) before they are kept.
+  std::vector<char> jump(size_t(g) * size_t(g), 0);
+  if (s > 1) {
+    std::vector<std::pair<int, int>> check;
+    for (int j = 0; j < g; ++j)
+      for (int i = 0; i < g; ++i) {
+        const uint32_t a = uint32_t(j * (g + 1) + i), b = a + 1, c = a + uint32_t(g) + 2, d = a + uint32_t(g) + 1;
+        const Traced* corners[4] = {&grid[a], &grid[b], &grid[c], &grid[d]};
+        const int mesh = corners[0]->p.mesh;
+        if (consistent(corners) && mesh >= 0 && curved[size_t(mesh)]) check.push_back({i, j});
+      }
+    tbb::parallel_for(size_t(0), check.size(), [&](size_t k) {
+      const auto [i, j] = check[k];
+      const uint32_t a = uint32_t(j * (g + 1) + i), b = a + 1, c = a + uint32_t(g) + 2, d = a + uint32_t(g) + 1;
+      const Traced centre = tr.at(ap.x0 + (i + 0.5) * dx, ap.y0 + (j + 0.5) * dy);
+      const Vec3 mean = 0.25 * (landing(grid[a]) + landing(grid[b]) + landing(grid[c]) + landing(grid[d]));
+      double spread = 0;
+      for (uint32_t v : {a, b, c, d}) spread = std::max(spread, glm::length(landing(grid[v]) - mean));
+      jump[size_t(j) * size_t(g) + size_t(i)] =
+          !centre.left || centre.p.mesh != grid[a].p.mesh || centre.p.bounces != grid[a].p.bounces ||
+          glm::length(landing(centre) - mean) > kJumpFraction * spread;
+    });
+    traced += (long long)check.size();
+  }
   for (int j = 0; j < g; ++j)
     for (int i = 0; i < g; ++i) {
       const uint32_t a = uint32_t(j * (g + 1) + i), b = a + 1, c = a + uint32_t(g) + 2, d = a + uint32_t(g) + 1;
       const Traced* corners[4] = {&grid[a], &grid[b], &grid[c], &grid[d]};
-      if (consistent(corners)) {
+      if (consistent(corners) && !jump[size_t(j) * size_t(g) + size_t(i)]) {
         addQuad(m.triangles, a, b, c, d);
         kept_area += dx * dy;
       } else if (s > 1 && (corners[0]->left || corners[1]->left || corners[2]->left || corners[3]->left)) {
@@ -225,6 +262,154 @@ std::vector<CausticReceiver> planarReceivers(const Scene& scene) {
   return out;
 }
 
+std::vector<CausticReceiver> heightFieldReceivers(const Scene& scene) {
+  std::vector<bool> planar(scene.meshes.size(), false);
+  for (const CausticReceiver& r : planarReceivers(scene)) planar[size_t(r.mesh)] = true;
+  std::vector<CausticReceiver> out;
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    const EnvMesh& mesh = scene.meshes[m];
+    if (planar[m] || mesh.triangles.empty() || mesh.normals.size() != mesh.positions.size()) continue;
+    // Each triangle's unit normal, oriented by its vertex normals (a mesh's winding need not be consistent).
+    std::vector<Vec3> tri_n(mesh.triangles.size());
+    Vec3 sum(0);
+    for (size_t k = 0; k < mesh.triangles.size(); ++k) {
+      const glm::u32vec3 t = mesh.triangles[k];
+      const Vec3 a(mesh.positions[t.x]), b(mesh.positions[t.y]), c(mesh.positions[t.z]);
+      Vec3 n = glm::cross(b - a, c - a);  // twice the area
+      const Vec3 shading = Vec3(mesh.normals[t.x]) + Vec3(mesh.normals[t.y]) + Vec3(mesh.normals[t.z]);
+      if (glm::dot(n, shading) < 0) n = -n;
+      sum += n;
+      const double len = glm::length(n);
+      tri_n[k] = len > 0 ? n / len : Vec3(0);
+    }
+    if (!(glm::length(sum) > 0)) continue;
+    const Vec3 n = glm::normalize(sum);
+    bool facing = true;
+    for (const Vec3& t : tri_n)
+      if (t != Vec3(0) && !(glm::dot(t, n) > kMinHeightFieldCos)) facing = false;
+    if (!facing) continue;
+    const glm::u32vec3 t0 = mesh.triangles[0];
+    Vec3 u = Vec3(mesh.positions[t0.y]) - Vec3(mesh.positions[t0.x]);
+    u = u - glm::dot(u, n) * n;
+    if (!(glm::length(u) > 0)) u = std::abs(n.x) < 0.9 ? glm::cross(n, Vec3(1, 0, 0)) : glm::cross(n, Vec3(0, 1, 0));
+    u = glm::normalize(u);
+    const Vec3 v = glm::cross(n, u);  // u x v = n
+    // Projections onto the plane (relative to the first vertex) and heights over it.
+    const Vec3 p0(mesh.positions[0]);
+    std::vector<Vec2> q(mesh.positions.size());
+    double u0 = kInf, u1 = -kInf, v0 = kInf, v1 = -kInf, h0 = kInf, h1 = -kInf;
+    for (size_t k = 0; k < q.size(); ++k) {
+      const Vec3 d = Vec3(mesh.positions[k]) - p0;
+      q[k] = Vec2(glm::dot(d, u), glm::dot(d, v));
+      u0 = std::min(u0, q[k].x), u1 = std::max(u1, q[k].x), v0 = std::min(v0, q[k].y), v1 = std::max(v1, q[k].y);
+      h0 = std::min(h0, glm::dot(d, n)), h1 = std::max(h1, glm::dot(d, n));
+    }
+    if (!(u1 > u0) || !(v1 > v0)) continue;
+    // One sheet over the plane: no triangle's centroid lies strictly inside another's projection (binned).
+    constexpr int kBins = 64;
+    const double bu = (u1 - u0) / kBins, bv = (v1 - v0) / kBins;
+    std::vector<std::vector<uint32_t>> bins(size_t(kBins) * kBins);
+    const auto binOf = [&](double x, double lo, double w) { return std::clamp(int((x - lo) / w), 0, kBins - 1); };
+    for (size_t k = 0; k < mesh.triangles.size(); ++k) {
+      const glm::u32vec3 t = mesh.triangles[k];
+      const double x0 = std::min({q[t.x].x, q[t.y].x, q[t.z].x}), x1 = std::max({q[t.x].x, q[t.y].x, q[t.z].x});
+      const double y0 = std::min({q[t.x].y, q[t.y].y, q[t.z].y}), y1 = std::max({q[t.x].y, q[t.y].y, q[t.z].y});
+      for (int j = binOf(y0, v0, bv); j <= binOf(y1, v0, bv); ++j)
+        for (int i = binOf(x0, u0, bu); i <= binOf(x1, u0, bu); ++i) bins[size_t(j) * kBins + i].push_back(uint32_t(k));
+    }
+    const auto strictlyInside = [&](const glm::u32vec3& t, const Vec2& c) {
+      const Vec2 a = q[t.x], b = q[t.y], d = q[t.z];
+      const double area = (b.x - a.x) * (d.y - a.y) - (b.y - a.y) * (d.x - a.x);
+      if (area == 0) return false;
+      const double w0 = ((b.x - c.x) * (d.y - c.y) - (b.y - c.y) * (d.x - c.x)) / area;
+      const double w1 = ((d.x - c.x) * (a.y - c.y) - (d.y - c.y) * (a.x - c.x)) / area;
+      const double w2 = 1 - w0 - w1;
+      constexpr double kEdge = 1e-6;  // on a shared edge or vertex is not over it
+      return w0 > kEdge && w1 > kEdge && w2 > kEdge;
+    };
+    bool sheet = true;
+    for (size_t k = 0; k < mesh.triangles.size() && sheet; ++k) {
+      const glm::u32vec3 t = mesh.triangles[k];
+      const Vec2 c = (q[t.x] + q[t.y] + q[t.z]) / 3.0;
+      for (uint32_t o : bins[size_t(binOf(c.y, v0, bv)) * kBins + binOf(c.x, u0, bu)])
+        if (o != k && strictlyInside(mesh.triangles[o], c)) {
+          sheet = false;
+          break;
+        }
+    }
+    if (!sheet) continue;
+    CausticReceiver r;
+    r.mesh = int(m);
+    r.curved = true;
+    r.full.u_axis = u;
+    r.full.v_axis = v;
+    r.full.centre = mesh.anchor + p0 + 0.5 * (u0 + u1) * u + 0.5 * (v0 + v1) * v + 0.5 * (h0 + h1) * n;
+    r.full.width_m = u1 - u0;
+    r.full.height_m = v1 - v0;
+    out.push_back(r);
+  }
+  return out;
+}
+
+std::vector<float> receiverHeights(const EnvMesh& mesh, const ReceiverRect& w) {
+  const int nu = w.cells_u, nv = w.cells_v;
+  std::vector<double> h(size_t(nu) * size_t(nv), kInf);
+  const Vec3 n = w.normal();
+  const double cw = w.cellWidth(), ch = w.cellHeight();
+  std::vector<Vec3> p(mesh.positions.size());  // (u, v, height) over the window's plane
+  for (size_t k = 0; k < p.size(); ++k) {
+    const Vec3 d = mesh.anchor + Vec3(mesh.positions[k]) - w.centre;
+    p[k] = Vec3(glm::dot(d, w.u_axis), glm::dot(d, w.v_axis), glm::dot(d, n));
+  }
+  constexpr double kEdge = 1e-9;  // cell centres on a shared edge count for both triangles (same height)
+  for (const glm::u32vec3& t : mesh.triangles) {
+    const Vec3 a = p[t.x], b = p[t.y], c = p[t.z];
+    const double area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+    if (area == 0) continue;
+    // Cells whose centres lie in the triangle's bounding box (cell centre i: -w/2 + (i + 0.5) cw).
+    const auto first = [](double x, double lo, double size, int count) {
+      return std::clamp(int(std::ceil((x - lo) / size - 0.5)), 0, count);
+    };
+    const auto last = [](double x, double lo, double size, int count) {
+      return std::clamp(int(std::floor((x - lo) / size - 0.5)), -1, count - 1);
+    };
+    const double lu = -0.5 * w.width_m, lv = -0.5 * w.height_m;
+    const int i0 = first(std::min({a.x, b.x, c.x}), lu, cw, nu), i1 = last(std::max({a.x, b.x, c.x}), lu, cw, nu);
+    const int j0 = first(std::min({a.y, b.y, c.y}), lv, ch, nv), j1 = last(std::max({a.y, b.y, c.y}), lv, ch, nv);
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) {
+        const Vec2 x = w.cellCentre(i, j);
+        const double w0 = ((b.x - x.x) * (c.y - x.y) - (b.y - x.y) * (c.x - x.x)) / area;
+        const double w1 = ((c.x - x.x) * (a.y - x.y) - (c.y - x.y) * (a.x - x.x)) / area;
+        const double w2 = 1 - w0 - w1;
+        if (w0 < -kEdge || w1 < -kEdge || w2 < -kEdge) continue;
+        h[size_t(j) * size_t(nu) + size_t(i)] = w0 * a.z + w1 * b.z + w2 * c.z;
+      }
+  }
+  // Two rings of uncovered cells take the mean of their covered neighbours (8-connected).
+  for (int ring = 0; ring < 2; ++ring) {
+    std::vector<double> next = h;
+    for (int j = 0; j < nv; ++j)
+      for (int i = 0; i < nu; ++i) {
+        if (std::isfinite(h[size_t(j) * size_t(nu) + size_t(i)])) continue;
+        double sum = 0;
+        int count = 0;
+        for (int dj = -1; dj <= 1; ++dj)
+          for (int di = -1; di <= 1; ++di) {
+            const int ii = i + di, jj = j + dj;
+            if (ii < 0 || jj < 0 || ii >= nu || jj >= nv) continue;
+            const double v = h[size_t(jj) * size_t(nu) + size_t(ii)];
+            if (std::isfinite(v)) sum += v, ++count;
+          }
+        if (count) next[size_t(j) * size_t(nu) + size_t(i)] = sum / count;
+      }
+    h.swap(next);
+  }
+  std::vector<float> out(h.size());
+  for (size_t k = 0; k < h.size(); ++k) out[k] = std::isfinite(h[k]) ? float(h[k]) : kNoHeight;
+  return out;
+}
+
 CausticPlan planCaustics(const RayScene& rays, const CausticPlanOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   if (o.grid < 1 || o.grid > 1024 || o.refine < 1 || o.refine > 64 || o.cells < 4 || o.cells > 4096)
@@ -237,6 +422,12 @@ CausticPlan planCaustics(const RayScene& rays, const CausticPlanOptions& o) {
   const std::vector<SpectralSample> samples = causticSamples(scene, co);
   const bool spectral = o.dispersion == DispersionMode::Spectral;
   Landings landed(scene.meshes.size());
+  std::vector<CausticReceiver> candidates = planarReceivers(scene);
+  std::vector<bool> curved_mesh(scene.meshes.size(), false);
+  for (CausticReceiver& r : heightFieldReceivers(scene)) {
+    curved_mesh[size_t(r.mesh)] = true;
+    candidates.push_back(std::move(r));
+  }
   for (const int li : causticLights(scene)) {
     const Light& light = scene.lights[size_t(li)];
     for (size_t ei = 0; ei < scene.elements.size(); ++ei) {
@@ -249,7 +440,7 @@ CausticPlan planCaustics(const RayScene& rays, const CausticPlanOptions& o) {
       }
       for (size_t si = 0; si < samples.size(); ++si) {
         const PairTracer tr{rays, light, ap, samples[si], int(ei), spectral, o.max_depth};
-        CausticMesh m = tracePair(tr, o, landed, plan.traced);
+        CausticMesh m = tracePair(tr, o, curved_mesh, landed, plan.traced);
         if (m.triangles.empty()) {
           if (si == 0)
             plan.notes.push_back("light " + std::to_string(li) + ", element \"" + scene.elements[ei].name +
@@ -264,25 +455,27 @@ CausticPlan planCaustics(const RayScene& rays, const CausticPlanOptions& o) {
       }
     }
   }
-  std::vector<CausticReceiver> planar = planarReceivers(scene);
-  std::vector<bool> is_planar(scene.meshes.size(), false);
-  for (CausticReceiver& r : planar) {
-    is_planar[size_t(r.mesh)] = true;
+  std::vector<bool> is_receiver(scene.meshes.size(), false);
+  for (CausticReceiver& r : candidates) {
+    is_receiver[size_t(r.mesh)] = true;
     chooseWindow(r, landed[size_t(r.mesh)], o.cells);
   }
   for (size_t m = 0; m < landed.size(); ++m)
-    if (!is_planar[m] && !landed[m].empty())
+    if (!is_receiver[m] && !landed[m].empty())
       plan.notes.push_back("mesh \"" + scene.meshes[m].name +
-                           "\" receives caustic light but is not planar: not drawn (planar receivers only)");
-  std::sort(planar.begin(), planar.end(),
-            [](const CausticReceiver& a, const CausticReceiver& b) { return a.landed_power > b.landed_power; });
-  for (const CausticReceiver& r : planar) {
+                           "\" receives caustic light but is neither planar nor a height field over a plane: not "
+                           "drawn (planar and height-field receivers only)");
+  // By landed power; stable, so that equal powers keep the planar receivers' order.
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const CausticReceiver& a, const CausticReceiver& b) { return a.landed_power > b.landed_power; });
+  for (CausticReceiver& r : candidates) {
     if (!(r.landed_power > 0)) break;
     if (int(plan.receivers.size()) == kMaxCausticReceivers) {
       plan.notes.push_back("mesh \"" + scene.meshes[size_t(r.mesh)].name + "\": not drawn, more than " +
                            std::to_string(kMaxCausticReceivers) + " receivers");
       continue;
     }
+    if (r.curved) r.height = receiverHeights(scene.meshes[size_t(r.mesh)], r.window);
     plan.receivers.push_back(r);
   }
   plan.elapsed_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -298,7 +491,7 @@ std::optional<CausticLightField> referenceCaustics(const RayScene& rays, const C
   const auto start = std::chrono::steady_clock::now();
   const CausticPlan plan = planCaustics(rays, plan_options);
   std::vector<CausticReceiverMap> windows;
-  for (const CausticReceiver& r : plan.receivers) windows.push_back({r.mesh, IrradianceGrid::zeros(r.window)});
+  for (const CausticReceiver& r : plan.receivers) windows.push_back({r.mesh, IrradianceGrid::zeros(r.window), r.height});
   CausticOptions o;
   o.photons_per_side = photons_per_side;
   o.max_depth = plan_options.max_depth;
@@ -311,7 +504,7 @@ std::optional<CausticLightField> referenceCaustics(const RayScene& rays, const C
                      std::to_string(windows.size()) + " receiver window(s) of the raster plan; lenses block the caustic "
                      "lights' shadow rays";
   for (const std::string& n : plan.notes) note += "; " + n;
-  if (windows.empty()) note = "no caustic light lands on a planar receiver: none added; " + note;
+  if (windows.empty()) note = "no caustic light lands on a planar or height-field receiver: none added; " + note;
   stages.ran(kReferenceCausticsStage, ms, int(std::min<long long>(field.emitted, 2147483647LL)), note);
   return field;
 }

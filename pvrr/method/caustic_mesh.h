@@ -6,15 +6,19 @@
 // vertices of a grid over the aperture instead of at jittered points: a "photon mesh". A cell whose four
 // corners took the same path (all left the element, after as many specular events, towards the same receiver)
 // is kept as two triangles; a cell whose corners differ (the element's rim, a shadow's edge, total internal
-// reflection setting in) is traced again on a finer sub-grid and its consistent sub-cells kept. The GPU
-// rasterizes the mesh into a caustic map over the aperture (one photon per texel, its exit ray and power
+// reflection setting in) is traced again on a finer sub-grid and its consistent sub-cells kept; so is a cell on a
+// curved receiver whose centre photon lands away from where its corners predict (the receiver shadowing itself).
+// The GPU rasterizes the mesh into a caustic map over the aperture (one photon per texel, its exit ray and power
 // interpolated between exact vertices) and splats the photons into the receivers' light maps.
 //
 // Receivers: the environment meshes that are planar (quads, grounds, flat meshes: every triangle in one
-// plane), as the reference's receiver rectangles; each map covers a window about the caustic light landing on
-// it (the square about the landed power's centroid holding kWindowQuantile of it, enlarged kWindowScale
-// times), at most kMaxCausticReceivers receivers, by landed power. Curved receivers get no caustic light; the
-// notes say so when photons land on one.
+// plane), as the reference's receiver rectangles, and the curved meshes that are height fields over their
+// best-fit plane (a bowl, a cylinder segment under 180 deg, a bumpy ground: heightFieldReceivers), whose maps lie
+// in that plane and hold the irradiance per unit area of the surface (DepositOptions::height_field); each map
+// covers a window about the caustic light landing on it (the square about the landed power's centroid holding
+// kWindowQuantile of it, enlarged kWindowScale times), at most kMaxCausticReceivers receivers, by landed power.
+// Meshes that are neither (closed solids, folded sheets) get no caustic light; the notes name them when photons
+// land on one.
 #pragma once
 #include <optional>
 #include <string>
@@ -48,6 +52,10 @@ struct CausticVertex {
   Vec2 xy{0};  // aperture coordinates
   Vec3 origin{0}, direction{0};
   Vec3 power_density{0};
+  // Its exit ray's first environment hit: the distance along it (0 when none) and the triangle's unit normal.
+  // The splat lands a photon on a curved receiver at the interpolation of its corners' exact distances.
+  double t_hit = 0;
+  Vec3 hit_normal{0};
   // The environment mesh its exit ray meets first (Scene::meshes index; -1: none). A kept cell's corners share it,
   // so the splat lands the cell's photons only on that mesh's light map: whatever stands between the element and
   // a receiver (an occluder that is not itself a mapped receiver) keeps the light off it.
@@ -65,9 +73,15 @@ struct CausticMesh {
 
 struct CausticReceiver {
   int mesh = -1;            // Scene::meshes index
-  ReceiverRect full;        // the mesh's rectangle in its plane (cells unused)
+  ReceiverRect full;        // the mesh's rectangle in its plane (cells unused); curved: its best-fit plane, through
+                            // the middle of its heights
   ReceiverRect window;      // the light map: part of `full`, with its cells
   double landed_power = 0;  // scalar power of the vertex photons landing on it (the choice's measure)
+  // A curved receiver (a height field over full's plane, not planar): its map holds the irradiance per unit area
+  // of the surface (DepositOptions::height_field), and `height` the surface's height over the window's plane per
+  // window cell (CausticReceiverMap::height; filled by planCaustics for the receivers it keeps).
+  bool curved = false;
+  std::vector<float> height;
 };
 
 struct CausticPlan {
@@ -82,6 +96,18 @@ struct CausticPlan {
 std::vector<int> causticLights(const Scene& scene);
 // The scene's planar environment meshes, as receiver rectangles (their bounding rectangle in their plane).
 std::vector<CausticReceiver> planarReceivers(const Scene& scene);
+// The scene's curved environment meshes that are height fields over their best-fit plane (the plane normal to
+// the area-weighted mean of their triangles' normals, each triangle oriented by its vertex normals): every
+// triangle faces that normal (cos above kMinHeightFieldCos) and no triangle's centroid lies over another
+// triangle; curved = true, `full` their bounding rectangle in that plane through the middle of their heights.
+// Planar meshes are planarReceivers', not these.
+inline constexpr double kMinHeightFieldCos = 1e-3;
+std::vector<CausticReceiver> heightFieldReceivers(const Scene& scene);
+// The height of mesh `mesh` over `window`'s plane (along its normal, m) at each cell's centre (index j * cells_u
+// + i): the triangles projected onto the plane, interpolated linearly; cells no triangle covers take the mean of
+// their covered neighbours (two rings: the lookup's bilinear interpolation stays on the surface to its rim),
+// else kNoHeight.
+std::vector<float> receiverHeights(const EnvMesh& mesh, const ReceiverRect& window);
 // Traces the photon meshes of every light with caustics on and chooses the receivers' windows.
 // Throws pvrr::Error for options out of range.
 CausticPlan planCaustics(const RayScene& rays, const CausticPlanOptions& options);
@@ -91,7 +117,7 @@ CausticPlan planCaustics(const RayScene& rays, const CausticPlanOptions& options
 // plan chooses, so that both pictures add the same kind of map. `stages` gets the stage
 // kReferenceCausticsStage: its photon count and receivers, or why it was skipped (no light with caustics on:
 // then nullopt and the reference is what it was). Returns an empty field (lenses still block the caustic
-// lights) when no caustic light lands on a planar receiver.
+// lights) when no caustic light lands on a planar or height-field receiver.
 inline constexpr const char* kReferenceCausticsStage = "reference-caustics";
 // The reference's photons per side: the light tracer's default, within 0.1 % of 1024^2 inside the burning
 // lens's spot (docs/caustics.md "Convergence").

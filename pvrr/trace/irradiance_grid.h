@@ -11,6 +11,9 @@
 //   (Pictures show row j = cells_v - 1 at the top, so that +v points up.)
 // - Irradiance is power per unit area of the rectangle (W/m^2 in the scene's light units, linear RGB per
 //   channel); it equals the receiving surface's own irradiance where that surface lies in the rectangle's plane.
+//   A curved receiver's grid (a height field over the rectangle's plane, DepositOptions::height_field in
+//   light_tracer.h) holds the surface's own irradiance instead: per unit area of the surface, whose piece over a
+//   cell is cellArea() / cos(theta); power() is then the plane's sum, under the surface's power.
 //   The scalar irradiance of a cell is the mean of its three channels (a white light's power).
 #pragma once
 #include <vector>

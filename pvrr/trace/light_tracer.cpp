@@ -164,6 +164,7 @@ PhotonFate followPhoton(const RayScene& rays, int element, double wavelength_nm,
       p.direction = d;
       p.t_hit = hit.hit() ? hit.t : kInf;
       p.mesh = hit.hit() ? hit.mesh : -1;
+      p.hit_normal = hit.hit() ? hit.normal : Vec3(0);
       return PhotonFate::Left;
     }
     if (depth >= max_depth) return PhotonFate::Absorbed;
@@ -269,6 +270,8 @@ PhotonBundle shootCausticPhotons(const RayScene& rays, const CausticOptions& o) 
 CausticResult depositPhotons(const PhotonBundle& bundle, const ReceiverRect& rect, const DepositOptions& opt) {
   if (rect.cells_u < 1 || rect.cells_v < 1 || !(rect.width_m > 0) || !(rect.height_m > 0))
     throw Error("caustics: the receiver needs positive cells and size");
+  const bool curved = opt.mode == DepositOptions::Mode::Surfaces && opt.height_field;
+  if (curved && opt.mesh < 0) throw Error("caustics: a curved (height-field) receiver needs its mesh");
   CausticResult res;
   res.emitted = bundle.emitted;
   res.grid = IrradianceGrid::zeros(rect);
@@ -287,7 +290,7 @@ CausticResult depositPhotons(const PhotonBundle& bundle, const ReceiverRect& rec
     } else {
       if (!std::isfinite(p.t_hit) || (opt.mesh >= 0 && p.mesh != opt.mesh)) continue;
       x = p.origin + p.t_hit * p.direction;
-      if (std::abs(glm::dot(x - rect.centre, normal)) > opt.slab_m) continue;
+      if (!curved && std::abs(glm::dot(x - rect.centre, normal)) > opt.slab_m) continue;
     }
     const Vec2 uv = rect.toReceiver(x);
     // Photons up to half a cell outside still reach the border cells through the kernel.
@@ -300,14 +303,16 @@ CausticResult depositPhotons(const PhotonBundle& bundle, const ReceiverRect& rec
     const double fx = (uv.x + 0.5 * rect.width_m) / cw - 0.5, fy = (uv.y + 0.5 * rect.height_m) / ch - 0.5;
     const int i0 = int(std::floor(fx)), j0 = int(std::floor(fy));
     const double ax = fx - i0, ay = fy - j0;
-    const double scalar = (p.power.x + p.power.y + p.power.z) / 3.0;
+    // Curved: the power per unit area of the surface, whose piece over a cell is cell area / cos of it.
+    const Vec3 power = curved ? p.power * std::abs(glm::dot(p.hit_normal, normal)) : p.power;
+    const double scalar = (power.x + power.y + power.z) / 3.0;
     for (int dj = 0; dj < 2; ++dj)
       for (int di = 0; di < 2; ++di) {
         const int i = i0 + di, j = j0 + dj;
         if (i < 0 || j < 0 || i >= rect.cells_u || j >= rect.cells_v) continue;
         const double w = (di ? ax : 1 - ax) * (dj ? ay : 1 - ay);
         const size_t k = res.grid.index(i, j);
-        res.grid.irradiance[k] += w * inv_area * p.power;
+        res.grid.irradiance[k] += w * inv_area * power;
         sum_sq[k] += (w * scalar) * (w * scalar);
       }
   }
@@ -335,25 +340,36 @@ CausticResult depositPhotons(const PhotonBundle& bundle, const ReceiverRect& rec
   return res;
 }
 
+namespace {
+
+// Bilinear between cell centres, clamped to the border cells (GL_CLAMP_TO_EDGE), at receiver coordinates uv.
+template <typename T>
+T bilinearCells(const ReceiverRect& r, const std::vector<T>& cells, const Vec2& uv) {
+  const double x = (uv.x + 0.5 * r.width_m) / r.cellWidth() - 0.5;
+  const double y = (uv.y + 0.5 * r.height_m) / r.cellHeight() - 0.5;
+  const double fx = std::floor(x), fy = std::floor(y), ax = x - fx, ay = y - fy;
+  const auto cell = [&](int i, int j) {
+    return cells[size_t(std::clamp(j, 0, r.cells_v - 1)) * size_t(r.cells_u) + size_t(std::clamp(i, 0, r.cells_u - 1))];
+  };
+  const int i0 = int(fx), j0 = int(fy);
+  const auto mix = [](const T& a, const T& b, double t) { return T(a * (1 - t) + b * t); };  // glm::mix's rounding
+  return mix(mix(cell(i0, j0), cell(i0 + 1, j0), ax), mix(cell(i0, j0 + 1), cell(i0 + 1, j0 + 1), ax), ay);
+}
+
+}  // namespace
+
 Vec3 CausticLightField::irradianceAt(const Vec3& p) const {
   Vec3 e(0.0);
   const double slab = DepositOptions{}.slab_m;
   for (const CausticReceiverMap& m : receivers) {
     const ReceiverRect& r = m.grid.rect;
-    if (std::abs(glm::dot(p - r.centre, r.normal())) > slab) continue;
+    const double h = glm::dot(p - r.centre, r.normal());
+    if (m.height.empty() && std::abs(h) > slab) continue;
     const Vec2 uv = r.toReceiver(p);
     if (!r.contains(uv)) continue;
-    // Cell coordinates with cell centres at integers; bilinear, clamped to the border cells.
-    const double x = (uv.x + 0.5 * r.width_m) / r.cellWidth() - 0.5;
-    const double y = (uv.y + 0.5 * r.height_m) / r.cellHeight() - 0.5;
-    const double fx = std::floor(x), fy = std::floor(y), ax = x - fx, ay = y - fy;
-    const auto cell = [&](int i, int j) {
-      return m.grid.irradiance[m.grid.index(std::clamp(i, 0, r.cells_u - 1), std::clamp(j, 0, r.cells_v - 1))];
-    };
-    const int i0 = int(fx), j0 = int(fy);
-    const Vec3 c0 = glm::mix(cell(i0, j0), cell(i0 + 1, j0), ax);
-    const Vec3 c1 = glm::mix(cell(i0, j0 + 1), cell(i0 + 1, j0 + 1), ax);
-    e += glm::mix(c0, c1, ay);
+    // A curved receiver: the point is on it where its height matches the surface's (the map's heights).
+    if (!m.height.empty() && !(std::abs(h - double(bilinearCells(r, m.height, uv))) <= slab)) continue;
+    e += bilinearCells(r, m.grid.irradiance, uv);
   }
   return e;
 }
@@ -370,7 +386,8 @@ CausticLightField causticLightField(const RayScene& rays, const std::vector<Caus
   for (const CausticReceiverMap& w : windows) {
     DepositOptions d;
     d.mesh = w.mesh;
-    f.receivers.push_back({w.mesh, depositPhotons(b, w.grid.rect, d).grid});
+    d.height_field = !w.height.empty();
+    f.receivers.push_back({w.mesh, depositPhotons(b, w.grid.rect, d).grid, w.height});
   }
   f.elapsed_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return f;

@@ -26,7 +26,11 @@
 //   pvrr/optics/spectrum.h. Scenes without a dispersing lens (or, spectral, a tabulated metal) trace one sample.
 // - Deposit (depositPhotons): the photon's ray after its last specular event meets the receiver: either the
 //   scene's surfaces (the first environment hit, kept if it lies within `slab_m` of the receiver's plane and
-//   inside the rectangle) or the receiver's plane alone (a virtual screen: focus sweeps). Its power is splatted
+//   inside the rectangle) or the receiver's plane alone (a virtual screen: focus sweeps). A curved receiver (a
+//   mesh that is a height field over the rectangle's plane, DepositOptions::height_field) keeps every hit on its
+//   mesh, projected along the plane's normal, with its power weighed by cos(theta) between the hit triangle's
+//   normal and the plane's: a cell over the plane covers cell area / cos(theta) of the surface, so the map is
+//   the irradiance per unit area of the surface itself. Its power is splatted
 //   with a tent kernel one cell wide (bilinear weights to the four nearest cell centres; the weights sum to 1, so
 //   the border cells also take their share of the photons up to half a cell outside, so that they are not
 //   biased low; power is conserved except within half a cell of the border) and divided by the cell area.
@@ -59,6 +63,7 @@ struct CausticPhoton {
   Vec3 power{0};                 // per channel (W in the scene's light units)
   double t_hit = kInf;           // distance along the ray to the first environment surface (kInf: escapes)
   int mesh = -1;                 // that surface's mesh index, or -1
+  Vec3 hit_normal{0};            // that surface's unit geometric normal there (the triangle's; 0 when it escapes)
   int light = -1, element = -1;  // where it came from: light index, first element
   int bounces = 0;               // specular events
 };
@@ -83,8 +88,14 @@ PhotonBundle shootCausticPhotons(const RayScene& rays, const CausticOptions& opt
 struct DepositOptions {
   enum class Mode { Surfaces, Plane };
   Mode mode = Mode::Surfaces;
-  double slab_m = 1e-3;  // Surfaces: how far from the rectangle's plane a hit may lie
+  double slab_m = 1e-3;  // Surfaces: how far from the rectangle's plane a hit may lie (not height_field)
   int mesh = -1;         // Surfaces: only hits on this mesh (-1: any)
+  // Surfaces: the receiver is curved, a height field over the rectangle's plane (pvrr/method/caustic_mesh.h
+  // heightFieldReceivers; `mesh` must be it): every hit on `mesh` counts at any height (slab_m unused),
+  // projected along the plane's normal, its power weighed by |cos| between the hit's geometric normal and the
+  // plane's normal, so that each cell holds the irradiance per unit area of the surface (a cell of the plane
+  // covers cell area / cos of it), not per unit area of the plane.
+  bool height_field = false;
 };
 
 struct CausticResult {
@@ -109,7 +120,15 @@ CausticResult depositPhotons(const PhotonBundle& bundle, const ReceiverRect& rec
 struct CausticReceiverMap {
   int mesh = -1;  // Scene::meshes index: only photons landing on it are deposited
   IrradianceGrid grid;
+  // A curved receiver (a height field over grid.rect's plane): per cell, the surface's height over that plane
+  // along its normal (m) at the cell's centre, kNoHeight where the surface does not reach it; a point counts as
+  // on the receiver where its own height lies within DepositOptions::slab_m of these heights' bilinear
+  // interpolation (as the irradiance's). Empty: planar, the plane itself (height 0).
+  std::vector<float> height;
 };
+// A height map's cells that the surface does not cover: far beyond any slab, finite so that the bilinear
+// interpolation stays finite (no point within a cell of such a cell takes the map's light).
+inline constexpr float kNoHeight = 1e30f;
 struct CausticLightField {
   std::vector<CausticReceiverMap> receivers;
   long long emitted = 0;        // photons shot (the sample count)
@@ -119,7 +138,7 @@ struct CausticLightField {
   Vec3 irradianceAt(const Vec3& p) const;
 };
 // Shoots the photons of the lights with caustics on (options.caustic_lights_only is forced) and deposits them
-// on each receiver's window, keeping the hits on its mesh.
+// on each receiver's window, keeping the hits on its mesh (height_field where the window has heights).
 CausticLightField causticLightField(const RayScene& rays, const std::vector<CausticReceiverMap>& windows,
                                     CausticOptions options);
 

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -64,6 +65,59 @@ TEST(CausticCli, ShavingMirrorFocusesTheSunOnTheWall) {
   fs::remove_all(dir);
 }
 
+// A curved receiver (docs/caustics.md "Curved receivers"): the burning lens's scene with a bowl (a spherical cap,
+// R = 0.1 m, 60 mm square, concave up, an OBJ of 48 x 48 quads) standing on the table under the spot, its lowest
+// point 1 mm above the table top at the spot. pvrr caustic chooses it by itself (it catches the light), maps it
+// per unit area of its surface, and finds the spot at the bowl's bottom, within the table test's 2 mm.
+TEST(CausticCli, BurningLensOnACurvedBowl) {
+  const fs::path dir = pvrr::test::freshTestDir("caustic-bowl");
+  constexpr double kR = 0.1, kHalf = 0.03, kX = 0.0446, kY = 0.7512;
+  {
+    std::ofstream obj(dir / "bowl.obj");
+    constexpr int kN = 48;
+    for (int j = 0; j <= kN; ++j)
+      for (int i = 0; i <= kN; ++i) {
+        const double x = -kHalf + 2 * kHalf * i / kN, z = -kHalf + 2 * kHalf * j / kN;
+        const double s = std::sqrt(kR * kR - x * x - z * z);
+        obj << "v " << x << " " << kR - s << " " << z << "\n";
+        obj << "vn " << -x / kR << " " << s / kR << " " << -z / kR << "\n";
+      }
+    for (int j = 0; j < kN; ++j)
+      for (int i = 0; i < kN; ++i) {
+        const int a = j * (kN + 1) + i + 1, b = a + 1, c = a + kN + 2, d = a + kN + 1;
+        obj << "f " << a << "//" << a << " " << c << "//" << c << " " << b << "//" << b << "\n";
+        obj << "f " << a << "//" << a << " " << d << "//" << d << " " << c << "//" << c << "\n";
+      }
+  }
+  std::string scene = slurp(fs::path(PVRR_SOURCE_DIR) / "models/burning-lens.json");
+  const std::string wall = "    {\"type\": \"quad\", \"name\": \"wall\"";
+  const size_t at = scene.find(wall);
+  ASSERT_NE(at, std::string::npos);
+  scene.insert(at, "    {\"type\": \"mesh\", \"name\": \"bowl\", \"file\": \"" + (dir / "bowl.obj").string() +
+                       "\", \"transform\": {\"position\": [" + std::to_string(kX) + ", " + std::to_string(kY) +
+                       ", 0]}, \"material\": {\"color\": [0.9, 0.9, 0.9]}},\n");
+  std::ofstream(dir / "scene.json") << scene;
+  const fs::path out = dir / "out";
+  const CliResult r = runPvrr("caustic '" + (dir / "scene.json").string() + "' --photons 128 --cells 80 --out '" +
+                              out.string() + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(slurp(out / "caustic.json"));
+  EXPECT_EQ(j["receiver"]["name"], "bowl");
+  EXPECT_TRUE(j["receiver"]["curved"].get<bool>());
+  constexpr double kSpotTol_m = 0.002;
+  const auto& peak = j["peak"]["world"];  // on the bowl's plane, projected: x and z
+  EXPECT_NEAR(peak[0].get<double>(), 0.2532 * std::tan(10 * M_PI / 180), kSpotTol_m);
+  EXPECT_NEAR(peak[2].get<double>(), 0.0, kSpotTol_m);
+  // What lands on the bowl is what the table got without it: two faces' Fresnel and the edge band.
+  const double passed = j["power_w"]["on_window"].get<double>() / j["power_w"]["entering_elements"].get<double>();
+  EXPECT_GT(passed, 0.88);
+  EXPECT_LT(passed, 0.92);
+  std::printf("[ caustic cli ] bowl: peak %.4g W/m^2 at x = %.2f mm, z = %.2f mm; %.4f of the intercepted power lands\n",
+              j["peak"]["irradiance_w_m2"].get<double>(), 1e3 * peak[0].get<double>(), 1e3 * peak[2].get<double>(),
+              passed);
+  fs::remove_all(dir);
+}
+
 TEST(CausticCli, RefusesWithOneLineAndWritesNothing) {
   const fs::path dir = pvrr::test::freshTestDir("caustic-bad");
   const std::string out = " --photons 32 --out '" + (dir / "out").string() + "'";
@@ -71,7 +125,8 @@ TEST(CausticCli, RefusesWithOneLineAndWritesNothing) {
       runPvrr("caustic models/burning-lens.json --receiver tabel-top" + out),
       "models/burning-lens.json: environment: no object named \"tabel-top\"; did you mean \"table-top\"?");
   expectOneLineError(runPvrr("caustic models/burning-lens.json --receiver table" + out),
-                     "models/burning-lens.json: environment[1] (table): a receiver must be a quad or ground");
+                     "models/burning-lens.json: environment[1] (table): a receiver must be a quad, a ground or a mesh "
+                     "that is a height field over a plane, not this box");
   expectOneLineError(runPvrr("caustic models/burning-lens.json --window 0,0,-1,1" + out), "--window");
   expectOneLineError(runPvrr("caustic models/burning-lens.json --window 5,5,0.1,0.1" + out), "outside the receiver");
   expectOneLineError(runPvrr("caustic models/burning-lens.json --receiver wall" + out),
