@@ -52,6 +52,7 @@ void ReferenceRun::allocate() {
   ref_.element.assign(n, -1);
   ref_.element_point.assign(n, Vec3(0));
   ref_.bounces.assign(n, 0);
+  ref_.depth_limited.assign(n, 0);
   rgba_.assign(n * 4, 0);
 }
 
@@ -117,6 +118,8 @@ void ReferenceRun::traceAndMeasure() {
   if (cancel_) return;
   trace_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   ref_.frame_ms = trace_ms_;
+  // compare's reference.depth_limit_pixels: the element pixels whose path ended at the depth limit.
+  for (size_t i = 0; i < ref_.element.size(); ++i) depth_limit_pixels_ += ref_.element[i] >= 0 && depthLimited(ref_, i);
   // The mode's frame: drawn meanwhile by another thread; waited for in steps, so that a cancel is heard.
   while (mode_frame_.wait_for(std::chrono::milliseconds(kWaitStepMs)) != std::future_status::ready)
     if (cancel_) return;
@@ -140,6 +143,7 @@ void ReferenceRun::traceTiles(const Tracer& tracer) {
         ref_.element[i] = p.first_element;
         ref_.element_point[i] = p.element_point;
         ref_.bounces[i] = p.bounces;
+        ref_.depth_limited[i] = p.depth_limited ? 1 : 0;  // as Tracer::render records it
         // As srgbPicture encodes a picture: non-finite colours black, each channel clamped to [0, 1].
         const Vec3 c = isFinite(p.color) ? p.color : Vec3(0);
         for (int k = 0; k < 3; ++k) rgba_[4 * i + size_t(k)] = linearToSrgb8(std::clamp(c[k], 0.0, 1.0));
@@ -156,8 +160,11 @@ void ReferenceRun::computeErrors(const Frame& mode_frame) {
   has_errors_ = mode_frame.seen.size() == n;
   heat_rgba_.assign(n * 4, 0);
   if (!has_errors_) return;
-  // pvrr compare's figures: the angular error of the mode's seen points against the reference's, summarised.
+  // pvrr compare's figures: the angular error of the mode's seen points against the reference's, summarised. The
+  // pixels whose reference path ended at the depth limit have no seen point: angularErrors leaves them out (NaN),
+  // so they are in neither the figures nor the heat map ('not compared'), and are compared by colour only.
   errors_ = angularErrors(ref_, ref_.seen, mode_frame.seen);
+  depth_limit_ = depthLimitColour(ref_, mode_frame);
   stats_ = summarizeErrors(errors_);
   scale_arcmin_ = heatMapScaleArcmin(stats_);
   for (size_t i = 0; i < n; ++i) {

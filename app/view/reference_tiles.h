@@ -65,7 +65,7 @@ class ReferenceRun {
   const std::vector<std::uint8_t>& rgba() const { return rgba_; }
 
   // After finished(): the reference frame, the trace's wall time, the errors (arcmin per pixel, NaN where the
-  // reference sees no element), their summary, compare's heat map scale and its RGBA picture (alpha 255 at the
+  // reference sees no element or its path ended at the depth limit, as compare leaves them out), their summary, compare's heat map scale and its RGBA picture (alpha 255 at the
   // pixels with a finite error, 0 elsewhere).
   const Frame& reference() const { return ref_; }
   double traceMs() const { return trace_ms_; }
@@ -74,6 +74,12 @@ class ReferenceRun {
   bool hasErrors() const { return has_errors_; }
   double scaleArcmin() const { return scale_arcmin_; }
   const std::vector<std::uint8_t>& heatRgba() const { return heat_rgba_; }
+  // After finished(): the element pixels whose reference path ended at the depth limit (render.max_depth reached
+  // on an element: no seen point, drawn black), left out of the errors as compare leaves them out; compare's
+  // reference.depth_limit_pixels. With errors, compare's colour check of them (depthLimitColour) against the
+  // mode's frame (zero when that frame has no colours).
+  std::size_t depthLimitPixels() const { return depth_limit_pixels_; }
+  const DepthLimitColour& depthLimit() const { return depth_limit_; }
 
  private:
   void run();
@@ -98,6 +104,8 @@ class ReferenceRun {
   ErrorStats stats_;
   bool has_errors_ = false;
   double scale_arcmin_ = 1;
+  std::size_t depth_limit_pixels_ = 0;
+  DepthLimitColour depth_limit_;
   std::vector<std::uint8_t> heat_rgba_;
   std::thread thread_;
 };

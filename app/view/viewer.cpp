@@ -579,11 +579,15 @@ json Viewer::referenceStats() const {
   if (!reference_ || !reference_->finished()) return j;
   j["threads"] = reference_->threads();
   j["trace_ms"] = reference_->traceMs();
+  // compare's reference.depth_limit_pixels: left out of the errors, as compare leaves them out.
+  j["depth_limit_pixels"] = reference_->depthLimitPixels();
   if (reference_->hasErrors()) {
     const ErrorStats& st = reference_->stats();
     j["pixels"] = st.pixels;
     j["angular_error_arcmin"] = {{"median", st.median_arcmin}, {"p95", st.p95_arcmin}, {"max", st.max_arcmin}};
     j["heat_map_scale_arcmin"] = reference_->scaleArcmin();
+    const DepthLimitColour& dl = reference_->depthLimit();  // compare's modes.MODE.depth_limit
+    j["depth_limit"] = {{"pixels", dl.pixels}, {"drawn_lit", dl.drawn_lit}, {"psnr_db", dl.psnr_db}};
   }
   return j;
 }

@@ -147,13 +147,24 @@ void Viewer::referencePanel() {
   if (ImGui::SliderFloat("wipe", &wipe, 0.0f, 1.0f, "%.2f")) wipe_x_ = double(wipe);
   ImGui::Checkbox("error overlay (E)", &overlay_);
   if (!reference_->finished()) return;
+  // Pixels whose reference path ended at the depth limit have no seen point: not compared (as pvrr compare).
+  const size_t limited = reference_->depthLimitPixels();
   if (!reference_->hasErrors()) {
     ImGui::TextWrapped("no error figures: the mode's frame has no seen points");
+    if (limited > 0)
+      ImGui::TextWrapped("%zu px where the reference's path ended at the depth limit (render.max_depth %d)", limited,
+                         ls_.scene.render.max_depth);
     return;
   }
   const ErrorStats& st = reference_->stats();
   ImGui::Text("angular error (as pvrr compare): median %.3f', p95 %.3f', max %.2f' over %zu px", st.median_arcmin,
               st.p95_arcmin, st.max_arcmin, st.pixels);
+  if (limited > 0) {
+    const DepthLimitColour& dl = reference_->depthLimit();
+    ImGui::TextWrapped("not compared: %zu px where the reference's path ended at the depth limit (render.max_depth "
+                       "%d; no seen point, drawn black); by colour: %zu drawn lit, PSNR %.1f dB",
+                       limited, ls_.scene.render.max_depth, dl.drawn_lit, dl.psnr_db);
+  }
   // The heat map's colour bar: errorHeatColour is linear in each third, so three gradients draw it exactly.
   ImDrawList* dl = ImGui::GetWindowDrawList();
   const ImVec2 p = ImGui::GetCursorScreenPos();

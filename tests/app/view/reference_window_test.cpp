@@ -90,6 +90,83 @@ TEST(ViewReference, MatchesCompareForTheSameView) {
   fs::remove_all(dir);
 }
 
+// Pixels whose reference path ended at the depth limit (render.max_depth reached on an element: no seen point,
+// drawn black): the live reference records them as compare's does, leaves them out of the overlay's figures and
+// heat map ('not compared'), and counts them. `scene` at render.max_depth 1, the view saved and compared: the
+// median, p95, the compared pixels and the depth-limited count are compare's. Returns the stats' reference part
+// (null on a failure above; {"skipped": why} where no X server can be started).
+json depthLimitedAgainstCompare(const std::string& name, const std::string& scene) {
+  const fs::path dir = freshTestDir("view-reference-depth-limit-" + name);
+  const fs::path script = dir / "script.json", overlay = dir / "overlay.png", view = dir / "view.json",
+                 stats = dir / "stats.json", cmp = dir / "compare";
+  writeText(script, R"({"size": [200, 150], "events": [
+      {"at_frame": 1, "do": "reference"},
+      {"at_frame": 2, "do": "wipe", "x": 1},
+      {"at_frame": 2, "do": "overlay", "on": true},
+      {"at_frame": 3, "do": "screenshot", "file": ")" +
+                        overlay.string() + R"("},
+      {"at_frame": 3, "do": "save_view", "file": ")" +
+                        view.string() + R"("},
+      {"at_frame": 4, "do": "quit"}]})");
+  CliResult r;
+  const std::string args =
+      scene + " --set render.max_depth=1 --script '" + script.string() + "' --stats '" + stats.string() + "'";
+  std::string why;
+  if (!runView(args, &r, &why)) return json{{"skipped", why}};
+  EXPECT_EQ(r.code, 0) << r.err;
+  const CliResult c = runPvrr("compare '" + view.string() + "' --modes pvrr --frames 1 --out '" + cmp.string() + "'");
+  EXPECT_EQ(c.code, 0) << c.err;
+  if (r.code != 0 || c.code != 0) return json();
+  const json all = readJson(cmp / "metrics.json"), live = readJson(stats)["reference"],
+             metrics = all["modes"]["pvrr"];
+  EXPECT_EQ(live["state"], "done") << live.dump();
+  const long limited = all["reference"]["depth_limit_pixels"].get<long>();
+  EXPECT_EQ(live["depth_limit_pixels"].get<long>(), limited);
+  EXPECT_EQ(live["depth_limit"]["pixels"], metrics["depth_limit"]["pixels"]);
+  EXPECT_EQ(live["depth_limit"]["drawn_lit"], metrics["depth_limit"]["drawn_lit"]);
+  EXPECT_EQ(live["pixels"], metrics["pixels"]);
+  for (const char* q : {"median", "p95"}) {
+    const double a = live["angular_error_arcmin"][q], b = metrics["angular_error_arcmin"][q];
+    EXPECT_NEAR(a, b, kMedianRelTol * b) << q;
+  }
+  // The heat map colours only the compared pixels, as compare's does: the depth-limited ones are not compared.
+  const ImageRGB8 heat = readPng((cmp / "pvrr-error.png").string()), shot = readPng(overlay.string());
+  int compared = 0, failing = 0;
+  for (int y = 0; y < shot.height; ++y)
+    for (int x = 0; x < shot.width; ++x) {
+      const uint8_t* h = heat.at(x, y);
+      if (h[0] == kNoErrorGrey && h[1] == kNoErrorGrey && h[2] == kNoErrorGrey) continue;
+      ++compared;
+      const uint8_t* s = shot.at(x, y);
+      for (int k = 0; k < 3; ++k) failing += std::abs(int(h[k]) - int(s[k])) > kHeatCodes;
+    }
+  EXPECT_EQ(compared, live["pixels"].get<int>());
+  EXPECT_EQ(failing, 0) << "of " << compared << " heat-map pixels";
+  json out = live;
+  out["compare_depth_limit_pixels"] = limited;
+  fs::remove_all(dir);
+  return out;
+}
+
+// The mirror pair at render.max_depth 1: the convex mirror's pixels that see the wall mirror end there (1401 of
+// 2662 element pixels at 200 x 150); the rest keep their errors, whose median is compare's.
+TEST(ViewReference, DepthLimitedPixelsLeftOutAsCompareDoesMirrorPair) {
+  const json live = depthLimitedAgainstCompare("pair", "models/mirror-pair.json");
+  if (live.contains("skipped")) GTEST_SKIP() << live["skipped"].get<std::string>();
+  if (live.is_null()) return;  // failed above
+  EXPECT_GT(live["depth_limit_pixels"].get<long>(), 500);
+  EXPECT_GT(live["pixels"].get<long>(), 500);  // both kinds in the view: a median of its own
+}
+
+// The reading lens at render.max_depth 1 (the hunt's finding 4, tests/app/hunt_cli_test.cpp): its light needs two
+// refractions, so every lens pixel's path ends at the depth limit: no error figures, all counted apart.
+TEST(ViewReference, DepthLimitedPixelsLeftOutAsCompareDoesReadingLens) {
+  const json live = depthLimitedAgainstCompare("lens", "models/reading-lens.json");
+  if (live.contains("skipped")) GTEST_SKIP() << live["skipped"].get<std::string>();
+  if (live.is_null()) return;
+  EXPECT_GT(live["depth_limit_pixels"].get<long>(), 500);  // most of the lens
+}
+
 // Spectacles move with the head: the worker's renderer, kept from the first reference, re-poses the lens for the
 // turned head as the window does, and the second reference's errors are compare's of the saved view.
 TEST(ViewReference, SpectaclesTurnedWithTheHeadMatchCompare) {
