@@ -10,6 +10,7 @@ layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv;
 uniform mat4 u_view_proj;  // projection * view, with the view's translation removed (camera at the origin)
 uniform vec3 u_offset;
+uniform vec4 u_clip_plane;  // camera-relative: clipped where dot(xyz, v_pos) + w < 0, while GL_CLIP_DISTANCE0 is on
 out vec3 v_pos;            // relative to the camera origin
 out vec3 v_normal;
 out vec2 v_uv;
@@ -38,4 +39,5 @@ void main() {
   aoVertex(v_pos);
 #endif
   gl_Position = u_view_proj * vec4(v_pos, 1.0);
+  gl_ClipDistance[0] = dot(u_clip_plane.xyz, v_pos) + u_clip_plane.w;
 }

@@ -189,8 +189,13 @@ void EnvironmentPass::drawCasters(const Program& p, const Mat4& view_proj, const
 }
 
 CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& origin, bool reversed_depth,
-                                const Vec3* rays_from, bool planes, bool with_seen, bool peel) const {
+                                const Vec3* rays_from, bool planes, bool with_seen, bool peel,
+                                const Vec4* clip_plane) const {
   const Mat4 vp = relativeViewProj(proj, view, origin);
+  // The clip plane on camera-relative points q = p - origin: dot(n, q) + (d + dot(n, origin)).
+  const glm::vec4 clip_relative =
+      clip_plane ? glm::vec4(Vec4(Vec3(*clip_plane), clip_plane->w + glm::dot(Vec3(*clip_plane), origin)))
+                 : glm::vec4(0.0f);
   const Program& sky = programs.sky(planes, with_seen, peel);
   auto drawSky = [&] {
     sky.use();
@@ -224,6 +229,7 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
     p->use();
     if (peel) p->set("u_peel", kPeelUnit);
     p->set("u_view_proj", toFloat(vp));
+    if (clip_plane) p->set("u_clip_plane", clip_relative);
     p->set("u_view_origin", rays_from ? glm::vec3(*rays_from - origin) : glm::vec3(0.0f));
     if (textured) p->set("u_texture", 0);
     setLights(*p, scene, origin);
@@ -254,7 +260,8 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
   // NearClip): a ray from the centre of projection to a back-face point first crosses a front face
   // of the same solid, itself beyond the near plane, which the depth test keeps instead. Not with reversed
   // depth, where the farther face wins.
-  const bool may_cull = options.cull_back_faces && !reversed_depth;
+  const bool may_cull = options.cull_back_faces && !reversed_depth && !clip_plane;
+  if (clip_plane) glEnable(GL_CLIP_DISTANCE0);
   const NearClip near_clip(vp);
   glDisable(GL_CULL_FACE);  // whatever an interrupted pass left
   if (may_cull) {
@@ -309,6 +316,7 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
         p = &programs.envOcclusion(env_faceted[part.m], part.ao.kind);
         p->use();
         p->set("u_view_proj", toFloat(vp));
+        if (clip_plane) p->set("u_clip_plane", clip_relative);
         p->set("u_view_origin", rays_from ? glm::vec3(*rays_from - origin) : glm::vec3(0.0f));
         ao_->bind(*p, origin);
         glActiveTexture(GL_TEXTURE0);
@@ -337,6 +345,7 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
   }
   glDisable(GL_CULL_FACE);
   glFrontFace(GL_CCW);
+  if (clip_plane) glDisable(GL_CLIP_DISTANCE0);
   if (!reversed_depth) {  // the sky triangle lies at depth 1: it passes only where nothing was drawn
     glDepthFunc(GL_LEQUAL);
     glDepthMask(GL_FALSE);

@@ -39,9 +39,12 @@ class EnvironmentPass {
   // kFirstCubeUnit).
   // With ambient occlusion, a forward pass that is not a peel first draws the static receivers' occlusion into
   // its low-resolution occlusion image (binding its own framebuffer and viewport, then restoring the caller's).
+  // clip_plane (world, ViewVolume::clip_plane): the meshes are clipped where dot(n, p) + d < 0 (gl_ClipDistance[0],
+  // shaders/env.vert), and no back face is culled (the plane may cut a solid open); the sky is not clipped.
   // Returns how many closed convex meshes it drew and culled.
   CullCount draw(const Mat4& view, const Mat4& proj, const Vec3& origin, bool reversed_depth = false,
-                 const Vec3* rays_from = nullptr, bool planes = false, bool with_seen = false, bool peel = false) const;
+                 const Vec3* rays_from = nullptr, bool planes = false, bool with_seen = false, bool peel = false,
+                 const Vec4* clip_plane = nullptr) const;
 
   // The environment meshes as shadow casters (shaders/shadow_caster.vert; pvrr/gl/shadow_pass.h): positions
   // only, every face, into whatever target is bound; view_proj acts on points relative to `origin`.

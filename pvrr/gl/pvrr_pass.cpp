@@ -551,8 +551,10 @@ CullCount PvrrPass::renderPasses(size_t whole_slots, int64_t* skipped, int64_t* 
     if (ctx.options.skip_unread_texels && mp.slot >= whole_slots) *skipped += closeUnreadTexels(mp, region);
     // In a reversed (zooming) map the rays come from the mirror, not from the viewpoint.
     const Vec3 element_centre = Vec3(ctx.scene.elements[size_t(mp.owner->element)].local_to_world[3]);
+    // A patch whose near plane could not clip the mirror: what lies behind the mirror is clipped at its plane.
+    const Vec4* clip = pv.volume.clip_plane ? &*pv.volume.clip_plane : nullptr;
     count.add(ctx.environment.draw(pv.volume.view, pv.volume.projection, pv.volume.eye, pv.volume.backward,
-                                   pv.volume.backward ? &element_centre : nullptr, planes));
+                                   pv.volume.backward ? &element_centre : nullptr, planes, false, false, clip));
     PassCamera cam;
     cam.planes = planes;
     cam.origin = pv.volume.eye;

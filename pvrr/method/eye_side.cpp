@@ -255,14 +255,16 @@ bool segmentCrosses(const Vec3& o, const Vec3& d, double t0, double t1, const Ve
 // (docs/robustness.md, "compare and the quality checks"): two cards 2 and 6 cm before a plane mirror moved its
 // near plane 47 mm towards the viewpoint, and the wall 1 cm behind the mirror covered a triangle of the picture
 // (p95 10800', good). Counted at the seen vertices: the segment from the near plane to the vertex along the
-// viewpoint's line crosses an environment triangle.
+// viewpoint's line crosses an environment triangle. Where the volume has a clip plane (ViewVolume::clip_plane: the
+// renderer clips what lies behind it in the map's environment pass), only the segment's part on its kept side
+// counts; the plane is dropped where no segment crosses anything (the map is drawn as without it).
 void applyBehindMirror(const Scene& scene, ElementFrame& f) {
   if (scene.elements[size_t(f.element)].type != ElementType::Mirror) return;
   int marked = 0, total = 0;
   for (PatchView& pv : f.views) {
-    const ViewVolume& vv = pv.volume;
+    ViewVolume& vv = pv.volume;
     if (!pv.in_view || vv.backward || vv.mirror_vertices_unclipped == 0) continue;
-    int hidden = 0;
+    int behind = 0, hidden = 0;  // seen vertices whose segment crosses the environment: at all, on the kept side
     for (uint32_t vi : f.grid_patches[size_t(pv.patch)].vertices) {
       if ((!f.in_view.empty() && f.in_view[vi] != 2) || vi >= f.world_pos.size()) continue;
       const Vec3 to = f.world_pos[vi] - vv.eye;
@@ -271,18 +273,29 @@ void applyBehindMirror(const Scene& scene, ElementFrame& f) {
       if (!(len > 0) || !(along > vv.near_m)) continue;
       const Vec3 d = to / len;
       const double t_near = len * vv.near_m / along, t_end = len * (1 - 1e-9);
-      bool crossed = false;
-      for (const EnvMesh& m : scene.meshes) {
-        for (const glm::u32vec3& t : m.triangles)
-          if (segmentCrosses(vv.eye, d, t_near, t_end, m.anchor + Vec3(m.positions[t.x]),
-                             m.anchor + Vec3(m.positions[t.y]), m.anchor + Vec3(m.positions[t.z]))) {
-            crossed = true;
-            break;
-          }
-        if (crossed) break;
+      auto crosses = [&](double t0, double t1) {
+        for (const EnvMesh& m : scene.meshes)
+          for (const glm::u32vec3& t : m.triangles)
+            if (segmentCrosses(vv.eye, d, t0, t1, m.anchor + Vec3(m.positions[t.x]),
+                               m.anchor + Vec3(m.positions[t.y]), m.anchor + Vec3(m.positions[t.z])))
+              return true;
+        return false;
+      };
+      if (!crosses(t_near, t_end)) continue;
+      ++behind;
+      if (vv.clip_plane) {  // only the part of the segment on the plane's kept side
+        double t0 = t_near, t1 = t_end;
+        const Vec3 n(*vv.clip_plane);
+        const double s0 = glm::dot(n, vv.eye) + vv.clip_plane->w, ds = glm::dot(n, d);
+        if (ds > 0) t0 = std::max(t0, -s0 / ds);
+        else if (ds < 0) t1 = std::min(t1, -s0 / ds);
+        else if (!(s0 > 0)) t1 = t0;
+        if (!(t1 > t0) || !crosses(t0, t1)) continue;
       }
-      hidden += crossed;
+      ++hidden;
     }
+    // The clip plane is drawn only where it removes something from the map's segments (shipped scenes: nowhere).
+    if (behind == 0) vv.clip_plane.reset();
     if (hidden == 0) continue;
     pv.quality.verdict = std::max(pv.quality.verdict, QualityVerdict::kDegraded);
     pv.quality.reasons += std::string(pv.quality.reasons.empty() ? "" : "; ") + std::to_string(hidden) +

@@ -153,6 +153,44 @@ void fitSides(ViewVolume& vv, const std::vector<std::pair<Vec3, Vec3>>& segments
 
 }  // namespace
 
+// The clip plane of a forward volume whose near plane could not clip the mirror (ViewVolume::clip_plane): the
+// plane of the three ray origins spanning the largest triangle (found greedily: the origin farthest from the
+// first, the one farthest from that, the one farthest from their line), turned so that the hits lie on its
+// positive side, moved to the rearmost origin less 1e-6 of the origins' extent (float rounding on the GPU).
+// None when the origins are (nearly) collinear or some hit of this volume is not beyond every origin. Every
+// vertex ray's segment [origin, hit] then lies on the kept side: the plane clips nothing a vertex ray meets.
+static std::optional<Vec4> separatingPlane(const std::vector<ViewpointRay>& rays, const std::vector<char>& is_zoom) {
+  if (rays.size() < 3) return std::nullopt;
+  auto farthestFrom = [&](const Vec3& p) {
+    size_t best = 0;
+    double d = -1;
+    for (size_t i = 0; i < rays.size(); ++i)
+      if (glm::length(rays[i].origin - p) > d) d = glm::length(rays[i].origin - p), best = i;
+    return best;
+  };
+  const Vec3 a = rays[farthestFrom(rays[0].origin)].origin, b = rays[farthestFrom(a)].origin;
+  Vec3 n(0.0);
+  for (const ViewpointRay& r : rays) {
+    const Vec3 c = glm::cross(b - a, r.origin - a);
+    if (glm::length(c) > glm::length(n)) n = c;
+  }
+  const double ab = glm::length(b - a);
+  if (!(ab > 0) || !(glm::length(n) > 1e-6 * ab * ab)) return std::nullopt;
+  n = glm::normalize(n);
+  double towards = 0;
+  for (size_t i = 0; i < rays.size(); ++i)
+    if (!is_zoom[i]) towards += glm::dot(n, rays[i].hit - rays[i].origin);
+  if (towards < 0) n = -n;
+  double o_min = kInf, o_max = -kInf, h_min = kInf;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    o_min = std::min(o_min, glm::dot(n, rays[i].origin));
+    o_max = std::max(o_max, glm::dot(n, rays[i].origin));
+    if (!is_zoom[i]) h_min = std::min(h_min, glm::dot(n, rays[i].hit));
+  }
+  if (!(h_min > o_max) || !std::isfinite(h_min)) return std::nullopt;
+  return Vec4(n, -(o_min - 1e-6 * ab));
+}
+
 ViewVolume buildViewVolume(const Vec3& eye, const std::vector<ViewpointRay>& rays, const ViewVolumeOptions& opt) {
   validate("buildViewVolume", eye, rays);
   ViewVolume vv;
@@ -201,6 +239,11 @@ ViewVolume buildViewVolume(const Vec3& eye, const std::vector<ViewpointRay>& ray
                             fmt("%.3g", zo_max - zh_min) + " m along forward): near placed just before it, " +
                             std::to_string(vv.mirror_vertices_unclipped) +
                             " mirror vertices not clipped: leave the element out of its own map pass");
+    vv.clip_plane = separatingPlane(rays, is_zoom);
+    if (vv.clip_plane)
+      appendNote(vv.note, "what lies behind the mirror is clipped at a plane just behind it (clip_plane; the "
+                          "viewpoint " + fmt("%.3g", -(vv.clip_plane->w + glm::dot(Vec3(*vv.clip_plane), eye))) +
+                          " m behind it)");
   }
   double far = zh_max;
   if (opt.scene_radius_m > 0) far = std::max(far, glm::dot(opt.scene_center - eye, vv.forward) + opt.scene_radius_m);

@@ -114,6 +114,14 @@ struct ViewVolume {
   int hits_covered = 0;      // hits this volume projects (forward: the others; reversed: the zooming ones)
   int hits_outside = 0;      // of those, hits that project outside [0, 1]^2 (max_fov_rad limit)
   int mirror_vertices_unclipped = 0;  // mirror vertices the near (forward) / far (reversed) plane fails to clip
+  // Forward volume whose near plane could not be placed beyond the mirror (mirror_vertices_unclipped > 0): a
+  // plane (n, d) in world space, n unit, with the mirror's vertices on its positive side (it passes just behind
+  // the rearmost one) and what they hit farther along n than every vertex: dot(n, p) + d > 0 along every vertex
+  // ray's segment. The renderer clips what lies on its negative side (behind the mirror) in the map's
+  // environment pass (gl_ClipDistance). Absent when the near plane clips the mirror, or when the hits are not
+  // all beyond every vertex along n (n: the plane of three ray origins spanning the largest triangle).
+  // applyEyeSide (eye_side.h) drops it again for a mirror patch where it clips nothing inside the map.
+  std::optional<Vec4> clip_plane;
   std::string note;  // "" or what was unusual and what the renderer must do about it
 };
 
