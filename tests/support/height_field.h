@@ -5,6 +5,7 @@
 #include <functional>
 
 #include "pvrr/scene/scene.h"
+#include "support/test_scenes.h"
 
 namespace pvrr::test {
 
@@ -68,6 +69,21 @@ inline HeightField cylinderSegment(const Vec3& base, const Vec3& n, const Vec3& 
   f.height = [a, sign](double x, double) { return sign * (a - std::sqrt(a * a - x * x)); };
   f.gradient = [a, sign](double x, double) { return Vec2(sign * x / std::sqrt(a * a - x * x), 0.0); };
   return f;
+}
+
+// The beam scenes of the curved-receiver tests: the height field's mesh (diffuse) as receiver, the sun straight
+// down (-z, radiance 1) with caustics on, and a plane mirror of radius `mirror_radius` at the origin facing
+// (1, 0, 1), which turns the sun's light along +x onto the receiver.
+inline void addBeamOnReceiver(Scene& s, const HeightField& f, int cells_x, int cells_y, const std::string& name,
+                              double mirror_radius = 0.1, double reflectance = 0.9) {
+  s.meshes.push_back(heightFieldMesh(f, cells_x, cells_y, name));
+  s.materials.push_back(DiffuseMaterial{});
+  Light sun;
+  sun.direction = Vec3(0, 0, -1);
+  sun.caustics = true;
+  s.lights = {sun};
+  const cad::Outline disc = cad::Outline::circle(mirror_radius);
+  addMirror(s, cad::makePlane(disc), disc, pose(Vec3(0), glm::normalize(Vec3(1, 0, 1))), 7, reflectance);
 }
 
 }  // namespace pvrr::test

@@ -260,14 +260,7 @@ TEST_P(CausticTest, BeamOnABowlMapAndPicture) {
   // 141 x 141 facets (0.99 mm): no mesh vertex on the beam's central ray. With 140 x 140 (a vertex exactly
   // there) the raster map dips by up to 24 % in 4 cells beside the centre (docs/caustics.md "Curved receivers":
   // measured, not yet explained; the reference and the photon mesh's exact vertices are right there).
-  s.meshes.push_back(test::heightFieldMesh(bowl, 141, 141, "bowl"));
-  s.materials.push_back(DiffuseMaterial{});
-  Light sun;
-  sun.direction = Vec3(0, 0, -1);
-  sun.caustics = true;
-  s.lights = {sun};
-  const cad::Outline disc = cad::Outline::circle(0.1);
-  test::addMirror(s, cad::makePlane(disc), disc, test::pose(Vec3(0), glm::normalize(Vec3(1, 0, 1))), 7, 0.9);
+  test::addBeamOnReceiver(s, bowl, 141, 141, "bowl");
   s.updateBounds();
   RayScene rays(s);
   gl::Renderer renderer(s, rays, gl::RendererOptions{});
@@ -353,14 +346,7 @@ TEST_P(CausticTest, ASelfShadowingReceiverKeepsItsShadows) {
   s.name = "grazing-waves";
   s.observer.eye = Vec3(0.3, 0.3, 0.3);
   s.observer.target = Vec3(0.4, 0, 0);
-  s.meshes.push_back(test::heightFieldMesh(f, 240, 60, "waves"));
-  s.materials.push_back(DiffuseMaterial{});
-  Light sun;
-  sun.direction = Vec3(0, 0, -1);
-  sun.caustics = true;
-  s.lights = {sun};
-  const cad::Outline disc = cad::Outline::circle(0.1);
-  test::addMirror(s, cad::makePlane(disc), disc, test::pose(Vec3(0), glm::normalize(Vec3(1, 0, 1))), 7, 0.9);
+  test::addBeamOnReceiver(s, f, 240, 60, "waves");
   s.updateBounds();
   RayScene rays(s);
   gl::Renderer renderer(s, rays, gl::RendererOptions{});

@@ -146,14 +146,7 @@ TEST(CausticMesh, CurvedReceiverHeightsAndLookup) {
   const test::HeightField bowl = test::sphericalBowl(Vec3(0.4, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, 0), 0.1, 0.07);
   Scene s;
   s.name = "beam-on-bowl";
-  s.meshes.push_back(test::heightFieldMesh(bowl, 140, 140, "bowl"));
-  s.materials.push_back(DiffuseMaterial{});
-  Light sun;
-  sun.direction = Vec3(0, 0, -1);
-  sun.caustics = true;
-  s.lights = {sun};
-  const cad::Outline disc = cad::Outline::circle(0.1);
-  test::addMirror(s, cad::makePlane(disc), disc, test::pose(Vec3(0), glm::normalize(Vec3(1, 0, 1))), 7, 0.9);
+  test::addBeamOnReceiver(s, bowl, 140, 140, "bowl");
   s.updateBounds();
   RayScene rays(s);
   FrameStages stages;

@@ -32,15 +32,7 @@ Scene beamScene(const test::HeightField& f) {
   s.name = "curved-receiver";
   s.observer.eye = Vec3(0.2, 0.3, 0.3);
   s.observer.target = Vec3(0.3, 0, 0);
-  s.meshes.push_back(test::heightFieldMesh(f, 160, 120, "receiver"));
-  s.materials.push_back(DiffuseMaterial{});
-  Light sun;
-  sun.direction = Vec3(0, 0, -1);
-  sun.radiance = Vec3(1.0);  // 1 W/m^2 facing the light
-  sun.caustics = true;
-  s.lights = {sun};
-  const cad::Outline disc = cad::Outline::circle(kMirrorD);
-  test::addMirror(s, cad::makePlane(disc), disc, test::pose(Vec3(0), glm::normalize(Vec3(1, 0, 1))), 7, kRho);
+  test::addBeamOnReceiver(s, f, 160, 120, "receiver", kMirrorD, kRho);  // sun radiance 1 W/m^2
   s.updateBounds();
   return s;
 }
