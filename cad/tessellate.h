@@ -1,6 +1,7 @@
 // Tessellation with vertices on the exact surface and normals from the surface derivatives (never averaged
 // from faces).
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -29,6 +30,11 @@ struct Tessellation {
   std::vector<uint32_t> triangle_quads;
   size_t vertexCount() const { return positions.size(); }
   bool locallyRefined() const { return !triangle_quads.empty(); }
+  // The base quad of a triangle whose corners are all grid vertices (indices below grid_u * grid_v).
+  size_t gridQuadOf(uint32_t a, uint32_t b, uint32_t c) const {
+    const uint32_t gv = uint32_t(grid_v);
+    return size_t(std::min({a / gv, b / gv, c / gv})) * size_t(grid_v - 1) + std::min({a % gv, b % gv, c % gv});
+  }
 };
 
 struct TessellationOptions {

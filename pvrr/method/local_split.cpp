@@ -30,7 +30,7 @@ std::vector<double> quadSpreadRatios(const ElementFrame& f, const FrameQualityLi
       q = f.grid.triangle_quads[t];
     } else {
       if (std::max({a, b, c}) >= n_grid) continue;
-      q = size_t(std::min({a / gv, b / gv, c / gv})) * size_t(gv - 1) + std::min({a % gv, b % gv, c % gv});
+      q = f.grid.gridQuadOf(a, b, c);
     }
     double r;
     if (rays[a].status == VertexStatus::Tir || rays[b].status == VertexStatus::Tir ||
@@ -157,7 +157,7 @@ std::vector<double> quadMapErrors(const RayScene& rays, const ElementFrame& f) {
         continue;
       size_t q;
       if (a < n_grid && b < n_grid && c < n_grid) {
-        q = size_t(std::min({a / gv, b / gv, c / gv})) * size_t(gv - 1) + std::min({a % gv, b % gv, c % gv});
+        q = f.grid.gridQuadOf(a, b, c);
       } else {
         continue;  // set below from triangle_quads
       }
@@ -238,10 +238,7 @@ LocalSplit chooseLocalSplitByMapError(const RayScene& rays, const ElementFrame& 
     const cad::Triangle& tri = f.grid.triangles[t];
     if (vr[tri.x].status != VertexStatus::Tir && vr[tri.y].status != VertexStatus::Tir && vr[tri.z].status != VertexStatus::Tir)
       continue;
-    const size_t gv = size_t(f.grid.grid_v);
-    const size_t q = f.grid.locallyRefined()
-                         ? f.grid.triangle_quads[t]
-                         : std::min({tri.x / gv, tri.y / gv, tri.z / gv}) * (gv - 1) + std::min({tri.x % gv, tri.y % gv, tri.z % gv});
+    const size_t q = f.grid.locallyRefined() ? f.grid.triangle_quads[t] : f.grid.gridQuadOf(tri.x, tri.y, tri.z);
     if (q < has_tir.size()) has_tir[q] = 1;
   }
   for (size_t q = 0; q < ratio.size(); ++q)
