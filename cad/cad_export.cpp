@@ -204,6 +204,26 @@ constexpr const char* kStepTimeStamp = "2000-01-01T00:00:00";
 constexpr const char* kIgesDate = "20000101.000000";
 constexpr const char* kAuthor = "pvrr";
 
+// Writes the face of `s` (trimmed by `trim`) to `path` all or nothing, under OCCT's translation lock:
+// `translate(tmp, face, u)` fills the temporary file; OCCT's exceptions become one line naming the file.
+template <typename Translate>
+void writeFace(const std::string& path, const NurbsSurface& s, const std::optional<Outline>& trim,
+               const std::string& unit, const char* format, Translate&& translate) {
+  const LengthUnit u = writeUnit(unit, path);
+  std::lock_guard<std::mutex> lock(occt::translationMutex());
+  occt::silence();
+  writeAtomic(
+      path,
+      [&](const std::string& tmp) {
+        try {
+          translate(tmp, makeFace(s, trim, path), u);
+        } catch (const Standard_Failure& f) {
+          throw Error(path + ": OpenCASCADE failed to write " + format + " (" + occt::failureMessage(f) + ")");
+        }
+      },
+      MissingFolder::Fail);
+}
+
 }  // namespace
 
 NurbsSurface scaled(const NurbsSurface& s, double factor) {
@@ -214,78 +234,56 @@ NurbsSurface scaled(const NurbsSurface& s, double factor) {
 
 void writeStep(const std::string& path, const NurbsSurface& s, const std::optional<Outline>& trim,
                const std::string& unit) {
-  const LengthUnit u = writeUnit(unit, path);
-  std::lock_guard<std::mutex> lock(occt::translationMutex());
-  occt::silence();
-  writeAtomic(
-      path,
-      [&](const std::string& tmp) {
-        try {
-          const TopoDS_Face face = makeFace(s, trim, path);
-          Interface_Static::SetCVal("write.step.unit", unit == "mm" ? "MM" : "M");
-          Interface_Static::SetIVal("write.surfacecurve.mode", 1);  // write the pcurves
-          STEPControl_Writer writer;
-          // Our numbers are already in the file's unit: no conversion on the way out.
-          writer.Model()->SetLocalLengthUnit(u.mm);
-          if (writer.Transfer(face, STEPControl_AsIs) != IFSelect_RetDone)
-            throw Error(path + ": OpenCASCADE could not translate the face to STEP");
-          // OCCT names the product "Open CASCADE STEP translator 7.6 <n>" with a per-process counter; the
-          // file's stem keeps the output reproducible.
-          const Handle(StepData_StepModel) model = writer.Model();
-          const Handle(TCollection_HAsciiString) product =
-              new TCollection_HAsciiString(fs::path(path).stem().string().c_str());
-          for (int i = 1; i <= model->NbEntities(); ++i)
-            if (const Handle(StepBasic_Product) p = Handle(StepBasic_Product)::DownCast(model->Value(i))) {
-              p->SetId(product);
-              p->SetName(product);
-            }
-          APIHeaderSection_MakeHeader header(model);
-          header.SetName(new TCollection_HAsciiString(fs::path(path).filename().string().c_str()));
-          header.SetTimeStamp(new TCollection_HAsciiString(kStepTimeStamp));
-          header.SetAuthorValue(1, new TCollection_HAsciiString(kAuthor));
-          header.SetOrganizationValue(1, new TCollection_HAsciiString(kAuthor));
-          header.SetOriginatingSystem(new TCollection_HAsciiString("pvrr (OpenCASCADE 7.6)"));
-          header.SetAuthorisation(new TCollection_HAsciiString(""));
-          if (writer.Write(tmp.c_str()) != IFSelect_RetDone) throw Error(path + ": cannot write the STEP file");
-        } catch (const Standard_Failure& f) {
-          throw Error(path + ": OpenCASCADE failed to write STEP (" + occt::failureMessage(f) + ")");
-        }
-      },
-      MissingFolder::Fail);
+  writeFace(path, s, trim, unit, "STEP", [&](const std::string& tmp, const TopoDS_Face& face, const LengthUnit& u) {
+    Interface_Static::SetCVal("write.step.unit", unit == "mm" ? "MM" : "M");
+    Interface_Static::SetIVal("write.surfacecurve.mode", 1);  // write the pcurves
+    STEPControl_Writer writer;
+    // Our numbers are already in the file's unit: no conversion on the way out.
+    writer.Model()->SetLocalLengthUnit(u.mm);
+    if (writer.Transfer(face, STEPControl_AsIs) != IFSelect_RetDone)
+      throw Error(path + ": OpenCASCADE could not translate the face to STEP");
+    // OCCT names the product "Open CASCADE STEP translator 7.6 <n>" with a per-process counter; the
+    // file's stem keeps the output reproducible.
+    const Handle(StepData_StepModel) model = writer.Model();
+    const Handle(TCollection_HAsciiString) product =
+        new TCollection_HAsciiString(fs::path(path).stem().string().c_str());
+    for (int i = 1; i <= model->NbEntities(); ++i)
+      if (const Handle(StepBasic_Product) p = Handle(StepBasic_Product)::DownCast(model->Value(i))) {
+        p->SetId(product);
+        p->SetName(product);
+      }
+    APIHeaderSection_MakeHeader header(model);
+    header.SetName(new TCollection_HAsciiString(fs::path(path).filename().string().c_str()));
+    header.SetTimeStamp(new TCollection_HAsciiString(kStepTimeStamp));
+    header.SetAuthorValue(1, new TCollection_HAsciiString(kAuthor));
+    header.SetOrganizationValue(1, new TCollection_HAsciiString(kAuthor));
+    header.SetOriginatingSystem(new TCollection_HAsciiString("pvrr (OpenCASCADE 7.6)"));
+    header.SetAuthorisation(new TCollection_HAsciiString(""));
+    if (writer.Write(tmp.c_str()) != IFSelect_RetDone) throw Error(path + ": cannot write the STEP file");
+  });
 }
 
 void writeIges(const std::string& path, const NurbsSurface& s, const std::optional<Outline>& trim,
                const std::string& unit) {
-  const LengthUnit u = writeUnit(unit, path);
-  std::lock_guard<std::mutex> lock(occt::translationMutex());
-  occt::silence();
-  writeAtomic(
-      path,
-      [&](const std::string& tmp) {
-        try {
-          const TopoDS_Face face = makeFace(s, trim, path);
-          Interface_Static::SetCVal("write.iges.header.author", kAuthor);
-          Interface_Static::SetCVal("write.iges.header.company", kAuthor);
-          Interface_Static::SetCVal("write.iges.header.product", "pvrr");
-          Interface_Static::SetCVal("write.iges.header.receiver", "");
-          // Mode 0: faces as trimmed surfaces (entity 144), which every IGES reader understands.
-          IGESControl_Writer writer(unit == "mm" ? "MM" : "M", 0);
-          IGESData_GlobalSection gs = writer.Model()->GlobalSection();
-          gs.SetCascadeUnit(u.mm);  // our numbers are already in the file's unit
-          gs.SetDate(new TCollection_HAsciiString(kIgesDate));
-          gs.SetLastChangeDate(new TCollection_HAsciiString(kIgesDate));
-          gs.SetFileName(new TCollection_HAsciiString(fs::path(path).filename().string().c_str()));
-          gs.SetAuthorName(new TCollection_HAsciiString(kAuthor));
-          gs.SetCompanyName(new TCollection_HAsciiString(kAuthor));
-          writer.Model()->SetGlobalSection(gs);
-          if (!writer.AddShape(face)) throw Error(path + ": OpenCASCADE could not translate the face to IGES");
-          writer.ComputeModel();
-          if (!writer.Write(tmp.c_str())) throw Error(path + ": cannot write the IGES file");
-        } catch (const Standard_Failure& f) {
-          throw Error(path + ": OpenCASCADE failed to write IGES (" + occt::failureMessage(f) + ")");
-        }
-      },
-      MissingFolder::Fail);
+  writeFace(path, s, trim, unit, "IGES", [&](const std::string& tmp, const TopoDS_Face& face, const LengthUnit& u) {
+    Interface_Static::SetCVal("write.iges.header.author", kAuthor);
+    Interface_Static::SetCVal("write.iges.header.company", kAuthor);
+    Interface_Static::SetCVal("write.iges.header.product", "pvrr");
+    Interface_Static::SetCVal("write.iges.header.receiver", "");
+    // Mode 0: faces as trimmed surfaces (entity 144), which every IGES reader understands.
+    IGESControl_Writer writer(unit == "mm" ? "MM" : "M", 0);
+    IGESData_GlobalSection gs = writer.Model()->GlobalSection();
+    gs.SetCascadeUnit(u.mm);  // our numbers are already in the file's unit
+    gs.SetDate(new TCollection_HAsciiString(kIgesDate));
+    gs.SetLastChangeDate(new TCollection_HAsciiString(kIgesDate));
+    gs.SetFileName(new TCollection_HAsciiString(fs::path(path).filename().string().c_str()));
+    gs.SetAuthorName(new TCollection_HAsciiString(kAuthor));
+    gs.SetCompanyName(new TCollection_HAsciiString(kAuthor));
+    writer.Model()->SetGlobalSection(gs);
+    if (!writer.AddShape(face)) throw Error(path + ": OpenCASCADE could not translate the face to IGES");
+    writer.ComputeModel();
+    if (!writer.Write(tmp.c_str())) throw Error(path + ": cannot write the IGES file");
+  });
 }
 
 }  // namespace pvrr::cad
