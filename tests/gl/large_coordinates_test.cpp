@@ -10,6 +10,7 @@
 
 #include "pvrr/gl/renderer.h"
 #include "pvrr/trace/tracer.h"
+#include "support/accuracy.h"
 #include "support/gl_backends.h"
 #include "support/scenes.h"
 #include "support/test_scenes.h"
@@ -72,9 +73,7 @@ Result run(const Vec3& offset, RenderMode mode, Kind kind) {
             : kind == Kind::MirrorPair ? mirrorPair(offset)
                                        : mirrorInARoom(offset);
   RayScene rays(s);
-  TraceOptions to;
-  to.max_depth = s.render.max_depth;
-  const Frame ref = Tracer(rays, to).render();
+  const Frame ref = test::referenceFrame(rays);
   gl::RendererOptions opt;
   opt.map_size = 512;
   gl::Renderer r(s, rays, opt);

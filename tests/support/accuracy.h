@@ -13,6 +13,14 @@
 
 namespace pvrr::test {
 
+// The reference picture of `rays`'s scene at the scene's depth limit: what every accuracy test compares with
+// (no dispersion, no caustic light; tests that need them set their own TraceOptions).
+inline Frame referenceFrame(const RayScene& rays) {
+  TraceOptions to;
+  to.max_depth = rays.scene().render.max_depth;
+  return Tracer(rays, to).render();
+}
+
 // The median angular error (arcmin; pvrr/analysis/accuracy.h: for an even count the mean of the two middle errors) over
 // the pixels where the reference sees an element (and its path did not end at the depth limit). Every such pixel must
 // have a finite error (a test failure names each that does not). 1e9 when no pixel has one or the frame has no seen

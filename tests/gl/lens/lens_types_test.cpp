@@ -18,6 +18,7 @@
 #include "pvrr/gl/renderer.h"
 #include "pvrr/trace/tracer.h"
 #include "support/test_scenes.h"
+#include "support/accuracy.h"
 #include "support/gl_backends.h"
 
 namespace pvrr {
@@ -133,9 +134,7 @@ TEST_P(LensTypesTest, TotalInternalReflectionShowsWhatTheReferenceShows) {
   const cad::Outline disc = cad::Outline::circle(0.036);  // diameter
   Scene s = lensScene("plano-convex", cad::makePlane(disc), cad::makeSphere(-0.02, disc), 0.012, disc);
   RayScene rays(s);
-  TraceOptions to;
-  to.max_depth = s.render.max_depth;
-  const Frame ref = Tracer(rays, to).render();
+  const Frame ref = test::referenceFrame(rays);
   gl::Renderer r(s, rays, gl::RendererOptions{});
   const gl::RasterFrame f = r.render(RenderMode::Pvrr);
   ASSERT_EQ(f.elements.size(), 1u);

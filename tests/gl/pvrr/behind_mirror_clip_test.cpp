@@ -13,6 +13,7 @@
 #include "pvrr/scene/scene_build.h"
 #include "pvrr/scene/scene_json.h"
 #include "pvrr/trace/tracer.h"
+#include "support/accuracy.h"
 #include "support/gl_backends.h"
 
 namespace pvrr {
@@ -29,9 +30,7 @@ TEST_P(BehindMirrorClipTest, WallBehindAPlaneMirrorIsClippedFromItsMap) {
                                            "/tests/data/stress/hunt-impostor-behind-two-cards.json",
                                        {"observer.image_size=[160,120]"}));
   RayScene rays(s);
-  TraceOptions to;
-  to.max_depth = s.render.max_depth;
-  const Frame ref = Tracer(rays, to).render();
+  const Frame ref = test::referenceFrame(rays);
   gl::Renderer r(s, rays, gl::RendererOptions{});
   const gl::RasterFrame f = r.render(RenderMode::Pvrr);
   ASSERT_EQ(f.elements.size(), 1u);

@@ -41,9 +41,7 @@ TEST_P(LocalSplitGlTest, StrongLensIsCloserToTheReference) {
   if (!ctx) return;
   const Scene s = strongLens();
   RayScene rays(s);
-  TraceOptions to;
-  to.max_depth = s.render.max_depth;
-  const Frame ref = Tracer(rays, to).render();
+  const Frame ref = test::referenceFrame(rays);
   double median[2];
   for (int local = 0; local < 2; ++local) {
     gl::Renderer r(s, rays, options(local == 1));
@@ -64,9 +62,7 @@ TEST_P(LocalSplitGlTest, PerFragmentRefinementWorksOnTheSplit) {
   if (!ctx) return;
   const Scene s = strongLens({"render.refine=4"});
   RayScene rays(s);
-  TraceOptions to;
-  to.max_depth = s.render.max_depth;
-  const Frame ref = Tracer(rays, to).render();
+  const Frame ref = test::referenceFrame(rays);
   gl::Renderer r(s, rays, options(true));
   const gl::RasterFrame f = r.render(RenderMode::Pvrr);
   ASSERT_NE(f.elements[0].quality.action.find("split locally"), std::string::npos) << f.elements[0].quality.action;

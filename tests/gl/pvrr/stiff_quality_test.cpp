@@ -66,9 +66,7 @@ TEST_P(StiffQualityTest, RightOrFlaggedNeverWrongAndGood) {
     sets.push_back("observer.image_size=[160,120]");
     const Scene s = test::shippedScene(c.scene, sets);
     RayScene rays(s);
-    TraceOptions to;
-    to.max_depth = s.render.max_depth;
-    const Frame ref = Tracer(rays, to).render();
+    const Frame ref = test::referenceFrame(rays);
     gl::Renderer r(s, rays, gl::RendererOptions{});
     const gl::RasterFrame f = r.render(RenderMode::Pvrr);
     size_t pixels = 0;
