@@ -10,9 +10,12 @@
 #include "cad/local_refine.h"
 #include "cad/sag.h"
 #include "cad/tessellate.h"
+#include "support/surfaces.h"
 
 namespace pvrr::cad {
 namespace {
+
+using test::FlippedPlane;
 
 // Boundary vertices lie on the outline's circle: fromSquare maps the square's edge onto it within round-off.
 constexpr double kOnOutline_m = 1e-12;
@@ -176,21 +179,6 @@ TEST(LocalRefine, PatchesShareTheirBoundaryVertices) {
     EXPECT_EQ(a[k].triangles, b[k].triangles);
   }
 }
-
-// A surface whose normal() points against du × dv: the grid's triangles are reversed, and so are the new ones.
-class FlippedPlane : public Surface {
- public:
-  ParamDomain domain() const override { return {}; }
-  SurfaceDerivs evaluate(double u, double v) const override {
-    SurfaceDerivs d{};
-    d.p = Vec3(u, v, 0);
-    d.du = Vec3(1, 0, 0);
-    d.dv = Vec3(0, 1, 0);
-    return d;
-  }
-  Vec3 normal(double, double) const override { return Vec3(0, 0, -1); }
-  std::string describe() const override { return "flipped plane"; }
-};
 
 TEST(LocalRefine, WindingFollowsTheGrid) {
   const FlippedPlane p;

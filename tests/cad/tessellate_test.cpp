@@ -11,9 +11,12 @@
 #include "cad/nurbs.h"
 #include "cad/sag.h"
 #include "cad/tessellate.h"
+#include "support/surfaces.h"
 
 namespace pvrr::cad {
 namespace {
+
+using test::FlippedPlane;
 
 // Distances of vertices from an analytic sphere: a few ulps of the radius.
 constexpr double kOnSurfaceRel = 1e-14;
@@ -79,22 +82,6 @@ TEST(TessellateGrid, NurbsCapWithPoleIsCounterClockwiseWithoutDegenerateTriangle
   EXPECT_EQ(t.params.front(), Vec2(0, 0));
   EXPECT_EQ(t.params.back(), Vec2(1, 1));
 }
-
-// A surface whose normal() points against du × dv (violating the convention) still gets triangles wound
-// counter-clockwise about its normals.
-class FlippedPlane : public Surface {
- public:
-  ParamDomain domain() const override { return {}; }
-  SurfaceDerivs evaluate(double u, double v) const override {
-    SurfaceDerivs d{};
-    d.p = Vec3(u, v, 0);
-    d.du = Vec3(1, 0, 0);
-    d.dv = Vec3(0, 1, 0);
-    return d;
-  }
-  Vec3 normal(double, double) const override { return Vec3(0, 0, -1); }
-  std::string describe() const override { return "flipped plane"; }
-};
 
 TEST(TessellateGrid, WindingFollowsTheNormals) {
   expectCounterClockwise(tessellateGrid(FlippedPlane(), 4, 5));
