@@ -5,6 +5,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "cad/lens_chord.h"
 #include "cad/tessellate.h"
 #include "pvrr/gl/environment_pass.h"
 #include "pvrr/gl/gl.h"
@@ -88,12 +89,22 @@ ShadowPass::ShadowPass(const Scene& scene, const Programs& programs, const Envir
     std::vector<uint32_t> idx;
     for (const auto& tri : t.triangles) idx.insert(idx.end(), {tri.x, tri.y, tri.z});
     uploadMesh(element_meshes_[e], data, {3}, idx);
+    if (el.type == ElementType::Lens && el.absorbing()) {
+      caster_points_.resize(scene_.elements.size());
+      caster_indices_.resize(scene_.elements.size());
+      chord_casters_.resize(scene_.elements.size());
+      caster_points_[e] = t.positions;
+      caster_indices_[e] = idx;
+      chord_casters_[e].resize(scene_.lights.size());
+    }
   }
   checkGlError("making the shadow maps");
 }
 
 ShadowPass::~ShadowPass() {
   for (auto& m : element_meshes_) m.release();
+  for (auto& per_light : chord_casters_)
+    for (ChordCaster& c : per_light) c.mesh.release();
   const unsigned textures[] = {depth_, lens_depth_, lens_t_};
   for (unsigned t : textures)
     if (t) glDeleteTextures(1, &t);
@@ -114,6 +125,7 @@ void ShadowPass::makeLayers() {
       layer.proj = glm::ortho(-radius, radius, -radius, radius, 0.5 * radius, 3.5 * radius);
       layer.texel_m = 2.0 * radius / kMapSize;
       layer.caustics = l.caustics;
+      layer.light = size_t(&l - scene_.lights.data());
       layers_.push_back(layer);
       continue;
     }
@@ -136,6 +148,7 @@ void ShadowPass::makeLayers() {
       layer.near_m = kPointNear_m;
       layer.far_m = far_m;
       layer.caustics = l.caustics;
+      layer.light = size_t(&l - scene_.lights.data());
       layers_.push_back(layer);
     }
   }
@@ -242,14 +255,41 @@ void ShadowPass::render() {
       const Element& el = scene_.elements[e];
       if (el.type != ElementType::Lens) continue;
       lens.set("u_view_proj", toFloat(layer.proj * layer.view * el.local_to_world));
-      lens.set("u_transmittance", layer.caustics ? glm::vec3(0.0f) : glm::vec3(lensShadowPassed(el)));
-      draw(element_meshes_[e]);
+      const bool tinted = el.absorbing() && !layer.caustics;
+      lens.set("u_fresnel", layer.caustics ? glm::vec3(0.0f) : glm::vec3(float(lensShadowTransmittance(el))));
+      lens.set("u_tinted", int(tinted));
+      lens.set("u_absorption_per_m", glm::vec3(el.absorption_per_m));
+      draw(tinted ? tintedCaster(e, layer.light) : element_meshes_[e]);
     }
   }
   glDisable(GL_POLYGON_OFFSET_FILL);
   glBindFramebuffer(GL_FRAMEBUFFER, GLuint(previous_fbo));
   glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
   checkGlError("rendering the shadow maps");
+}
+
+const MeshBuffers& ShadowPass::tintedCaster(size_t element, size_t light) {
+  const Element& el = scene_.elements[element];
+  const Light& l = scene_.lights[light];
+  const bool directional = l.type == Light::Type::Directional;
+  const Vec3 key = directional ? Mat3(el.world_to_local) * l.direction : Vec3(el.world_to_local * Vec4(l.position, 1.0));
+  ChordCaster& c = chord_casters_[element][light];
+  if (c.made && c.light_local == key) return c.mesh;
+  // Each vertex's chord along the light through it; where none exists (a grazing light), the mean thickness
+  // (Element::shadow_path_m), as the reference's shadow rays take it there.
+  const std::vector<Vec3>& points = caster_points_[element];
+  std::vector<float> data;
+  data.reserve(points.size() * 4);
+  for (const Vec3& p : points) {
+    const Vec3 d = directional ? key : p - key;
+    const std::optional<cad::LensChord> chord = cad::chordInside(el.lens, 0, p, d);
+    const double length = chord ? chord->length_m : el.shadow_path_m;
+    data.insert(data.end(), {float(p.x), float(p.y), float(p.z), float(length)});
+  }
+  uploadMesh(c.mesh, data, {3, 1}, caster_indices_[element]);
+  c.light_local = key;
+  c.made = true;
+  return c.mesh;
 }
 
 void ShadowPass::bind(const Program& p, const Vec3& origin) const {

@@ -10,8 +10,9 @@
 // and filtered as 3 x 3 bilinear taps one texel apart (PCF over a 4 x 4 texel footprint, read by four
 // gathers; measured in docs/accuracy.md "Shadows", its cost in docs/performance.md "Shadows").
 // Casters: the environment meshes and the mirrors (opaque); the lenses go into their own depth layers with
-// their transmittance beside, per channel (RGBA16F): (1 - R0)^2, times a tinted lens's absorption over its mean
-// thickness (lensShadowPassed, pvrr/trace/shadow_rays.h): a point behind the nearest lens from the
+// their transmittance beside, per channel (RGBA16F): (1 - R0)^2, times a tinted lens's absorption along the
+// straight chord through its glass towards the light, per caster vertex (cad::chordInside; the reference's
+// shadow rays take the same chord at each point, pvrr/trace/shadow_rays.h): a point behind the nearest lens from the
 // light gets that lens's transmittance, behind an opaque caster nothing; for a light whose caustics are on
 // (pvrr/gl/caustic_pass.h) nothing either, as the light through the lens arrives as the caustic. The maps are
 // rendered when the
@@ -76,7 +77,16 @@ class ShadowPass {
     bool perspective = false;
     double near_m = 0, far_m = 0;  // point: the depth range
     bool caustics = false;         // the light's caustics are on: a lens passes none of its light straight
+    size_t light = 0;              // its light in Scene::lights
   };
+  // A tinted lens's caster for one light: its front surface with each vertex's chord through the glass along
+  // that light (cad::chordInside), remade when the light's direction (or position) in the lens's frame moved.
+  struct ChordCaster {
+    MeshBuffers mesh;
+    Vec3 light_local{0};  // the light's direction (directional) or position (point) in the lens's frame
+    bool made = false;
+  };
+  const MeshBuffers& tintedCaster(size_t element, size_t light);
   void makeLayers();
   void makeTextures();
   void render();
@@ -91,6 +101,9 @@ class ShadowPass {
   int unit_ = 0;  // the depth maps' unit; the lens depths and transmittances on the two after it
   unsigned depth_ = 0, lens_depth_ = 0, lens_t_ = 0, fbo_ = 0;
   std::vector<MeshBuffers> element_meshes_;  // per element: its front surface, element-local
+  std::vector<std::vector<Vec3>> caster_points_;        // per tinted lens: those vertices (else empty)
+  std::vector<std::vector<ChordCaster>> chord_casters_;  // per tinted lens and light
+  std::vector<std::vector<uint32_t>> caster_indices_;    // per tinted lens: its caster's triangles
   ScenePoses rendered_poses_;                // what the maps were rendered with
   bool rendered_ = false;
 };
