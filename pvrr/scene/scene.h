@@ -111,8 +111,8 @@ struct Element {
   // Lens: the glass's absorption coefficient per channel (R, G, B), 1/m (pvrr/optics/material.h); 0: clear.
   Vec3 absorption_per_m{0.0};
   bool absorbing() const { return absorption_per_m != Vec3(0.0); }
-  // Tinted lens: its mean thickness over the outline (m), the glass path the shadow rule charges
-  // (pvrr/trace/shadow_rays.h); 0 for a clear lens, which the rule does not charge.
+  // Tinted lens: its mean thickness over the outline (m), charged by the shadow rule where a line has no
+  // chord through the glass (pvrr/trace/shadow_rays.h: it grazes the surface); 0 for a clear lens.
   double shadow_path_m = 0;
   // What a path of length_m inside the lens's glass keeps per channel: exp(-absorption_per_m length_m).
   Vec3 internalTransmittance(double length_m) const { return pvrr::internalTransmittance(absorption_per_m, length_m); }
