@@ -20,9 +20,10 @@
 // With REFINE_COUNT (the second pass's draws in frames whose counts are read: pvrr/gl/pvrr_refine.cpp), atomic
 // counters count the fragments whose view ray missed the exact surface (the triangles' silhouette overhang) and
 // those whose search failed; pvrr/gl/pvrr_pass.cpp counts the fragments drawn with a query and reads both into
-// the second pass's note once the frame has finished. Without it the shader has no side effects: llvmpipe
-// shaded the counting variant's fragments about 0.8 ms a car-mirror frame slower (docs/performance.md), most of
-// it its late depth test, which a shader that writes memory gets unless it asks for early tests (as it does).
+// the second pass's note once the frame has finished. Without it the shader has no side effects: with them
+// llvmpipe took 0.3 to 0.8 ms longer over a steady car-mirror frame (docs/performance.md "The counters only
+// where they are read"), partly its late depth test, which a shader that writes memory gets unless it asks for
+// early tests (as the counting variant does).
 #if (defined(REFINE) || defined(REFINE_P2)) && CHANNELS != 1 && !defined(LENS)
 #error "REFINE: a mirror's one channel only"
 #endif
