@@ -17,9 +17,13 @@
 // subdivision surface the normal's third derivative jumps and the P2 normal errs by arcminutes, docs/accuracy.md.)
 // The triangles' vertices are not shared: each carries its barycentric corner and its triangle's deviations at
 // the three midpoints, in the channel sets a refined mirror's one channel leaves free (the aliases below).
-// Atomic counters count, in the second pass, the fragments whose view ray missed the exact surface (the
-// triangles' silhouette overhang) and those whose search failed; pvrr/gl/pvrr_pass.cpp counts the fragments
-// drawn with a query and reads both into the second pass's note once the frame has finished.
+// With REFINE_COUNT (the second pass's draws in frames whose counts are read: pvrr/gl/pvrr_refine.cpp), atomic
+// counters count the fragments whose view ray missed the exact surface (the triangles' silhouette overhang) and
+// those whose search failed; pvrr/gl/pvrr_pass.cpp counts the fragments drawn with a query and reads both into
+// the second pass's note once the frame has finished. Without it the shader has no side effects: with them
+// llvmpipe took 0.3 to 0.8 ms longer over a steady car-mirror frame (docs/performance.md "The counters only
+// where they are read"), partly its late depth test, which a shader that writes memory gets unless it asks for
+// early tests (as the counting variant does).
 #if (defined(REFINE) || defined(REFINE_P2)) && CHANNELS != 1 && !defined(LENS)
 #error "REFINE: a mirror's one channel only"
 #endif
@@ -39,14 +43,20 @@ vec2 quadraticST() {
 #endif
 #if defined(REFINE)
 uniform bool u_refine;          // this patch view is refined (else the interpolated coordinate, as without REFINE)
-uniform bool u_count;           // count the fallbacks (the second pass's draws, not the nested ones)
 uniform sampler2D u_map_depth;  // the map's depth attachment (window depth), with a linear sampler
 uniform mat4 u_map_vp;          // the map's camera: positions relative to its viewpoint -> clip
 uniform vec3 u_depth_lin;       // P[2][2], P[3][2] of its projection, and its near depth: the depth along the map's
                                 // forward of NDC depth z is P[3][2] / (z + P[2][2])
 uniform float u_edge;           // across a depth edge: the four texels' depths differ by more than this (relative)
+#if defined(REFINE_COUNT)
+// The depth test before the shader (the shader writes no depth and never discards: the same picture).
+layout(early_fragment_tests) in;
 layout(binding = 0, offset = 0) uniform atomic_uint u_count_failed;
 layout(binding = 0, offset = 4) uniform atomic_uint u_count_missed;
+#define REFINE_COUNTED(counter) atomicCounterIncrement(counter)
+#else
+#define REFINE_COUNTED(counter)
+#endif
 
 const float REFINE_TOL = 2e-5;     // converged: |depth difference| <= this * depth (the depth's float resolution)
 const float REFINE_ACCEPT = 1e-3;  // on the map's surface: at most this, after the last step
@@ -170,12 +180,12 @@ vec2 refinedST(vec3 view, vec2 st_interpolated) {
   if (!u_refine) return st_interpolated;
   vec3 x, R;
   if (!exactReflection(view, x, R)) {
-    if (u_count) atomicCounterIncrement(u_count_missed);
+    REFINE_COUNTED(u_count_missed);
     return st_interpolated;
   }
   vec2 st;
   if (!refineSearch(x, R, v_bary.z, st)) {
-    if (u_count) atomicCounterIncrement(u_count_failed);
+    REFINE_COUNTED(u_count_failed);
     return st_interpolated;
   }
   return mapTexST(st);
@@ -199,7 +209,9 @@ uniform vec3 u_offset;           // element.vert's: the lens's anchor (its local
 uniform mat3 u_to_local;         // world directions -> the lens's local frame (the height maps')
 uniform vec3 u_channel_index;    // the glass's index at the wavelengths of this draw's channels 0, 1, 2
 uniform int u_seen_channel;      // the channel (0 to 2) whose coordinate gives the seen point (v_st_seen's)
+#if defined(REFINE_COUNT)
 layout(binding = 0, offset = 8) uniform atomic_uint u_count_tir;
+#endif
 
 vec3 refine_entry;        // the view ray's entry point (lens frame), its direction and the inward surface normal
 vec3 refine_dir;
@@ -355,10 +367,12 @@ vec2 refinedLensST(int k, vec2 st_interpolated) {
 // Counts the fragment once (the second pass's draws): missed the glass, totally reflected, or some channel's
 // search off the map's surface.
 void refineLensCount() {
-  if (!u_count || refine_state == 0) return;
+#if defined(REFINE_COUNT)
+  if (refine_state == 0) return;
   if (refine_state == 2) atomicCounterIncrement(u_count_missed);
   else if (refine_tir) atomicCounterIncrement(u_count_tir);
   else if (refine_fell_back) atomicCounterIncrement(u_count_failed);
+#endif
 }
 #endif  // LENS
 #endif  // REFINE

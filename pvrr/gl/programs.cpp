@@ -71,16 +71,21 @@ const Program& Programs::envmap(bool lens) const {
               : built("element.vert", "element_envmap.frag", {});
 }
 
-const Program& Programs::pvrr(bool lens, size_t channels, bool rgb, bool planes, int refine, int spheres) const {
+const Program& Programs::pvrr(bool lens, size_t channels, bool rgb, bool planes, int refine, int spheres,
+                              bool count) const {
   std::vector<std::string> d = {channels > 1 ? "#define CHANNELS 3" : "#define CHANNELS 1"};
   if (lens) d.push_back("#define LENS");
   if (rgb) d.push_back("#define RGB_CHANNELS");
   if (refine == kRefineQuadratic) d.push_back("#define REFINE_P2");
   if (refine > 0) {
-    // Its counters and its depth edge test (shaders/pvrr_refine.glsl): GL 4.2's atomic counters and GL 4.0's
-    // textureGather, in a GLSL 3.30 shader.
-    d.push_back("#extension GL_ARB_shader_atomic_counters : require");
+    // Its depth edge test (shaders/pvrr_refine.glsl): GL 4.0's textureGather, in a GLSL 3.30 shader; counting,
+    // GL 4.2's atomic counters and early fragment tests.
     d.push_back("#extension GL_ARB_texture_gather : require");
+    if (count) {
+      d.push_back("#extension GL_ARB_shader_atomic_counters : require");
+      d.push_back("#extension GL_ARB_shader_image_load_store : require");
+      d.push_back("#define REFINE_COUNT");
+    }
     d.push_back("#define REFINE " + std::to_string(refine));
     if (spheres & 1) d.push_back("#define SPHERE_FRONT");
     if (spheres & 2) d.push_back("#define SPHERE_BACK");

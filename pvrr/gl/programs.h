@@ -56,8 +56,11 @@ class Programs {
   // (SPHERE_FRONT, SPHERE_BACK); bit 2 its outline is an ellipse or circle, tested in closed form
   // (OUTLINE_ELLIPSE).
   // refine kRefineQuadratic: a refined mirror's triangles that need no search (REFINE_P2).
+  // count (refine > 0): the variant that counts its fallbacks in atomic counters (REFINE_COUNT); llvmpipe
+  // shades such a shader's fragments markedly slower, so only the draws whose counts are read take it.
   static constexpr int kRefineQuadratic = -1;
-  const Program& pvrr(bool lens, size_t channels, bool rgb, bool planes, int refine = 0, int spheres = 0) const;
+  const Program& pvrr(bool lens, size_t channels, bool rgb, bool planes, int refine = 0, int spheres = 0,
+                      bool count = false) const;
   // Distance-impostor elements (shaders/element_impostor.frag): a mirror, or a lens with one or three
   // wavelengths; cube_elements > 0: searches that meet a mirror in a cube go on in its cubes (CUBE_ELEMENTS).
   // lens_in_cubes: the scene's one lens is drawn in the other elements' cubes and refracted through there.

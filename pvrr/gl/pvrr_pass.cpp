@@ -85,6 +85,7 @@ VertexStageOptions PvrrPass::optionsFor(size_t e) const {
 
 void PvrrPass::prepare(RenderMode, FrameStages& stages, FrameCache* cache) {
   const bool nothing_moved = cpuStages(stages, cache);
+  refine_nothing_moved = nothing_moved;
   // The quadratic split's nodes follow the eye, the element and the scene: kept only while nothing moved.
   if (!nothing_moved)
     for (RefineMidpoints& m : refine_mids) m.nodes_fresh = false;
@@ -373,8 +374,8 @@ void PvrrPass::drawPvrrElement(const ElementFrame& f, size_t first_slot, const P
   const bool refined = refine_skip.size() > size_t(f.element) && refine_skip[size_t(f.element)].empty();
   glm::vec4 spheres_uniform(0.0f), ellipse_uniform(0.0f);
   const int spheres = refined && lens ? refineSpheres(el, &spheres_uniform, &ellipse_uniform) : 0;
-  const Program& p =
-      ctx.programs.pvrr(lens, channels, rgb, cam.planes, refined ? ctx.scene.render.refine : 0, spheres);
+  const Program& p = ctx.programs.pvrr(lens, channels, rgb, cam.planes, refined ? ctx.scene.render.refine : 0, spheres,
+                                       refined && refine_counting && refine_count_frame);
   // A refined mirror in the second pass: its triangles that need no search drawn first by the quadratic
   // program (uploadQuadraticPatch), the others by the search.
   const bool split = refined && !lens && refine_counting;
@@ -578,10 +579,11 @@ bool PvrrPass::additiveDraws() const {
 std::string PvrrPass::drawElements(RenderMode, const PassCamera& eye, const Framebuffer& target) {
   size_t slot = 0;  // the map slot of frames[e].views[0]
   refine_counting = true;
+  refine_count_frame = refineCountThisFrame(eye, target);
   for (size_t e = 0; e < frames.size(); ++e) {
     const ElementFrame& f = frames[e];
     target.bind();
-    const bool refined = refine_skip.size() > e && refine_skip[e].empty();
+    const bool refined = refine_count_frame && refine_skip.size() > e && refine_skip[e].empty();
     if (refined) glBeginQuery(GL_SAMPLES_PASSED, refine_queries[e]);
     if (beyondDepth(ctx.scene, f)) drawDarkElement(f, eye);
     else drawPvrrElement(f, slot, eye, ctx.options.seen_channel);

@@ -64,6 +64,11 @@ class PvrrPass : public ModePass {
   void unsetRefinement() const;
   void setRefinementView(const Program& p, int element, const PatchView& pv, const Framebuffer& map, int side) const;
   std::string refinementSkips(bool* any) const;
+  // Whether this frame's second pass must count the refined elements' fragments (their draws then take the
+  // counting variant, Programs::pvrr's count): true unless it draws exactly what the last counted frame drew
+  // (nothing moved, the same maps, camera, target size, refined elements and split meshes), whose counts the
+  // note then repeats. Records this frame's inputs.
+  bool refineCountThisFrame(const PassCamera& eye, const Framebuffer& target);
   // A part of a patch's triangle (index into GridPatch::triangles): the triangle whose corners have the
   // barycentric coordinates b (of the patch triangle's corners 0, 1, 2); the whole triangle or one of its
   // subdivisions (uploadQuadraticPatch).
@@ -139,6 +144,11 @@ class PvrrPass : public ModePass {
   std::unique_ptr<ImpostorMaps> surface_maps;  // the refined mirrors' surface maps (pvrr/impostor/surface_map.h)
                                                // and lenses' refractor height maps (lens_height_map.h)
   bool refine_counting = false;          // drawing the second pass (counted), not a nested pass
+  bool refine_nothing_moved = false;     // this frame's CPU stages found nothing moved (prepare)
+  bool refine_count_frame = false;       // this frame's second pass counts (refineCountThisFrame)
+  std::vector<double> refine_count_key;  // the inputs of the last counted frame's refined draws
+  mutable uint64_t refine_last_drawn = 0;       // and its counts: fragments drawn, and the counters'
+  mutable std::array<unsigned, 3> refine_last_n{};
   mutable RefineSplitCounts refine_counts;  // this frame's second-pass mirror triangles (uploadQuadraticPatch)
   struct RefineMidpoints {
     cad::SurfacePtr surface;  // what they were computed for (held: never a reused address)

@@ -435,7 +435,6 @@ void PvrrPass::setRefinement(const Program& p, const ElementFrame& f, size_t see
     surface_maps->setMirrorMaps(p, size_t(f.element));
   }
   p.set("u_map_depth", kRefineDepthUnit);
-  p.set("u_count", refine_counting ? 1 : 0);
 }
 
 void PvrrPass::unsetRefinement() const {
@@ -461,9 +460,33 @@ void PvrrPass::setRefinementView(const Program& p, int element, const PatchView&
   p.set("u_edge", float(std::max(0.05, 57.0 * longerExtentTan(pv.volume) / std::max(side, 1))));
 }
 
+bool PvrrPass::refineCountThisFrame(const PassCamera& eye, const Framebuffer& target) {
+  std::vector<double> key;
+  if (ctx.scene.render.refine <= 0) return false;
+  key.push_back(ctx.scene.render.refine);
+  key.push_back(double(first_pass_serial));
+  key.push_back(target.width());
+  key.push_back(target.height());
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) key.push_back(eye.view_proj[c][r]);
+  for (int i = 0; i < 3; ++i) key.insert(key.end(), {eye.origin[i], eye.rays_from[i]});
+  for (size_t e = 0; e < refine_skip.size(); ++e) {
+    const bool refined = refine_skip[e].empty();
+    // A refined mirror's split meshes follow its nodes (recomputed in this frame when not fresh) and whether
+    // they are split (drawRefinedSplit).
+    const bool fresh = e < refine_mids.size() && refine_mids[e].nodes_fresh;
+    const bool settled = e < refine_mids.size() && (refine_mids[e].settled || !refine_continuing);
+    key.push_back(refined ? 1 + 2 * fresh + 4 * settled : 0);
+  }
+  const bool count = !refine_nothing_moved || key != refine_count_key;
+  if (count) refine_count_key = std::move(key);
+  return count;
+}
+
 // The refinement's part of the second pass's note, read once the frame's draws have finished (the renderer's
 // glFinish), so that no draw waits on the counts: the second pass's fragments of the refined elements, those
-// that kept the interpolated coordinate, and the elements not refined with why.
+// that kept the interpolated coordinate, and the elements not refined with why. A frame that drew what the last
+// counted frame drew (refineCountThisFrame) repeats its counts.
 std::string PvrrPass::finishedNote(const std::string& note) const {
   const int steps = ctx.scene.render.refine;
   if (steps <= 0) return note;
@@ -471,17 +494,23 @@ std::string PvrrPass::finishedNote(const std::string& note) const {
   const std::string skipped = refinementSkips(&any);
   std::string refine = "refine (" + std::to_string(steps) + " steps):";
   if (any) {
-    GLuint n[3] = {0, 0, 0};
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_ATOMIC_COUNTER_BARRIER_BIT);
-    glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, refine_counters);
-    glGetBufferSubData(GL_ATOMIC_COUNTER_BUFFER, 0, sizeof(n), n);
-    uint64_t drawn = 0;
-    for (size_t e = 0; e < refine_skip.size(); ++e) {
-      if (!refine_skip[e].empty()) continue;
-      GLuint samples = 0;
-      glGetQueryObjectuiv(refine_queries[e], GL_QUERY_RESULT, &samples);
-      drawn += samples;
+    if (refine_count_frame) {
+      GLuint n[3] = {0, 0, 0};
+      glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_ATOMIC_COUNTER_BARRIER_BIT);
+      glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, refine_counters);
+      glGetBufferSubData(GL_ATOMIC_COUNTER_BUFFER, 0, sizeof(n), n);
+      uint64_t drawn = 0;
+      for (size_t e = 0; e < refine_skip.size(); ++e) {
+        if (!refine_skip[e].empty()) continue;
+        GLuint samples = 0;
+        glGetQueryObjectuiv(refine_queries[e], GL_QUERY_RESULT, &samples);
+        drawn += samples;
+      }
+      refine_last_drawn = drawn;
+      refine_last_n = {n[0], n[1], n[2]};
     }
+    const uint64_t drawn = refine_last_drawn;
+    const std::array<unsigned, 3>& n = refine_last_n;
     refine += " " + std::to_string(drawn) + " fragments drawn, " + std::to_string(n[0]) +
               " kept the interpolated coordinate (search ended off the map's surface), " + std::to_string(n[1]) +
               " kept it where the view ray missed the exact surface";

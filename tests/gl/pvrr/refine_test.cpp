@@ -211,6 +211,39 @@ TEST_P(RefineTest, CountsAreEachFramesOwn) {
   EXPECT_EQ(notes[2], notes[0]);
 }
 
+// A frame that draws what the last counted frame drew (nothing moved, the same maps and camera) is drawn without
+// the counters (their shader variant is slower on llvmpipe) and repeats that frame's counts: the same picture
+// and the same note as a frame that counts, until something moves.
+TEST_P(RefineTest, SteadyFramesRepeatTheCountedFramesCounts) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  const cad::Outline outline = cad::Outline::rectangle(0.5, 0.4, 0.04);
+  Scene s = mirrorScene(cad::makeSphere(1.2, outline), 1);
+  s.render.refine = 2;
+  RayScene rays(s);
+  gl::Renderer r(s, rays, gl::RendererOptions{});
+  gl::FrameCache cache;
+  const Vec3 eye0 = s.observer.eye;
+  std::vector<gl::RasterFrame> frames;
+  std::vector<std::string> notes;
+  // Stands alone, settles (the nodes now cached: counted again), steady twice, moved 1 cm (counted).
+  for (const double dx : {0.0, 0.0, 0.0, 0.0, 0.01}) {
+    s.observer.eye = eye0 + Vec3(dx, 0.0, 0.0);
+    cache.environment_changed = false;
+    frames.push_back(r.render(RenderMode::Pvrr, &cache));
+    notes.push_back(refineNote(frames.back()));
+    const std::array<long, 3> n = refineCounts(notes.back());
+    ASSERT_GE(n[0], 0) << notes.back();
+    EXPECT_EQ(size_t(n[0]), size_t(std::count(frames.back().element.begin(), frames.back().element.end(), 0)))
+        << notes.back();
+  }
+  for (size_t i = 2; i < 4; ++i) {
+    EXPECT_EQ(notes[i], notes[1]);
+    EXPECT_TRUE(frames[i].color == frames[1].color) << "frame " << i << " differs from the counted frame";
+  }
+  EXPECT_NE(notes[4], notes[1]);
+}
+
 // The quadratic split's parts wait for the view to settle: a frame that stands alone (the first of its cache)
 // splits its failing triangles, a frame that moved since the cached one searches them whole (their parts'
 // nodes are not computed while the view moves), and the next frame in which nothing moved splits them again.
