@@ -70,10 +70,13 @@ nlohmann::json compareCaustics(LoadedScene& ls, const std::string& gl_name, cons
   o.spectral_samples = ls.scene.render.spectral_samples;
   const PhotonBundle bundle = shootCausticPhotons(*session.rays, o);
   for (const gl::CausticMap& m : maps) {
-    const std::string name = ls.scene.meshes[size_t(m.mesh)].name;
+    // A sheet of a split mesh (a box's face) is named with its index.
+    const std::string name =
+        ls.scene.meshes[size_t(m.mesh)].name + (m.sheet.whole() ? std::string() : "-sheet" + std::to_string(m.sheet.index));
     DepositOptions d;
     d.mesh = m.mesh;
     d.height_field = !m.height.empty();  // a curved receiver: irradiance per unit area of its surface
+    d.sheet = m.sheet;                   // a sheet: only the photons hitting its triangles
     const IrradianceGrid ref = depositPhotons(bundle, m.grid.rect, d).grid;
     json j = {{"receiver", name},
               {"cells", {m.grid.rect.cells_u, m.grid.rect.cells_v}},

@@ -5,7 +5,7 @@ layout(location = 0) in vec2 a_ndc;       // the vertex's aperture coordinates, 
 layout(location = 1) in vec3 a_origin;    // where it leaves the element, relative to the mesh's anchor
 layout(location = 2) in vec3 a_direction;
 layout(location = 3) in vec3 a_power;     // W per unit aperture measure
-layout(location = 4) in float a_mesh;     // the environment mesh its exit ray meets first (-1: none)
+layout(location = 4) in float a_mesh;     // the receiving surface its exit ray meets first (-1: none; CausticVertex::surface)
 layout(location = 5) in float a_t;        // the distance along the exit ray to that mesh (exact; 0: none)
 out vec3 v_origin;
 out vec3 v_direction;

@@ -15,7 +15,7 @@ uniform vec3 u_centre[CAUSTIC_RECEIVERS];          // each receiver's rectangle:
 uniform vec3 u_axis_u[CAUSTIC_RECEIVERS];
 uniform vec3 u_axis_v[CAUSTIC_RECEIVERS];
 uniform vec2 u_half[CAUSTIC_RECEIVERS];
-uniform int u_mesh[CAUSTIC_RECEIVERS];             // each receiver's Scene::meshes index
+uniform int u_mesh[CAUSTIC_RECEIVERS];             // each receiver's surface: its Scene::meshes index, or a sheet's id
 uniform int u_curved[CAUSTIC_RECEIVERS];           // 1: curved (a height field over its rectangle's plane)
 uniform vec2 u_window_centre;                      // the drawn map's window, receiver coordinates (m)
 uniform vec2 u_window_size;

@@ -161,21 +161,25 @@ void CausticPass::render() {
 // One photon mesh: its caustic map, then its photons into each receiver's light map.
 void CausticPass::splat(const CausticMesh& m) {
   const CausticAperture& ap = m.aperture;
-  // A curved receiver's plane normal per mesh: its photons' power is weighed by cos(theta) between the hit's
-  // normal and that plane's (irradiance per unit area of the surface, as DepositOptions::height_field).
-  std::vector<const ReceiverRect*> curved(scene_.meshes.size(), nullptr);
+  // A curved receiver's plane normal per surface (CausticVertex::surface): its photons' power is weighed by
+  // cos(theta) between the hit's normal and that plane's (irradiance per unit area of the surface, as
+  // DepositOptions::height_field).
+  std::vector<const ReceiverRect*> curved;
   for (const CausticReceiver& r : plan_.receivers)
-    if (r.curved) curved[size_t(r.mesh)] = &r.full;
+    if (r.curved) {
+      if (curved.size() <= size_t(r.surface)) curved.resize(size_t(r.surface) + 1, nullptr);
+      curved[size_t(r.surface)] = &r.full;
+    }
   std::vector<float> data;
   data.reserve(m.vertices.size() * 13);
   for (const CausticVertex& v : m.vertices) {
     const Vec3 o = v.origin - m.anchor;
-    const ReceiverRect* c = v.mesh >= 0 ? curved[size_t(v.mesh)] : nullptr;
+    const ReceiverRect* c = v.surface >= 0 && size_t(v.surface) < curved.size() ? curved[size_t(v.surface)] : nullptr;
     const Vec3 power = c ? v.power_density * std::abs(glm::dot(v.hit_normal, c->normal())) : v.power_density;
     data.insert(data.end(),
                 {float(2 * (v.xy.x - ap.x0) / (ap.x1 - ap.x0) - 1), float(2 * (v.xy.y - ap.y0) / (ap.y1 - ap.y0) - 1),
                  float(o.x), float(o.y), float(o.z), float(v.direction.x), float(v.direction.y), float(v.direction.z),
-                 float(power.x), float(power.y), float(power.z), float(v.mesh), float(v.t_hit)});
+                 float(power.x), float(power.y), float(power.z), float(v.surface), float(v.t_hit)});
   }
   MeshBuffers mesh;
   uploadMesh(mesh, data, {2, 3, 3, 3, 1, 1}, m.triangles);
@@ -210,7 +214,7 @@ void CausticPass::splat(const CausticMesh& m) {
     p.set("u_axis_u" + k, glm::vec3(full.u_axis));
     p.set("u_axis_v" + k, glm::vec3(full.v_axis));
     p.set("u_half" + k, glm::vec2(0.5 * full.width_m, 0.5 * full.height_m));
-    p.set("u_mesh" + k, plan_.receivers[r].mesh);
+    p.set("u_mesh" + k, plan_.receivers[r].surface);
     p.set("u_curved" + k, plan_.receivers[r].curved ? 1 : 0);
   }
   glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
@@ -267,6 +271,7 @@ std::vector<CausticMap> CausticPass::readMaps() const {
     m.mesh = plan_.receivers[r].mesh;
     m.grid = IrradianceGrid::zeros(plan_.receivers[r].window);
     m.height = plan_.receivers[r].height;
+    m.sheet = plan_.receivers[r].sheet;
     for (int j = 0; j < m.grid.rect.cells_v; ++j)
       for (int i = 0; i < m.grid.rect.cells_u; ++i) {
         const float* t = &all[r * layer + (size_t(j) * size_t(cells_side_) + size_t(i)) * 4];

@@ -17,7 +17,10 @@
 //    exact hits, projected onto the plane, its power weighed by cos(theta) between the hit's normal and the
 //    plane's (the irradiance per unit area of the surface); the layer's alpha holds the surface's height over
 //    the plane per cell, which the lookup compares with the shaded point's.
-// What is not drawn: light landing on meshes that are neither planar nor height fields, photons beyond a map's
+//    A mesh that is neither planar nor a height field (a box, a sphere) is mapped per sheet (CausticReceiver::sheet):
+//    the photon-mesh vertices carry the id of the sheet their exact hit triangle belongs to (CausticVertex::surface,
+//    the direction texture's w), and a photon lands only on its own sheet's map.
+// What is not drawn: light landing on a split mesh's triangles that are in no sheet, photons beyond a map's
 // window (it holds 99 % of the landed power), the light reflected by a lens's surfaces; the stage's note says
 // what the plan left out.
 // The maps are made when the renderer's first frame needs them and again only when an element moved (the
@@ -46,6 +49,9 @@ struct CausticMap {
   // A curved receiver: the surface's height over grid.rect's plane per cell (CausticReceiverMap::height); the
   // reference to compare with deposits with DepositOptions::height_field. Empty: planar.
   std::vector<float> height;
+  // One sheet of a mesh split into sheets (a box's face; pvrr/method/receiver_sheets.h), or the whole mesh: the
+  // reference to compare with deposits with DepositOptions::sheet.
+  ReceiverSheet sheet;
 };
 
 class CausticPass {

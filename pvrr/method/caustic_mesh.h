@@ -17,14 +17,17 @@
 // in that plane and hold the irradiance per unit area of the surface (DepositOptions::height_field); each map
 // covers a window about the caustic light landing on it (the square about the landed power's centroid holding
 // kWindowQuantile of it, enlarged kWindowScale times), at most kMaxCausticReceivers receivers, by landed power.
-// Meshes that are neither (closed solids, folded sheets) get no caustic light; the notes name them when photons
-// land on one.
+// Meshes that are neither (closed solids: a box, a sphere; a cylinder over 180 deg) are split into sheets
+// (pvrr/method/receiver_sheets.h), each a receiver of its own, planar or a height field over its own plane; a
+// photon lands on the sheet its exact hit triangle belongs to. The notes say how many sheets, and name what is
+// left out.
 #pragma once
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "pvrr/base/stats.h"
+#include "pvrr/method/receiver_sheets.h"
 
 #include "pvrr/scene/render_desc.h"
 #include "pvrr/trace/irradiance_grid.h"
@@ -60,6 +63,10 @@ struct CausticVertex {
   // so the splat lands the cell's photons only on that mesh's light map: whatever stands between the element and
   // a receiver (an occluder that is not itself a mapped receiver) keeps the light off it.
   int mesh = -1;
+  // The receiving surface it lands on: `mesh` for a mesh that is whole (planar, a height field, or none), else
+  // the id of the sheet its hit triangle belongs to (CausticReceiver::surface; -1: no sheet). The splat compares
+  // it with each receiver's.
+  int surface = -1;
 };
 
 struct CausticMesh {
@@ -82,6 +89,9 @@ struct CausticReceiver {
   // window cell (CausticReceiverMap::height; filled by planCaustics for the receivers it keeps).
   bool curved = false;
   std::vector<float> height;
+  // A sheet of a mesh split into sheets (a box's face, a part of a sphere: sheetReceivers), or the whole mesh.
+  ReceiverSheet sheet;
+  int surface = -1;  // the id the photon-mesh vertices carry (CausticVertex::surface): `mesh` when whole
 };
 
 struct CausticPlan {
@@ -101,13 +111,18 @@ std::vector<CausticReceiver> planarReceivers(const Scene& scene);
 // triangle faces that normal (cos above kMinHeightFieldCos) and no triangle's centroid lies over another
 // triangle; curved = true, `full` their bounding rectangle in that plane through the middle of their heights.
 // Planar meshes are planarReceivers', not these.
-inline constexpr double kMinHeightFieldCos = 1e-3;
 std::vector<CausticReceiver> heightFieldReceivers(const Scene& scene);
+// The sheets of the scene's meshes that are neither planar nor height fields (splitIntoSheets): one receiver per
+// sheet, planar (curved = false) or a height field over its own plane (curved = true), `full` its bounding
+// rectangle there; `sheet` names its triangles. `unsplit` (if given) gets the names of the meshes with triangles
+// in no sheet.
+std::vector<CausticReceiver> sheetReceivers(const Scene& scene, std::vector<std::string>* unsplit = nullptr);
 // The height of mesh `mesh` over `window`'s plane (along its normal, m) at each cell's centre (index j * cells_u
 // + i): the triangles projected onto the plane, interpolated linearly; cells no triangle covers take the mean of
 // their covered neighbours (two rings: the lookup's bilinear interpolation stays on the surface to its rim),
 // else kNoHeight.
-std::vector<float> receiverHeights(const EnvMesh& mesh, const ReceiverRect& window);
+// `sheet` (not whole): only its triangles.
+std::vector<float> receiverHeights(const EnvMesh& mesh, const ReceiverRect& window, const ReceiverSheet& sheet = {});
 // Traces the photon meshes of every light with caustics on and chooses the receivers' windows.
 // Throws pvrr::Error for options out of range.
 CausticPlan planCaustics(const RayScene& rays, const CausticPlanOptions& options);

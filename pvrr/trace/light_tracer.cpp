@@ -164,6 +164,7 @@ PhotonFate followPhoton(const RayScene& rays, int element, double wavelength_nm,
       p.direction = d;
       p.t_hit = hit.hit() ? hit.t : kInf;
       p.mesh = hit.hit() ? hit.mesh : -1;
+      p.triangle = hit.hit() ? hit.triangle : -1;
       p.hit_normal = hit.hit() ? hit.normal : Vec3(0);
       return PhotonFate::Left;
     }
@@ -289,6 +290,7 @@ CausticResult depositPhotons(const PhotonBundle& bundle, const ReceiverRect& rec
       x = p.origin + t * p.direction;
     } else {
       if (!std::isfinite(p.t_hit) || (opt.mesh >= 0 && p.mesh != opt.mesh)) continue;
+      if (!opt.sheet.holds(p.triangle)) continue;
       x = p.origin + p.t_hit * p.direction;
       if (!curved && std::abs(glm::dot(x - rect.centre, normal)) > opt.slab_m) continue;
     }
@@ -387,7 +389,8 @@ CausticLightField causticLightField(const RayScene& rays, const std::vector<Caus
     DepositOptions d;
     d.mesh = w.mesh;
     d.height_field = !w.height.empty();
-    f.receivers.push_back({w.mesh, depositPhotons(b, w.grid.rect, d).grid, w.height});
+    d.sheet = w.sheet;
+    f.receivers.push_back({w.mesh, depositPhotons(b, w.grid.rect, d).grid, w.height, w.sheet});
   }
   f.elapsed_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return f;

@@ -36,6 +36,7 @@
 //   biased low; power is conserved except within half a cell of the border) and divided by the cell area.
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -63,6 +64,7 @@ struct CausticPhoton {
   Vec3 power{0};                 // per channel (W in the scene's light units)
   double t_hit = kInf;           // distance along the ray to the first environment surface (kInf: escapes)
   int mesh = -1;                 // that surface's mesh index, or -1
+  int triangle = -1;             // the hit triangle (an index into that mesh's triangles), or -1
   Vec3 hit_normal{0};            // that surface's unit geometric normal there (the triangle's; 0 when it escapes)
   int light = -1, element = -1;  // where it came from: light index, first element
   int bounces = 0;               // specular events
@@ -85,6 +87,20 @@ struct PhotonBundle {
 // photons_per_side outside [1, 8192] or an element index out of range.
 PhotonBundle shootCausticPhotons(const RayScene& rays, const CausticOptions& options);
 
+// A receiver that is one sheet of a mesh split into sheets (pvrr/method/receiver_sheets.h: a box's face, a part
+// of a sphere): the sheet of each of the mesh's triangles (-1: none) and this receiver's sheet. Only photons whose
+// exact hit triangle lies in the sheet land on it, so no light crosses a seam to the wrong sheet. index -1: the
+// whole mesh.
+struct ReceiverSheet {
+  std::shared_ptr<const std::vector<int>> of_triangle;
+  int index = -1;
+  bool whole() const { return index < 0; }
+  bool holds(int triangle) const {
+    return index < 0 || (of_triangle && triangle >= 0 && size_t(triangle) < of_triangle->size() &&
+                         (*of_triangle)[size_t(triangle)] == index);
+  }
+};
+
 struct DepositOptions {
   enum class Mode { Surfaces, Plane };
   Mode mode = Mode::Surfaces;
@@ -96,6 +112,8 @@ struct DepositOptions {
   // plane's normal, so that each cell holds the irradiance per unit area of the surface (a cell of the plane
   // covers cell area / cos of it), not per unit area of the plane.
   bool height_field = false;
+  // Surfaces: only hits on this sheet of `mesh` (a mesh split into sheets; whole by default).
+  ReceiverSheet sheet;
 };
 
 struct CausticResult {
@@ -125,6 +143,7 @@ struct CausticReceiverMap {
   // on the receiver where its own height lies within DepositOptions::slab_m of these heights' bilinear
   // interpolation (as the irradiance's). Empty: planar, the plane itself (height 0).
   std::vector<float> height;
+  ReceiverSheet sheet;  // one sheet of the mesh (whole by default): only photons hitting its triangles
 };
 // A height map's cells that the surface does not cover: far beyond any slab, finite so that the bilinear
 // interpolation stays finite (no point within a cell of such a cell takes the map's light).

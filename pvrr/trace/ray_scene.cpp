@@ -489,6 +489,7 @@ bool RayScene::resolveCandidate(const Vec3& o, const Vec3& d, double t_min, doub
     const double bw = 1.0 - bu - bv;
     hit.uv = bw * Vec2(mesh.uvs[tri.x]) + bu * Vec2(mesh.uvs[tri.y]) + bv * Vec2(mesh.uvs[tri.z]);
     hit.mesh = g.index;
+    hit.triangle = int(prim_id);
     return true;
   }
   // Element candidate: refined on the exact surface.

@@ -26,6 +26,7 @@ struct RayHit {
                         // oriented as the surface: +z side of the element's local frame)
   Vec2 uv{0};           // environment texture coordinates
   int mesh = -1;        // environment mesh index
+  int triangle = -1;    // environment: the hit triangle, an index into that mesh's triangles
   int element = -1;     // element index
   int surface = 0;      // element surface: 0 = front (mirror surface, lens eye side), 1 = lens back
   Vec2 param{0};        // element surface parameters (u, v) of the exact hit
