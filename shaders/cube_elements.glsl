@@ -48,7 +48,7 @@ uniform mat3 u_lens_to_local;     // world directions -> the lens's local frame 
     int layer;                                                                                                     \
     l = layeredHit(u_seen_cubes[k], u_seen_cubes1[k], x - centre, R, layer);                                       \
     c = layer == 1 ? texture(u_cubes1[k], l).rgb : texture(u_cubes[k], l).rgb;                                     \
-    s = layer == 1 ? texture(u_seen_cubes1[k], l) : texture(u_seen_cubes[k], l);                                   \
+    s = g_seen_at; /* the search's read there (impostor_search.glsl) */                                           \
     nid = layer == 1 ? texture(u_normal_cubes1[k], l) : texture(u_normal_cubes[k], l);                             \
     if (g_escaped) c = u_background, s = vec4(x - centre + R * u_far, 0.0), nid = vec4(0.0);                        \
   }
@@ -59,7 +59,7 @@ uniform mat3 u_lens_to_local;     // world directions -> the lens's local frame 
     l = impostorHit(u_seen_cubes[k], x - centre, R, d_at);                                                         \
     checkResolved(l, d_at);                                                                                        \
     c = texture(u_cubes[k], l).rgb;                                                                                \
-    s = texture(u_seen_cubes[k], l);                                                                               \
+    s = g_seen_at;                                                                                                 \
     nid = texture(u_normal_cubes[k], l);                                                                           \
   }
 #endif

@@ -46,14 +46,14 @@ void envHit(vec3 x, vec3 R, out vec3 colour, out vec4 seen) {
   int layer;
   vec3 l = layeredHit(u_seen_cube, u_seen_cube1, x, R, layer);
   colour = layer == 1 ? texture(u_cube1, l).rgb : texture(u_cube, l).rgb;
-  seen = layer == 1 ? texture(u_seen_cube1, l) : texture(u_seen_cube, l);
+  seen = g_seen_at;  // the search's read there (impostor_search.glsl)
   if (g_escaped) colour = u_background, seen = vec4(x + R * u_far, 0.0);  // past an occluder to the sky
 #else
   float d_at;
   vec3 l = impostorHit(u_seen_cube, x, R, d_at);
   checkResolved(l, d_at);
   colour = texture(u_cube, l).rgb;
-  seen = texture(u_seen_cube, l);
+  seen = g_seen_at;
 #endif
 }
 #endif

@@ -27,14 +27,20 @@ void checkResolved(vec3 l, float d) {
 // that runs a branch's code for a whole SIMD group of pixels (llvmpipe masks lanes; it does not jump) paid for
 // the caller's read after the loop in every pixel, and pays for this pass only in groups where some pixel's
 // search ran out of steps.
+// g_seen_at: the texel itself (the seen point there), which the caller would otherwise read again at the same
+// coordinates for its seen point (element_impostor.frag envHit, cube_elements.glsl): the same value, one cube
+// read fewer for every pixel.
+vec4 g_seen_at = vec4(0.0);
 vec3 falsePosition(samplerCube seen, vec3 x, vec3 R, float r1, float dl, float dun, float pun, float dov, float pov,
                    out float d_at) {
   vec3 l = x + R * dl;
   d_at = -1.0;
   for (int i = 0; i <= IMPOSTOR_ITERATIONS; ++i) {
-    float d = envDistance(seen, l), llp = length(l) / d;
+    vec4 s = texture(seen, l);
+    float d = length(s.xyz), llp = length(l) / d;
     if (abs(1.0 - llp) < 1e-6 || i == IMPOSTOR_ITERATIONS) {  // as close as float distances resolve, or the last
       d_at = d;
+      g_seen_at = s;
       break;
     }
     float ddl;
@@ -50,9 +56,10 @@ vec3 falsePosition(samplerCube seen, vec3 x, vec3 R, float r1, float dl, float d
   }
   if (dot(l, l) > 0.0) return l;
   d_at = r1;
+  g_seen_at = texture(seen, R);  // (rare: a read here costs the pixels of its SIMD group only)
   return R;  // x at the cube's origin and d = 0: the direction itself
 }
-// r1: the distance the impostor holds along R; d_at as falsePosition's.
+// r1: the distance the impostor holds along R; d_at and g_seen_at as falsePosition's.
 vec3 impostorHit(samplerCube seen, vec3 x, vec3 R, out float r1, out float d_at) {
   r1 = envDistance(seen, R);
   float dp = r1 - dot(x, R);
@@ -155,11 +162,12 @@ vec3 layeredHit(samplerCube seen0, samplerCube seen1, vec3 x, vec3 R, out int la
   g_escaped = false;
   float rR0, d_at;
   vec3 l0 = impostorHit(seen0, x, R, rR0, d_at);
-  if (onSurface(seen0, l0, R, d_at) && !(texture(seen0, l0).w < 0.5 && skyPastSurface(seen0, x, R))) return l0;
+  if (onSurface(seen0, l0, R, d_at) && !(g_seen_at.w < 0.5 && skyPastSurface(seen0, x, R))) return l0;
 #if !defined(LAYER_MARCH)
   discard;  // the second draw, LAYER_MARCH, shades this pixel (pvrr/gl/cube_pass.cpp)
   return l0;
 #else
+  vec4 s_l0 = g_seen_at;  // (g_seen_at: the texel of the layer at the point returned)
   float a = length(x), t0 = 0.25 / float(LAYER_STEPS), d_prev = a * t0 / (1.0 - t0);
   vec3 p0 = x + R * d_prev;
   vec4 s0 = texture(seen0, p0), s1 = texture(seen1, p0);
@@ -191,15 +199,19 @@ vec3 layeredHit(samplerCube seen0, samplerCube seen1, vec3 x, vec3 R, out int la
     }
     if (i > LAYER_STEPS) break;  // no bracket left
     vec3 l, best = l0;
+    vec4 s_best = s_l0;
     float d_best = -1.0;
     if (r_prev.x < 1.0 && r.x >= 1.0 && layerCrossing(seen0, x, R, rR0, d_prev, r_prev.x, d, r.x, at_end, l))
-      best = l, d_best = dot(l - x, R);
+      best = l, d_best = dot(l - x, R), s_best = g_seen_at;
     if (r_prev.y < 1.0 && r.y >= 1.0 && layerCrossing(seen1, x, R, rR1, d_prev, r_prev.y, d, r.y, at_end, l) &&
         (d_best < 0.0 || dot(l - x, R) < d_best)) {
       layer = 1;
       return l;
     }
-    if (d_best >= 0.0) return best;
+    if (d_best >= 0.0) {
+      g_seen_at = s_best;
+      return best;
+    }
     d_prev = d, r_prev = r, w_prev = w;
     ++i;
   }
@@ -208,6 +220,7 @@ vec3 layeredHit(samplerCube seen0, samplerCube seen1, vec3 x, vec3 R, out int la
     return R;
   }
   g_unresolved = true;  // no bracket on either layer's surface
+  g_seen_at = s_l0;
   return l0;
 #endif
 }
