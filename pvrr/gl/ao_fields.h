@@ -19,10 +19,12 @@
 // fragments read (AoReceiver::Screen); moving ones (a car under another's field) evaluate the fields per fragment.
 #pragma once
 #include <array>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "pvrr/base/stats.h"
+#include "pvrr/gl/ao_vertex_receivers.h"
 #include "pvrr/gl/programs.h"
 #include "pvrr/method/ao_field.h"
 #include "pvrr/scene/scene.h"
@@ -77,6 +79,9 @@ class AoFields {
   // Notes the stage: the fields' count, size and precomputation time (once: "built"; later frames: "reused").
   void note(FrameStages& stages) const;
   const std::vector<AoField>& fields() const { return fields_; }
+  // The faces drawn with vertex values (a cache of grids made on first use, remade when something moves;
+  // null when the fields are not active).
+  AoVertexReceivers* vertexReceivers() const { return receivers_.get(); }
 
  private:
 
@@ -90,6 +95,7 @@ class AoFields {
   double build_ms_ = 0;
   size_t volume_bytes_ = 0, ground_bytes_ = 0;
   mutable bool noted_ = false;
+  std::unique_ptr<AoVertexReceivers> receivers_;
 };
 
 }  // namespace pvrr::gl
