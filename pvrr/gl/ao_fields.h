@@ -15,8 +15,10 @@
 // occlusion. Of the rest, a horizontal plane facing up (grounds, pavements: static, not an occluder, every
 // normal vertical, one height) is evaluated from the ground maps (pvrr/method/ao_field.h groundMap: one
 // bilinear lookup per occluder) while every occluder turns about the vertical only, anything else from the
-// volumes. Static receivers are evaluated so only into the pass's low-resolution occlusion image, which their
-// fragments read (AoReceiver::Screen); moving ones (a car under another's field) evaluate the fields per fragment.
+// volumes. A face that is a rectangle (static or moving) is drawn instead as a grid whose vertices hold its
+// occlusion (AoReceiver::Vertex, pvrr/gl/ao_vertex_receivers.h: no texture read per fragment). Of what cannot be
+// tessellated so, static receivers are evaluated only into the pass's low-resolution occlusion image, which their
+// fragments read (AoReceiver::Screen); moving ones evaluate the fields per fragment.
 #pragma once
 #include <array>
 #include <memory>

@@ -63,7 +63,7 @@ std::string AoVertexReceivers::note() const {
   }
   char text[256];
   std::snprintf(text, sizeof text,
-                "vertex values on %d face%s: %d triangles, %d vertices, %d grid%s made in %.1f ms (the last %.1f ms; "
+                "vertex values (faces drawn so far) on %d face%s: %d triangles, %d vertices, %d grid%s made in %.1f ms (the last %.1f ms; "
                 "made again only when the mesh or an occluder moves)",
                 faces, faces == 1 ? "" : "s", triangles, vertices, builds_, builds_ == 1 ? "" : "s", build_ms_,
                 last_build_ms_);
