@@ -7,7 +7,19 @@
 // field reaches is drawn without AMBIENT_OCCLUSION at all. llvmpipe shades both sides of a per-fragment branch,
 // so nothing here branches per fragment; a field that does not reach the draw is weighted by 0 (a loop over
 // a uniform list of them, dynamically indexed, measured slower).
-#if defined(AMBIENT_OCCLUSION) && defined(AO_SCREEN)
+#if defined(AMBIENT_OCCLUSION) && defined(AO_VALUES)
+// A faceted face drawn as a grid whose vertices hold its occlusion (pvrr/gl/ao_vertex_receivers.h): for its
+// normal as uploaded and for the opposite one; the side facing the viewer is chosen per vertex (one per face),
+// and the value interpolated across the triangles: no texture read.
+#if defined(AO_VERTEX)
+layout(location = 3) in vec2 a_ao;
+out float v_ao_value;
+void aoValues(vec3 n_facing, vec3 n_uploaded) { v_ao_value = dot(n_facing, n_uploaded) > 0.0 ? a_ao.x : a_ao.y; }
+#else
+in float v_ao_value;
+float ambientOcclusion(vec3 x, vec3 n) { return v_ao_value; }
+#endif
+#elif defined(AMBIENT_OCCLUSION) && defined(AO_SCREEN)
 // A static receiver in a pass that drew the occlusion image first (pvrr/gl/environment_pass.cpp): its occlusion,
 // evaluated from the fields at an eighth of the resolution per axis, read bilinearly where the fragment lies.
 #if !defined(AO_VERTEX)

@@ -34,6 +34,9 @@ void main() {
 #if defined(AO_PER_VERTEX) && !defined(AO_GROUND)
   aoVertexNormal(n);
 #endif
+#if defined(AMBIENT_OCCLUSION) && defined(AO_VALUES)
+  aoValues(n, a_normal);
+#endif
 #endif
 #if defined(AO_PER_VERTEX)
   aoVertex(v_pos);

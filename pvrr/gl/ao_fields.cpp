@@ -77,6 +77,7 @@ std::string ambientOcclusionSkipReason(const Scene& scene) {
 std::vector<std::string> aoDefines(const Scene& scene, AoReceiver receiver) {
   if (receiver == AoReceiver::None || !ambientOcclusionSkipReason(scene).empty()) return {};
   if (receiver == AoReceiver::Screen) return {"#define AMBIENT_OCCLUSION", "#define AO_SCREEN"};
+  if (receiver == AoReceiver::Vertex) return {"#define AMBIENT_OCCLUSION", "#define AO_VALUES"};
   std::vector<std::string> d = {"#define AMBIENT_OCCLUSION", "#define AO_FIELDS " + std::to_string(occluderCount(scene)),
                                 "#define AO_VOLUME " + std::to_string(kAoVolumeSize)};
   // 6 varying components per occluder (offset and face normal): with the environment's own 14, within the 64
@@ -147,6 +148,7 @@ AoFields::AoFields(const Scene& scene, int max_texture_units) : scene_(scene), u
     ground_bytes_ = maps.size();
   }
   checkGlError("uploading the ambient occlusion fields");
+  receivers_ = std::make_unique<AoVertexReceivers>(scene_, fields_);
 }
 
 AoFields::~AoFields() {
@@ -249,7 +251,7 @@ AoFields::Draw AoFields::receiver(size_t m, const std::array<Vec3, 2>& box, cons
 }
 
 void AoFields::setReceiver(const Program& p, size_t m, const Draw& d) const {
-  if (!active() || d.kind == AoReceiver::None || d.kind == AoReceiver::Screen) return;
+  if (!active() || d.kind == AoReceiver::None || d.kind == AoReceiver::Screen || d.kind == AoReceiver::Vertex) return;
   for (size_t f = 0; f < fields_.size(); ++f) p.set("u_ao_reaches[" + std::to_string(f) + "]", d.reaches[f]);
   p.set("u_ao_height", m < mesh_height_.size() ? std::max(0, mesh_height_[m]) : 0);
 }
@@ -277,6 +279,7 @@ void AoFields::note(FrameStages& stages) const {
     note += text;
   }
   note += " m";
+  if (receivers_) note += "; " + receivers_->note();
   stages.ran(kAmbientOcclusionStage, noted_ ? 0 : build_ms_, int(fields_.size()), note);
   noted_ = true;
 }

@@ -15,14 +15,18 @@
 // occlusion. Of the rest, a horizontal plane facing up (grounds, pavements: static, not an occluder, every
 // normal vertical, one height) is evaluated from the ground maps (pvrr/method/ao_field.h groundMap: one
 // bilinear lookup per occluder) while every occluder turns about the vertical only, anything else from the
-// volumes. Static receivers are evaluated so only into the pass's low-resolution occlusion image, which their
-// fragments read (AoReceiver::Screen); moving ones (a car under another's field) evaluate the fields per fragment.
+// volumes. A face that is a rectangle (static or moving) is drawn instead as a grid whose vertices hold its
+// occlusion (AoReceiver::Vertex, pvrr/gl/ao_vertex_receivers.h: no texture read per fragment). Of what cannot be
+// tessellated so, static receivers are evaluated only into the pass's low-resolution occlusion image, which their
+// fragments read (AoReceiver::Screen); moving ones evaluate the fields per fragment.
 #pragma once
 #include <array>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "pvrr/base/stats.h"
+#include "pvrr/gl/ao_vertex_receivers.h"
 #include "pvrr/gl/programs.h"
 #include "pvrr/method/ao_field.h"
 #include "pvrr/scene/scene.h"
@@ -77,6 +81,9 @@ class AoFields {
   // Notes the stage: the fields' count, size and precomputation time (once: "built"; later frames: "reused").
   void note(FrameStages& stages) const;
   const std::vector<AoField>& fields() const { return fields_; }
+  // The faces drawn with vertex values (a cache of grids made on first use, remade when something moves;
+  // null when the fields are not active).
+  AoVertexReceivers* vertexReceivers() const { return receivers_.get(); }
 
  private:
 
@@ -90,6 +97,7 @@ class AoFields {
   double build_ms_ = 0;
   size_t volume_bytes_ = 0, ground_bytes_ = 0;
   mutable bool noted_ = false;
+  std::unique_ptr<AoVertexReceivers> receivers_;
 };
 
 }  // namespace pvrr::gl

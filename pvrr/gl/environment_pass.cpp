@@ -116,6 +116,7 @@ void EnvironmentPass::upload(size_t m) {
       groups[g].first = int(idx.size());
       for (size_t t = 0; t < mesh.triangles.size(); ++t) {
         if (of[t] != g) continue;
+        groups[g].triangles.push_back(uint32_t(t));
         const auto& tri = mesh.triangles[t];
         idx.insert(idx.end(), {tri.x, tri.y, tri.z});
         for (const uint32_t v : {tri.x, tri.y, tri.z}) {
@@ -220,7 +221,7 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
   glDepthFunc(reversed_depth ? GL_GREATER : GL_LESS);
   // The programs of the kinds of mesh the scene has, [ambient occlusion][faceted][textured], set up for this
   // pass when first drawn; a draw's ambient occlusion variant is chosen per mesh or face (AoFields::receiver).
-  const Program* kinds[4][2][2] = {};
+  const Program* kinds[5][2][2] = {};
   glm::vec4 ao_image_map(0.0f);  // the occlusion image's coordinates (shaders/ambient_occlusion.glsl)
   auto program = [&](AoReceiver ao, bool faceted, bool textured) -> const Program& {
     const Program*& p = kinds[int(ao)][faceted][textured];
@@ -235,7 +236,7 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
     setLights(*p, scene, origin);
     if (shadows_) shadows_->bind(*p, origin);
     if (caustics_) caustics_->bind(*p, origin);
-    if (ao_) ao_->bind(*p, origin);
+    if (ao_ && ao != AoReceiver::Vertex) ao_->bind(*p, origin);
     if (ao == AoReceiver::Screen) {
       p->set("u_ao_image", ao_->unit());
       p->set("u_ao_image_map", ao_image_map);
@@ -243,8 +244,9 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
     glActiveTexture(GL_TEXTURE0);
     return *p;
   };
-  // Indices [first, first + count) of mesh m, drawn with ambient occlusion d.
-  auto drawPart = [&](size_t m, const AoFields::Draw& d, int first, int count) {
+  // Indices [first, first + count) of mesh m (or of the vertex-value grid `grid` of one of its faces), drawn with
+  // ambient occlusion d.
+  auto drawPart = [&](size_t m, const AoFields::Draw& d, int first, int count, const MeshBuffers* grid) {
     const EnvMesh& mesh = scene.meshes[m];
     const Program& p = program(d.kind, env_faceted[m], env_textured[m]);
     p.use();
@@ -252,7 +254,7 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
     p.set("u_albedo", glm::vec3(scene.materials[size_t(mesh.material)].color));
     if (ao_) ao_->setReceiver(p, m, d);
     if (env_textured[m]) glBindTexture(GL_TEXTURE_2D, textures[size_t(scene.materials[size_t(mesh.material)].texture)].name());
-    glBindVertexArray(env_meshes[m].vao);
+    glBindVertexArray(grid ? grid->vao : env_meshes[m].vao);
     glDrawElements(GL_TRIANGLES, count, GL_UNSIGNED_INT, reinterpret_cast<const void*>(size_t(first) * sizeof(uint32_t)));
   };
   const Vec3 viewer = rays_from ? *rays_from : origin;  // where the two-sided normals face
@@ -275,8 +277,34 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
     bool cull;
     AoFields::Draw ao;
     int first, count;
+    const MeshBuffers* grid = nullptr;  // a face drawn with vertex values (AoReceiver::Vertex): its grid
   };
   std::vector<Part> parts;
+  // How each mesh or face is ambient-occluded (AoFields::receiver; its vertex-value grid where it has one), kept
+  // while nothing moves: per mesh, face (-1: the whole mesh) and side the viewer is on (-1, 0, 1).
+  if (ao_ && scene.mesh_motion != ao_choices_motion) {
+    ao_choices.clear();
+    ao_choices_motion = scene.mesh_motion;
+  }
+  auto choice = [&](size_t m, int g, int side) -> const AoChoice& {
+    const auto [it, added] = ao_choices.try_emplace({m, g, side});
+    if (!added) return it->second;
+    AoChoice& c = it->second;
+    const EnvMesh& mesh = scene.meshes[m];
+    AoVertexReceivers* receivers = ao_->vertexReceivers();
+    if (g < 0) {
+      c.draw = ao_->receiver(m, worldBox(m));
+      if (receivers && c.draw.kind != AoReceiver::None) receivers->fallback(m, env_faceted[m] ? "more than 12 planes" : "not faceted");
+      return c;
+    }
+    const FaceGroup& f = env_groups[m][size_t(g)];
+    const Vec3 facing = side > 0 ? -f.normal : f.normal;
+    c.draw = ao_->receiver(m, {f.box[0] + mesh.anchor, f.box[1] + mesh.anchor}, side != 0 ? &facing : nullptr);
+    // A face some field counts for: its vertex-value grid where it has one (made or remade now if needed).
+    if (c.draw.kind != AoReceiver::None && receivers) c.grid = receivers->grid(m, size_t(g), f.triangles, f.normal);
+    if (c.grid) c.draw = AoFields::Draw{AoReceiver::Vertex, {}};
+    return c;
+  };
   CullCount count;
   const std::vector<std::array<Vec3, 2>> relative = boxes(origin);  // camera-relative
   for (const size_t m : drawOrder(relative, reversed_depth)) {
@@ -285,16 +313,19 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
     count.drawn += mesh.closed_convex;
     count.culled += cull;
     if (!ao_ || env_groups[m].empty()) {
-      parts.push_back({m, cull, ao_ ? ao_->receiver(m, worldBox(m)) : AoFields::Draw{}, 0, env_meshes[m].count});
+      parts.push_back({m, cull, ao_ ? choice(m, -1, 0).draw : AoFields::Draw{}, 0, env_meshes[m].count});
       continue;
     }
-    for (const FaceGroup& g : env_groups[m]) {
+    for (size_t gi = 0; gi < env_groups[m].size(); ++gi) {
+      const FaceGroup& g = env_groups[m][gi];
       const double side = glm::dot(g.normal, g.point + mesh.anchor - viewer);
-      const Vec3 facing = side > 0 ? -g.normal : g.normal;
-      const AoFields::Draw d =
-          ao_->receiver(m, {g.box[0] + mesh.anchor, g.box[1] + mesh.anchor}, side != 0 ? &facing : nullptr);
-      if (parts.empty() || parts.back().m != m || !(parts.back().ao == d))
-        parts.push_back({m, cull, d, g.first, 0});
+      const AoChoice& c = choice(m, int(gi), side > 0 ? 1 : side < 0 ? -1 : 0);
+      if (c.grid) {
+        parts.push_back({m, cull, c.draw, 0, c.grid->count, c.grid});
+        continue;
+      }
+      if (parts.empty() || parts.back().m != m || !(parts.back().ao == c.draw) || parts.back().grid)
+        parts.push_back({m, cull, c.draw, g.first, 0});
       parts.back().count += g.count;
     }
   }
@@ -302,7 +333,9 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
   // times fewer pixels per axis) and read from it bilinearly: fewer evaluations of the fields, one texture lookup
   // per fragment whatever the number of occluders. Not in the zooming-region and peeling passes.
   const bool image = ao_ && ao_->active() && !reversed_depth && !peel;
-  auto screen = [&](const Part& part) { return image && part.ao.kind != AoReceiver::None && !scene.meshAnimated(part.m); };
+  auto screen = [&](const Part& part) {
+    return image && (part.ao.kind == AoReceiver::Ground || part.ao.kind == AoReceiver::Volume) && !scene.meshAnimated(part.m);
+  };
   if (std::any_of(parts.begin(), parts.end(), screen)) {
     ao_image.begin();
     // The static receivers alone, nearest first: a moving one, and what is drawn without occlusion, hide nothing
@@ -341,7 +374,7 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
       part.cull ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
       culling = part.cull;
     }
-    drawPart(part.m, screen(part) ? AoFields::Draw{AoReceiver::Screen, {}} : part.ao, part.first, part.count);
+    drawPart(part.m, screen(part) ? AoFields::Draw{AoReceiver::Screen, {}} : part.ao, part.first, part.count, part.grid);
   }
   glDisable(GL_CULL_FACE);
   glFrontFace(GL_CCW);

@@ -2,8 +2,11 @@
 // textures), drawn from any camera in camera-relative coordinates; the lights' uniforms every program shares.
 #pragma once
 #include <array>
+#include <map>
+#include <tuple>
 #include <vector>
 
+#include "pvrr/gl/ao_fields.h"
 #include "pvrr/gl/framebuffer.h"
 #include "pvrr/gl/gl_objects.h"
 #include "pvrr/gl/occlusion_image.h"
@@ -15,7 +18,6 @@ namespace pvrr::gl {
 
 class ShadowPass;
 class CausticPass;
-class AoFields;
 
 // The uniforms of shaders/shading.glsl, for a pass whose camera origin is `origin`.
 void setLights(const Program& p, const Scene& scene, const Vec3& origin);
@@ -93,9 +95,18 @@ class EnvironmentPass {
     Vec3 normal{0};            // the planes' normal, as uploaded
     Vec3 point{0};             // a point of the plane, relative to the mesh's anchor
     std::array<Vec3, 2> box;   // its vertices' bounding box, relative to the mesh's anchor
+    std::vector<uint32_t> triangles;  // its triangles (the mesh's), for its vertex-value grid (AoVertexReceivers)
   };
   std::vector<std::vector<FaceGroup>> env_groups;
   bool group_faces = false;  // the scene has ambient occlusion
+  // How each mesh or face is ambient-occluded (EnvironmentPass::draw), per (mesh, face or -1, the viewer's side),
+  // for the meshes' motions in ao_choices_motion.
+  struct AoChoice {
+    AoFields::Draw draw;
+    const MeshBuffers* grid = nullptr;
+  };
+  mutable std::map<std::tuple<size_t, int, int>, AoChoice> ao_choices;
+  mutable std::vector<Mat4> ao_choices_motion;
   // The passes' low-resolution occlusion image (the static receivers' ambient occlusion).
   mutable OcclusionImage ao_image;
   std::vector<Texture> textures;  // environment textures, in Scene::textures order

@@ -15,8 +15,9 @@ namespace pvrr::gl {
 
 // How an environment draw's fragments are ambient-occluded (the program variant; pvrr/gl/ao_fields.h): not at
 // all, from the ground maps (a horizontal plane facing up), from the occlusion volumes, from the pass's
-// low-resolution occlusion image (static receivers: pvrr/gl/environment_pass.h).
-enum class AoReceiver { None, Ground, Volume, Screen };
+// low-resolution occlusion image (static receivers: pvrr/gl/environment_pass.h), from the vertices' values (a
+// faceted face re-tessellated as a grid: pvrr/gl/ao_vertex_receivers.h).
+enum class AoReceiver { None, Ground, Volume, Screen, Vertex };
 
 class Programs {
  public:

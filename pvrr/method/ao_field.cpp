@@ -254,12 +254,12 @@ double groundMapOcclusion(const AoField& f, const std::vector<uint8_t>& map, con
   return o;
 }
 
-double volumeOcclusion(const AoField& f, const Mat4& motion, const Vec3& x_world, const Vec3& n_world) {
-  if (f.volume.empty()) return 0;
-  const Mat3 r(motion);
-  const Vec3 p = glm::transpose(r) * (x_world - Vec3(motion[3])) - f.centre, n = glm::transpose(r) * n_world;
+std::array<double, 6> volumeCube(const AoField& f, const Mat4& motion, const Vec3& x_world) {
+  std::array<double, 6> o{};
+  if (f.volume.empty()) return o;
+  const Vec3 p = glm::transpose(Mat3(motion)) * (x_world - Vec3(motion[3])) - f.centre;
   const double fade = aoFade(f.radius * f.radius / std::max(glm::dot(p, p), 1e-300));
-  if (fade <= 0) return 0;
+  if (fade <= 0) return o;
   const int sz = kAoVolumeSize;
   // Trilinear between grid points at texture coordinates (i + 0.5) / n, clamped at the outermost (GL's
   // GL_LINEAR with GL_CLAMP_TO_EDGE).
@@ -271,17 +271,26 @@ double volumeOcclusion(const AoField& f, const Mat4& motion, const Vec3& x_world
     i0[a] = std::min(int(std::floor(g[a])), sz - 2);
     fr[a] = g[a] - i0[a];
   }
-  double o[6] = {};
   for (int c = 0; c < 8; ++c) {
     const int dx = c & 1, dy = (c >> 1) & 1, dz = c >> 2;
     const double w = (dx ? fr[0] : 1 - fr[0]) * (dy ? fr[1] : 1 - fr[1]) * (dz ? fr[2] : 1 - fr[2]);
     const uint8_t* texel =
         &f.volume[(size_t(i0[2] + dz) * size_t(sz) * size_t(sz) + size_t(i0[1] + dy) * size_t(sz) + size_t(i0[0] + dx)) * 8];
-    for (int a = 0; a < 6; ++a) o[a] += w * texel[a] / 255.0;
+    for (size_t a = 0; a < 6; ++a) o[a] += w * texel[a] / 255.0;
   }
+  for (double& v : o) v *= fade;
+  return o;
+}
+
+double cubeOcclusion(const std::array<double, 6>& o, const Vec3& n) {
   double sum = 0;
-  for (int a = 0; a < 3; ++a) sum += n[a] * n[a] * o[2 * a + (n[a] < 0)];
-  return fade * sum;
+  for (int a = 0; a < 3; ++a) sum += n[a] * n[a] * o[size_t(2 * a + (n[a] < 0))];
+  return sum;
+}
+
+double volumeOcclusion(const AoField& f, const Mat4& motion, const Vec3& x_world, const Vec3& n_world) {
+  if (f.volume.empty()) return 0;
+  return cubeOcclusion(volumeCube(f, motion, x_world), glm::transpose(Mat3(motion)) * n_world);
 }
 
 double volumeVisibility(const std::vector<AoField>& fields, const Scene& scene, const Vec3& x, const Vec3& n,

@@ -37,6 +37,7 @@
 // trilinear ones of four.
 #pragma once
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -109,6 +110,10 @@ double fieldVisibility(const std::vector<AoField>& fields, const Scene& scene, c
 // The occlusion of the field's volume (trilinear, ambient cube) at world x with unit normal n: what a frame
 // shades (shaders/ambient_occlusion.glsl).
 double volumeOcclusion(const AoField& f, const Mat4& motion, const Vec3& x, const Vec3& n);
+// The volume's ambient cube at world x (trilinear, the fade included): the occlusion for the six axis normals
+// +x, -x, +y, -y, +z, -z of the field's frame; and what it gives normal n (the field's frame): sum n_i^2 O_i.
+std::array<double, 6> volumeCube(const AoField& f, const Mat4& motion, const Vec3& x);
+double cubeOcclusion(const std::array<double, 6>& cube, const Vec3& n);
 // The visibility from the volumes of every occluder but `receiver`.
 double volumeVisibility(const std::vector<AoField>& fields, const Scene& scene, const Vec3& x, const Vec3& n,
                         int receiver);

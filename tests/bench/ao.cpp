@@ -55,6 +55,7 @@ void BM_AoFrame(benchmark::State& state, const char* name, RenderMode mode, std:
   opt.seen_points = false;  // the picture only, as pvrr render draws it
   gl::Renderer r_off(off, rays_off, opt), r_on(on, rays_on, opt);
   r_off.render(mode);  // warm-up: shader compilation (and, with ambient occlusion, the fields)
+  r_on.render(mode);  // (the vertex-value grids are made while the first frame draws: noted from the second)
   const gl::RasterFrame first = r_on.render(mode);
   std::vector<double> with, without, cpu_with, cpu_without;
   for (auto _ : state) {

@@ -125,6 +125,32 @@ TEST_P(AmbientOcclusionTest, TheFieldMovesWithTheCar) {
                "moved car", 5000, 0.4);
 }
 
+// The static faces are drawn with vertex values (pvrr/gl/ao_vertex_receivers.h), kept from frame to frame: with
+// the car moved between two frames of one renderer, the second frame's ground follows it (its grids made again)
+// and agrees with the reference there.
+TEST_P(AmbientOcclusionTest, TheVertexValuesFollowTheCarFromFrameToFrame) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  const SceneDesc desc =
+      carDesc(R"({"keys": [{"time_s": 0}, {"time_s": 1, "offset": [1.5, 0, -1], "rotation_deg": [0, 40, 0]}]})", "", "true");
+  Scene s = buildScene(desc);
+  applyAnimation(s, desc, 0.0);
+  RayScene rays(s);
+  gl::Renderer renderer(s, rays, gl::RendererOptions{});
+  const Frame before_ref = Tracer(rays, TraceOptions{}).render();
+  expectAgrees(groundDifference(before_ref, renderer.render(RenderMode::Raster), 0, 1.0, Vec3(0)),
+               "vertex values, first frame", 5000, 0.4);
+  renderer.render(RenderMode::Raster);  // the grids kept: nothing moved
+  applyAnimation(s, desc, 1.0);
+  RayScene moved_rays(s);
+  const Frame after_ref = Tracer(moved_rays, TraceOptions{}).render();
+  const gl::RasterFrame after = renderer.render(RenderMode::Raster);
+  expectAgrees(groundDifference(after_ref, after, 0, 1.0, Vec3(1.5, 0, -1)), "vertex values, the car moved", 5000, 0.4);
+  const StageTiming* stage = after.stages.find(gl::kAmbientOcclusionStage);
+  ASSERT_TRUE(stage);
+  EXPECT_NE(stage->note.find("vertex values (faces drawn so far) on"), std::string::npos) << stage->note;
+}
+
 // A car lifted off the ground (a jump): its ground maps no longer lie on the road's plane, so the road reads the
 // occlusion volumes instead (pvrr/gl/ao_fields.h), and agrees all the same.
 TEST_P(AmbientOcclusionTest, ALiftedCarsGroundReadsTheVolumes) {
