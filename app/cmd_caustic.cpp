@@ -48,17 +48,35 @@ double mean3(const Vec3& v) { return (v.x + v.y + v.z) / 3.0; }
 // A receiver: a quad or ground of the scene (their rectangles are the scene's own), or a curved mesh that is a
 // height field over its best-fit plane (pvrr/method/caustic_mesh.h heightFieldReceivers: the rectangle in that
 // plane; the map holds the irradiance per unit area of the surface).
+// A mesh that is neither (a box, a sphere) is split into sheets (pvrr/method/receiver_sheets.h): the receiver is
+// then one sheet, named "<mesh>-sheet<k>" as pvrr compare names it, and only photons hitting its triangles count.
 struct Receiver {
   int index = -1;  // environment object = mesh index (a curved receiver: its mesh index)
   std::string name;
   ReceiverRect rect;
   bool curved = false;
+  ReceiverSheet sheet;  // whole unless the mesh is split into sheets
 };
+
+// Mesh m's sheets (none when it is planar or one sheet), each with the scalar power of the photons landing on it.
+std::vector<std::pair<Receiver, double>> sheetsOf(const Scene& scene, int m, const PhotonBundle& b) {
+  std::vector<std::pair<Receiver, double>> out;
+  for (const CausticReceiver& c : sheetReceivers(scene)) {
+    if (c.mesh != m) continue;
+    double power = 0;
+    for (const CausticPhoton& p : b.photons)
+      if (p.mesh == m && std::isfinite(p.t_hit) && c.sheet.holds(p.triangle)) power += mean3(p.power);
+    out.push_back({Receiver{m, scene.meshes[size_t(m)].name + "-sheet" + std::to_string(c.sheet.index), c.full,
+                            c.curved, c.sheet},
+                   power});
+  }
+  return out;
+}
 
 // The height-field receiver of mesh `mesh`, if it is one.
 std::optional<Receiver> curvedReceiver(const Scene& scene, int mesh) {
   for (const CausticReceiver& c : heightFieldReceivers(scene))
-    if (c.mesh == mesh) return Receiver{mesh, scene.meshes[size_t(mesh)].name, c.full, true};
+    if (c.mesh == mesh) return Receiver{mesh, scene.meshes[size_t(mesh)].name, c.full, true, ReceiverSheet{}};
   return std::nullopt;
 }
 
@@ -92,11 +110,21 @@ Receiver chooseReceiver(const SceneDesc& desc, const Scene& scene, const PhotonB
         continue;
       }
       if (isPlanar(o)) return receiverOf(desc, int(i));
-      for (size_t m = 0; m < scene.meshes.size(); ++m)
-        if (scene.meshes[m].name == *asked)
-          if (const std::optional<Receiver> c = curvedReceiver(scene, int(m))) return *c;
+      for (size_t m = 0; m < scene.meshes.size(); ++m) {
+        if (scene.meshes[m].name != *asked) continue;
+        if (const std::optional<Receiver> c = curvedReceiver(scene, int(m))) return *c;
+        // Split into sheets: the one the most caustic light lands on.
+        const auto sheets = sheetsOf(scene, int(m), b);
+        const auto lit = std::max_element(sheets.begin(), sheets.end(),
+                                          [](const auto& x, const auto& y) { return x.second < y.second; });
+        if (lit != sheets.end() && lit->second > 0) return lit->first;
+        if (lit != sheets.end())
+          throw Error(path + ": environment[" + std::to_string(i) + "] (" + o.name + "): no caustic light lands on " +
+                      "any of its " + std::to_string(sheets.size()) + " sheets");
+      }
       throw Error(path + ": environment[" + std::to_string(i) + "] (" + o.name + "): a receiver must be a quad, a " +
-                  "ground or a mesh that is a height field over a plane, not this " + std::string(nameOf(o.type)));
+                  "ground or a mesh with a sheet that is a height field over a plane, not this " +
+                  std::string(nameOf(o.type)));
     }
     const std::string hint = nearest(*asked, names);
     throw Error(path + ": environment: no object named \"" + *asked + "\"" +
@@ -112,7 +140,17 @@ Receiver chooseReceiver(const SceneDesc& desc, const Scene& scene, const PhotonB
   for (const CausticReceiver& c : heightFieldReceivers(scene))
     if (power[size_t(c.mesh)] > 0 && power[size_t(c.mesh)] > (best < 0 ? 0.0 : power[size_t(best)]) &&
         (!curved || power[size_t(c.mesh)] > power[size_t(curved->index)]))
-      curved = Receiver{c.mesh, scene.meshes[size_t(c.mesh)].name, c.full, true};
+      curved = Receiver{c.mesh, scene.meshes[size_t(c.mesh)].name, c.full, true, ReceiverSheet{}};
+  // A sheet of a split mesh competes with the rest by its own landed power.
+  double curved_power = curved ? power[size_t(curved->index)] : 0.0;
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    if (power[m] <= 0) continue;
+    for (const auto& [sheet, sheet_power] : sheetsOf(scene, int(m), b))
+      if (sheet_power > 0 && sheet_power > (best < 0 ? 0.0 : power[size_t(best)]) && sheet_power > curved_power) {
+        curved = sheet;
+        curved_power = sheet_power;
+      }
+  }
   if (curved) return *curved;
   if (best < 0)
     throw Error(path + ": environment: no quad, ground or height-field mesh receives caustic light (" +
@@ -132,7 +170,7 @@ void chooseWindow(Receiver& r, const PhotonBundle& b, const Args& a, const std::
   } else {
     std::vector<std::pair<Vec2, double>> landed;
     for (const CausticPhoton& p : b.photons) {
-      if (p.mesh != r.index || !std::isfinite(p.t_hit)) continue;
+      if (p.mesh != r.index || !std::isfinite(p.t_hit) || !r.sheet.holds(p.triangle)) continue;
       const Vec2 uv = full.toReceiver(p.origin + p.t_hit * p.direction);
       if (full.contains(uv)) landed.push_back({uv, mean3(p.power)});
     }
@@ -348,6 +386,7 @@ int cmdCaustic(const std::vector<std::string>& argv) {
   dep.mesh = rec.index;
   dep.slab_m = kSlab_m;
   dep.height_field = rec.curved;
+  dep.sheet = rec.sheet;
   const CausticResult res = depositPhotons(b, rec.rect, dep);
   const SpotMetrics s = spotMetrics(res.grid);
   if (!s.found) throw Error(scene_path + ": environment (" + rec.name + "): no caustic light inside the window");
