@@ -20,6 +20,17 @@ using pvrr::test::slurp;
 
 const char* kFiles[] = {"caustic.png", "caustic-colour.png", "caustic.csv", "caustic.json"};
 
+// The shipped scene `model` with one more environment object, `object`, inserted before the entry that starts with
+// `before`; written to dir/scene.json, whose path it returns.
+fs::path sceneWithObject(const fs::path& dir, const char* model, const std::string& before, const std::string& object) {
+  std::string scene = slurp(fs::path(PVRR_SOURCE_DIR) / model);
+  const size_t at = scene.find(before);
+  EXPECT_NE(at, std::string::npos) << before;
+  if (at != std::string::npos) scene.insert(at, object + ",\n    ");
+  std::ofstream(dir / "scene.json") << scene;
+  return dir / "scene.json";
+}
+
 TEST(CausticCli, BurningLensFocusesTheSunOnTheTable) {
   const fs::path dir = pvrr::test::freshTestDir("caustic-lens");
   const CliResult r = runPvrr("caustic models/burning-lens.json --photons 128 --cells 80 --out '" + dir.string() + "'");
@@ -89,17 +100,14 @@ TEST(CausticCli, BurningLensOnACurvedBowl) {
         obj << "f " << a << "//" << a << " " << d << "//" << d << " " << c << "//" << c << "\n";
       }
   }
-  std::string scene = slurp(fs::path(PVRR_SOURCE_DIR) / "models/burning-lens.json");
-  const std::string wall = "    {\"type\": \"quad\", \"name\": \"wall\"";
-  const size_t at = scene.find(wall);
-  ASSERT_NE(at, std::string::npos);
-  scene.insert(at, "    {\"type\": \"mesh\", \"name\": \"bowl\", \"file\": \"" + (dir / "bowl.obj").string() +
-                       "\", \"transform\": {\"position\": [" + std::to_string(kX) + ", " + std::to_string(kY) +
-                       ", 0]}, \"material\": {\"color\": [0.9, 0.9, 0.9]}},\n");
-  std::ofstream(dir / "scene.json") << scene;
+  const fs::path scene = sceneWithObject(dir, "models/burning-lens.json", "{\"type\": \"quad\", \"name\": \"wall\"",
+                                         "{\"type\": \"mesh\", \"name\": \"bowl\", \"file\": \"" +
+                                             (dir / "bowl.obj").string() + "\", \"transform\": {\"position\": [" +
+                                             std::to_string(kX) + ", " + std::to_string(kY) +
+                                             ", 0]}, \"material\": {\"color\": [0.9, 0.9, 0.9]}}");
   const fs::path out = dir / "out";
-  const CliResult r = runPvrr("caustic '" + (dir / "scene.json").string() + "' --photons 128 --cells 80 --out '" +
-                              out.string() + "'");
+  const CliResult r =
+      runPvrr("caustic '" + scene.string() + "' --photons 128 --cells 80 --out '" + out.string() + "'");
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(slurp(out / "caustic.json"));
   EXPECT_EQ(j["receiver"]["name"], "bowl");
@@ -124,16 +132,12 @@ TEST(CausticCli, BurningLensOnACurvedBowl) {
 // the mirror, y = 1.0 - 0.383 sin(8 deg) = 0.947, with all of the reflected power (none strays to the other faces).
 TEST(CausticCli, ShavingMirrorOnABoxFace) {
   const fs::path dir = pvrr::test::freshTestDir("caustic-box");
-  std::string scene = slurp(fs::path(PVRR_SOURCE_DIR) / "models/shaving-mirror-sun.json");
-  const std::string table = "    {\"type\": \"box\", \"name\": \"table\"";
-  const size_t at = scene.find(table);
-  ASSERT_NE(at, std::string::npos);
-  scene.insert(at, "    {\"type\": \"box\", \"name\": \"plaque\", \"centre\": [0, 0.944, 0.011], \"size\": [0.2, 0.2, "
-                   "0.02], \"material\": {\"color\": [0.9, 0.9, 0.9]}},\n");
-  std::ofstream(dir / "scene.json") << scene;
+  const fs::path scene = sceneWithObject(dir, "models/shaving-mirror-sun.json", "{\"type\": \"box\", \"name\": \"table\"",
+                                         "{\"type\": \"box\", \"name\": \"plaque\", \"centre\": [0, 0.944, 0.011], "
+                                         "\"size\": [0.2, 0.2, 0.02], \"material\": {\"color\": [0.9, 0.9, 0.9]}}");
   const fs::path out = dir / "out";
-  const CliResult r = runPvrr("caustic '" + (dir / "scene.json").string() + "' --photons 128 --cells 80 --out '" +
-                              out.string() + "'");
+  const CliResult r =
+      runPvrr("caustic '" + scene.string() + "' --photons 128 --cells 80 --out '" + out.string() + "'");
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(slurp(out / "caustic.json"));
   const std::string name = j["receiver"]["name"].get<std::string>();

@@ -19,16 +19,7 @@ Scene beamScene(const char* which) {
   s.observer.eye = Vec3(0.3, 0.3, 0.3);
   s.observer.target = Vec3(0.4, 0, 0);
   const std::string w = which;
-  const Vec3 n = glm::normalize(Vec3(-0.342, 0, 0.940));
-  const Vec3 beam(1, 0, 0);
-  test::HeightField f;
-  f.base = Vec3(0.4, 0, 0), f.n = n, f.u = glm::normalize(beam - glm::dot(beam, n) * n);
-  f.half_x = 0.12, f.half_y = 0.06;
-  constexpr double kA = 0.002, kK = 2 * kPi / 0.02;
-  const double a = w == "flat" ? 0.0 : kA;  // the waves, or the same plane flat
-  f.height = [=](double x, double) { return a * std::sin(kK * x); };
-  f.gradient = [=](double x, double) { return Vec2(a * kK * std::cos(kK * x), 0.0); };
-  test::addBeamOnReceiver(s, f, 240, 60, "receiver");
+  test::addBeamOnReceiver(s, test::grazingWaves(w == "flat" ? 0.0 : 0.002), 240, 60, "receiver");
   if (w == "box") {
     const double t = radians(30);
     const Mat3 rot(Vec3(std::cos(t), std::sin(t), 0), Vec3(-std::sin(t), std::cos(t), 0), Vec3(0, 0, 1));

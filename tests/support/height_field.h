@@ -71,6 +71,21 @@ inline HeightField cylinderSegment(const Vec3& base, const Vec3& n, const Vec3& 
   return f;
 }
 
+// Waves of amplitude `a` (metres) and wavelength 20 mm along the plane's u, over 240 x 120 mm of a plane at
+// x = 0.4 tilted 20 deg from facing the beam along +x: the grazing receiver of the caustic tests (a = 0: the same
+// plane flat).
+inline HeightField grazingWaves(double a) {
+  const Vec3 n = glm::normalize(Vec3(-0.342, 0, 0.940));
+  const Vec3 beam(1, 0, 0);
+  HeightField f;
+  f.base = Vec3(0.4, 0, 0), f.n = n, f.u = glm::normalize(beam - glm::dot(beam, n) * n);
+  f.half_x = 0.12, f.half_y = 0.06;
+  const double k = 2 * kPi / 0.02;
+  f.height = [=](double x, double) { return a * std::sin(k * x); };
+  f.gradient = [=](double x, double) { return Vec2(a * k * std::cos(k * x), 0.0); };
+  return f;
+}
+
 // The beam scenes of the curved-receiver tests: the height field's mesh (diffuse) as receiver, the sun straight
 // down (-z, radiance 1) with caustics on, and a plane mirror of radius `mirror_radius` at the origin facing
 // (1, 0, 1), which turns the sun's light along +x onto the receiver.

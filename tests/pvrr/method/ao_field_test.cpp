@@ -16,6 +16,7 @@
 #include "pvrr/method/ao_field.h"
 #include "pvrr/trace/ambient_occlusion.h"
 #include "pvrr/trace/ray_scene.h"
+#include "support/ao_scenes.h"
 
 namespace pvrr {
 namespace {
@@ -32,22 +33,6 @@ constexpr double kFieldTol = 0.03;
 constexpr double kGroundMad = 0.05;
 
 // Adds a mesh as object `object`; `occluder`: its EnvMesh::occluder (-1: it does not occlude).
-void addObject(Scene& s, EnvMesh mesh, size_t object, int occluder) {
-  mesh.occluder = occluder;
-  mesh.material = 0;
-  s.meshes.push_back(mesh);
-  s.mesh_object.push_back(object);
-  s.placed_meshes.push_back(EnvMesh{});
-  s.mesh_motion.push_back(Mat4(1.0));
-}
-
-Scene baseScene() {
-  Scene s;
-  s.materials.push_back(DiffuseMaterial{});
-  s.render.ambient_occlusion.on = true;
-  return s;
-}
-
 TEST(AoFieldTest, SamplingMapsInvert) {
   for (double a = -0.95; a <= 0.95; a += 0.1)
     for (double b = -0.95; b <= 0.95; b += 0.1) {
@@ -70,9 +55,9 @@ TEST(AoFieldTest, SamplingMapsInvert) {
 }
 
 TEST(AoFieldTest, SphereMatchesTheFormFactor) {
-  Scene s = baseScene();
+  Scene s = test::aoBaseScene();
   const double r = 0.5;
-  addObject(s, makeSphereMesh(Vec3(0), r, 192, 96), 0, 0);
+  test::addAoObject(s, makeSphereMesh(Vec3(0), r, 192, 96), 0, 0);
   s.updateBounds();
   const RayScene rays(s);
   const AoField f = buildAoField(s, 0, 64, 16);
@@ -95,9 +80,9 @@ TEST(AoFieldTest, PointUnderASquareMatchesTheFormFactor) {
   // A 2 m square slab 1 m above the point, parallel, centred: four rectangles a = b = h with the point under
   // a corner, each F = (1 / 2 pi) (2 X / sqrt(1 + X^2) atan(X / sqrt(1 + X^2))), X = a / h (the form factor of
   // a differential area to a parallel rectangle). A = 1 - 4 F.
-  Scene s = baseScene();
+  Scene s = test::aoBaseScene();
   const double h = 1.0, half = 1.0, thick = 0.01;
-  addObject(s, makeBoxMesh(Vec3(0, h + thick / 2, 0), Vec3(2 * half, thick, 2 * half), Mat3(1.0)), 0, 0);
+  test::addAoObject(s, makeBoxMesh(Vec3(0, h + thick / 2, 0), Vec3(2 * half, thick, 2 * half), Mat3(1.0)), 0, 0);
   s.updateBounds();
   const RayScene rays(s);
   const AoField f = buildAoField(s, 0, 64, 16);
@@ -110,34 +95,12 @@ TEST(AoFieldTest, PointUnderASquareMatchesTheFormFactor) {
   EXPECT_EQ(referenceAmbientVisibility(rays, Vec3(0, h + 0.5, 0), Vec3(0, 1, 0), -1, 256), 1.0);
 }
 
-// A box car (body, cabin, four wheels: one occluder of six boxes) on a ground quad, optionally moved rigidly.
-Scene carScene(const Mat4& motion) {
-  Scene s = baseScene();
-  addObject(s, makeQuadMesh(Vec3(0), Vec3(0, 1, 0), Vec3(0, 0, -1), 60, 60), 0, -1);
-  std::vector<EnvMesh> parts = {makeBoxMesh(Vec3(0, 0.75, 0), Vec3(4.4, 0.8, 1.8), Mat3(1.0)),
-                                makeBoxMesh(Vec3(-0.3, 1.45, 0), Vec3(2.4, 0.6, 1.6), Mat3(1.0))};
-  for (const double wx : {-1.4, 1.4})
-    for (const double wz : {-0.8, 0.8}) parts.push_back(makeBoxMesh(Vec3(wx, 0.32, wz), Vec3(0.64, 0.64, 0.22), Mat3(1.0)));
-  const Mat3 r(motion);
-  for (EnvMesh& m : parts) {
-    const EnvMesh placed = m;
-    m.anchor = Vec3(motion * Vec4(placed.anchor, 1.0));
-    for (size_t i = 0; i < m.positions.size(); ++i) m.positions[i] = glm::vec3(r * Vec3(placed.positions[i]));
-    for (size_t i = 0; i < m.normals.size(); ++i) m.normals[i] = glm::vec3(r * Vec3(placed.normals[i]));
-    addObject(s, m, 1, 0);
-    s.placed_meshes.back() = placed;
-    s.mesh_motion.back() = motion;
-  }
-  s.updateBounds();
-  return s;
-}
-
 // Mean |A_field - A_reference| over ground points within 7 m of the car's centre (a 0.5 m grid, points under
 // the body included, points inside a wheel's footprint left out), and the largest; likewise for the occlusion
 // volume (volume_mad) and the ground map at the ground's height (ground_mad, what the raster modes shade).
 void groundDifference(const Mat4& motion, double& mad, double& worst, double& darkest, double& volume_mad,
                       double& ground_mad) {
-  const Scene s = carScene(motion);
+  const Scene s = test::boxCarScene(motion);
   const RayScene rays(s);
   const std::vector<AoField> fields = buildAoFields(s);
   ASSERT_EQ(fields.size(), 1u);

@@ -14,6 +14,7 @@
 #include "pvrr/method/ao_receiver_grid.h"
 #include "pvrr/trace/ambient_occlusion.h"
 #include "pvrr/trace/ray_scene.h"
+#include "support/ao_scenes.h"
 
 namespace pvrr {
 namespace {
@@ -24,15 +25,6 @@ constexpr double kGroundMad = 0.05;
 constexpr double kSizeTol = 1e-5;
 // llvmpipe pays per triangle: a ground of 60 m around one car stays within the low thousands.
 constexpr size_t kMaxTriangles = 6000;
-
-void addObject(Scene& s, EnvMesh mesh, size_t object, int occluder) {
-  mesh.occluder = occluder;
-  mesh.material = 0;
-  s.meshes.push_back(mesh);
-  s.mesh_object.push_back(object);
-  s.placed_meshes.push_back(EnvMesh{});
-  s.mesh_motion.push_back(Mat4(1.0));
-}
 
 std::vector<uint32_t> allTriangles(const EnvMesh& m) {
   std::vector<uint32_t> t(m.triangles.size());
@@ -61,30 +53,6 @@ TEST(AoReceiverGridTest, FindsRectangles) {
   EXPECT_EQ(why, "its face is not a rectangle");
 }
 
-// A box car (one occluder of six boxes) on a 60 m ground, moved by `motion`.
-Scene carScene(const Mat4& motion) {
-  Scene s;
-  s.materials.push_back(DiffuseMaterial{});
-  s.render.ambient_occlusion.on = true;
-  addObject(s, makeQuadMesh(Vec3(0), Vec3(0, 1, 0), Vec3(0, 0, -1), 60, 60), 0, -1);
-  std::vector<EnvMesh> parts = {makeBoxMesh(Vec3(0, 0.75, 0), Vec3(4.4, 0.8, 1.8), Mat3(1.0)),
-                                makeBoxMesh(Vec3(-0.3, 1.45, 0), Vec3(2.4, 0.6, 1.6), Mat3(1.0))};
-  for (const double wx : {-1.4, 1.4})
-    for (const double wz : {-0.8, 0.8}) parts.push_back(makeBoxMesh(Vec3(wx, 0.32, wz), Vec3(0.64, 0.64, 0.22), Mat3(1.0)));
-  const Mat3 r(motion);
-  for (EnvMesh& m : parts) {
-    const EnvMesh placed = m;
-    m.anchor = Vec3(motion * Vec4(placed.anchor, 1.0));
-    for (size_t i = 0; i < m.positions.size(); ++i) m.positions[i] = glm::vec3(r * Vec3(placed.positions[i]));
-    for (size_t i = 0; i < m.normals.size(); ++i) m.normals[i] = glm::vec3(r * Vec3(placed.normals[i]));
-    addObject(s, m, 1, 0);
-    s.placed_meshes.back() = placed;
-    s.mesh_motion.back() = motion;
-  }
-  s.updateBounds();
-  return s;
-}
-
 // The grid's value at plane point p (mesh coordinates) for side `side`: the triangle holding it, linearly.
 bool interpolate(const AoReceiverGrid& g, const Vec3& p, const Vec3& n, int side, double& out) {
   for (size_t t = 0; t < g.indices.size(); t += 3) {
@@ -103,7 +71,7 @@ bool interpolate(const AoReceiverGrid& g, const Vec3& p, const Vec3& n, int side
 // The ground's grid (made with the car where `motion` puts it) against the reference within 7 m of the car on a
 // 0.5 m grid (points inside a wheel's footprint left out); also checks the grid is closed.
 void groundAgrees(const Mat4& motion, const char* what) {
-  const Scene s = carScene(motion);
+  const Scene s = test::boxCarScene(motion);
   const RayScene rays(s);
   const std::vector<AoField> fields = buildAoFields(s);
   const EnvMesh& ground = s.meshes[0];
