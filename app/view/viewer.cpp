@@ -259,7 +259,9 @@ void Viewer::frame() {
   // draws of the saved view: frames that reuse earlier maps (map reuse, render.map_reuse_margin_deg) differ
   // from a fresh frame in places, as they do in pvrr render --frames --orbit.
   gl::FrameCache whole;
+  const double render_cpu0_ms = threadCpuMs();
   gl::RasterFrame f = renderer_->render(mode_, pending_screenshots_.empty() ? &cache_ : &whole);
+  renderer_cpu_ms_.push_back(threadCpuMs() - render_cpu0_ms);
   cache_.environment_changed = false;  // the environment never changes while the window is open
   for (const StageTiming& st : f.stages.stages)
     if (st.ran) {
@@ -627,6 +629,9 @@ json Viewer::stats() const {
            {{"render", t.empty() ? 0.0 : median(render_ms_)},
             // of which the renderer's frame itself, as pvrr render's frame_ms times it
             {"renderer", t.empty() ? 0.0 : median(renderer_ms_)},
+            // and the window thread's CPU time in it (with LP_NUM_THREADS=0 llvmpipe draws on this thread: the
+            // whole frame's CPU, whatever the load)
+            {"renderer_thread_cpu", t.empty() ? 0.0 : median(renderer_cpu_ms_)},
             {"present", t.empty() ? 0.0 : median(present_ms_)},
             {"panel", t.empty() ? 0.0 : median(panel_ms_)},
             // of which making it (Dear ImGui's frame and the panel's items, no GL; and a frame drawn again)

@@ -179,7 +179,7 @@ class Viewer {
   int frames_ = 0, saved_ = 0;
   std::vector<double> frame_ms_;  // every frame, for --stats
   // Where each frame's time went: the renderer's frame, presenting it, the panel, the swap and input.
-  std::vector<double> render_ms_, renderer_ms_, present_ms_, panel_ms_, panel_make_ms_, swap_ms_;
+  std::vector<double> render_ms_, renderer_ms_, renderer_cpu_ms_, present_ms_, panel_ms_, panel_make_ms_, swap_ms_;
   std::deque<double> recent_ms_;  // the last frames, for the panel
   std::map<std::string, std::pair<int, double>> stage_ms_;  // the renderer's stages: frames ran, their ms summed
   enum class Drag { None, Look, Wipe };

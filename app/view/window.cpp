@@ -30,6 +30,9 @@ namespace {
 // The window showed nothing of its own or lost it since the last swap (an expose, a resize): set by GLFW's
 // callbacks (one visible window a process), read after each poll.
 bool g_window_lost = false;
+// The window's framebuffer size as the last poll left it (GLFW's callback): glfwGetFramebufferSize asks the X
+// server each call (XGetWindowAttributes, a round trip), and the frame asked it three times.
+int g_framebuffer_width = 0, g_framebuffer_height = 0;
 
 std::string g_glfw_error;  // the last GLFW error, for the messages
 void onGlfwError(int code, const char* text) { g_glfw_error = std::string(text) + " (GLFW error " + std::to_string(code) + ")"; }
@@ -145,7 +148,12 @@ Window::Window(int width, int height, WindowGl api, bool vsync, const std::strin
     }
   }
   glfwSetWindowRefreshCallback(window_, [](GLFWwindow*) { g_window_lost = true; });
-  glfwSetFramebufferSizeCallback(window_, [](GLFWwindow*, int, int) { g_window_lost = true; });
+  glfwGetFramebufferSize(window_, &g_framebuffer_width, &g_framebuffer_height);
+  glfwSetFramebufferSizeCallback(window_, [](GLFWwindow*, int width, int height) {
+    g_window_lost = true;
+    g_framebuffer_width = width;
+    g_framebuffer_height = height;
+  });
   GLFWwindow* w = window_;
   gl::ForeignContext fc;
   fc.backend_name = name;
@@ -222,7 +230,10 @@ gl::ForeignContext WorkerContext::foreign() const {
 
 bool Window::closeRequested() const { return glfwWindowShouldClose(window_); }
 
-void Window::framebufferSize(int* width, int* height) const { glfwGetFramebufferSize(window_, width, height); }
+void Window::framebufferSize(int* width, int* height) const {
+  *width = g_framebuffer_width;
+  *height = g_framebuffer_height;
+}
 
 void beginPresentPass(int width, int height) {
   glBindFramebuffer(GL_FRAMEBUFFER, 0);

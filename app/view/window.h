@@ -67,6 +67,7 @@ class Window {
   gl::GlContext& context() { return *context_; }
   GLFWwindow* handle() { return window_; }
   bool closeRequested() const;
+  // The framebuffer's size as the last poll of events left it (swapAndPoll; a resize shows from the next frame).
   void framebufferSize(int* width, int* height) const;
   // Draws `texture` (a linear colour texture of the framebuffer's size, Renderer::colorTexture) into the default
   // framebuffer, encoded to sRGB as pvrr::srgbPicture encodes a picture, but for the pixels of `hole` (where an
