@@ -652,12 +652,12 @@ json Viewer::stats() const {
                        {"shows_part", window_.showsPart()},
                        {"part_shows", window_.partShows()},
                        {"panel_rect", {panel_rect_.x0, panel_rect_.y0, panel_rect_.x1, panel_rect_.y1}}}},
-          // The panel drawn from its picture (app/view/panel_cache.h): pictures made, frames copied from one.
-          // Of those, frames that kept the panel the window showed (not drawn; the frame shown less its
-          // rectangle: present.part_shows, where the window shows part of its back buffer, shows_part).
           // Screenshots of the window as shown ("panel": "shown"): the frame (1 the first) and whether it kept the
           // panel an earlier frame showed.
           {"shown_screenshots", shown_shots_},
+          // The panel drawn from its picture (app/view/panel_cache.h): pictures made, frames copied from one, and
+          // frames that kept the panel the window showed (not drawn; the frame shown less its rectangle:
+          // present.part_shows, where the window shows part of its back buffer, present.shows_part).
           {"panel", {{"pictures", window_.panelCache().pictures()},
                      {"copies", window_.panelCache().copies()},
                      {"kept", window_.panelCache().kept()}}},
