@@ -67,7 +67,7 @@ const std::map<std::string, Command>& commands() {
         "metres in\n"
         "  the observer frame: x right, y up, -z forward), \"screenshot\" (\"file\": PNG, the frame without the "
         "panel,\n"
-        "  or with it: \"panel\": true),\n"
+        "  or with it: \"panel\": true, or the window as shown: \"panel\": \"shown\"),\n"
         "  \"save_view\" (\"file\": JSON), \"key\" (\"key\": a GLFW key name of the keys above, \"shift\": "
         "true|false), \"quit\",\n"
         "  \"turn_element\" (\"element\": name, \"yaw_deg\", \"pitch_deg\"), \"move_element\" (\"element\", \"by\":\n"

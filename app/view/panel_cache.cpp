@@ -29,13 +29,24 @@ PanelCache::~PanelCache() {
   if (texture_) glDeleteTextures(1, &texture_);
 }
 
-void PanelCache::draw(ImDrawData& dd, const ImDrawList* panel, const PixelRect& rect, int width, int height) {
+void PanelCache::shown(bool whole) {
+  if (whole) {
+    shown_valid_ = from_picture_;
+    shown_picture_ = pictures_;
+    shown_rect_ = rect_;
+  }
+  from_picture_ = false;
+}
+
+bool PanelCache::draw(ImDrawData& dd, const ImDrawList* panel, const PixelRect& rect, int width, int height,
+                      bool may_keep) {
+  from_picture_ = false;
   int at = -1;
   for (int i = 0; i < dd.CmdListsCount; ++i)
     if (dd.CmdLists[i] == panel) at = i;
   if (at < 0) {  // no panel this frame
     drawListsOf(dd, 0, dd.CmdListsCount);
-    return;
+    return false;
   }
   if (width != width_ || height != height_ || !texture_) {
     if (!framebuffer_) glGenFramebuffers(1, &framebuffer_);
@@ -54,8 +65,18 @@ void PanelCache::draw(ImDrawData& dd, const ImDrawList* panel, const PixelRect& 
     valid_ = false;
   }
   const auto now = std::chrono::steady_clock::now();
-  if (!valid_ || !(rect == rect_) ||
-      std::chrono::duration<double, std::milli>(now - made_).count() >= kPanelRefreshMs) {
+  const bool due = !valid_ || !(rect == rect_) ||
+                   std::chrono::duration<double, std::milli>(now - made_).count() >= kPanelRefreshMs;
+  if (may_keep && !due && shown_valid_ && shown_picture_ == pictures_ && shown_rect_ == rect &&
+      at + 1 == dd.CmdListsCount) {
+    // The window shows this picture here already, and nothing is drawn over it: the lists under it only (what
+    // of them lies in the panel's rectangle the opaque panel hides, and it is not shown).
+    drawListsOf(dd, 0, at);
+    ++kept_;
+    gl::checkGlError("drawing the lists under the kept panel");
+    return true;
+  }
+  if (due) {
     glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_);
     glDisable(GL_SCISSOR_TEST);
     const GLfloat clear[4] = {0, 0, 0, 0};
@@ -80,7 +101,9 @@ void PanelCache::draw(ImDrawData& dd, const ImDrawList* panel, const PixelRect& 
   }
   ++copies_;
   drawListsOf(dd, at + 1, dd.CmdListsCount);  // over it
+  from_picture_ = at + 1 == dd.CmdListsCount;
   gl::checkGlError("drawing the panel from its picture");
+  return false;
 }
 
 }  // namespace pvrr::app::view

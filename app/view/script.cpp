@@ -148,8 +148,13 @@ ScriptEvent readEvent(const Reader& r, const json& e, const std::string& path) {
       if (ev.file.size() < 4 || ev.file.substr(ev.file.size() - 4) != ".png")
         r.expected(path + ".file", "a file name ending in \".png\"", e.at("file"));
       if (e.contains("panel")) {
-        if (!e.at("panel").is_boolean()) r.expected(path + ".panel", "true or false", e.at("panel"));
-        ev.with_panel = e.at("panel").get<bool>();
+        const json& p = e.at("panel");
+        if (p.is_string() && p.get<std::string>() == "shown")
+          ev.shown = true;
+        else if (p.is_boolean())
+          ev.with_panel = p.get<bool>();
+        else
+          r.expected(path + ".panel", "true, false or \"shown\"", p);
       }
       break;
     case EventKind::SaveView:

@@ -29,6 +29,9 @@ struct ScriptEvent {
   Vec3 by_m{0};                       // move_eye: metres in the observer frame (x right, y up, -z forward)
   std::string file;                   // screenshot, save_view
   bool with_panel = false;            // screenshot: with the panel over the frame ("panel": true)
+  // screenshot: the window as the display shows it after the frame ("panel": "shown"), read from the X server:
+  // where a frame kept the panel (app/view/panel_cache.h), its pixels are those an earlier frame showed
+  bool shown = false;
   int key = 0;                        // key: the GLFW key code of "key" (a GLFW key name: "W", "LEFT", "HOME")
   bool shift = false;                 // key: with Shift held ("shift": true)
   // reference: start the live reference of the current view and run no later event until it is finished

@@ -139,7 +139,9 @@ void Viewer::runEvents() {
           break;
         case EventKind::TurnHead: turnHead(pose_, radians(e.yaw_deg), radians(e.pitch_deg)); break;
         case EventKind::MoveEye: moveEye(pose_, design_, e.by_m); break;
-        case EventKind::Screenshot: (e.with_panel ? panel_screenshots_ : pending_screenshots_).push_back(e.file); break;
+        case EventKind::Screenshot:
+          (e.shown ? shown_screenshots_ : e.with_panel ? panel_screenshots_ : pending_screenshots_).push_back(e.file);
+          break;
         case EventKind::SaveView: saveViewTo(e.file); break;
         case EventKind::Quit: quit_ = true; break;
         case EventKind::Key: onKey(e.key, GLFW_PRESS, e.shift ? GLFW_MOD_SHIFT : 0); break;  // the keyboard's path
@@ -257,8 +259,16 @@ void Viewer::frame() {
   // draws of the saved view: frames that reuse earlier maps (map reuse, render.map_reuse_margin_deg) differ
   // from a fresh frame in places, as they do in pvrr render --frames --orbit.
   gl::FrameCache whole;
+  const double render_cpu0_ms = threadCpuMs();
   gl::RasterFrame f = renderer_->render(mode_, pending_screenshots_.empty() ? &cache_ : &whole);
+  renderer_cpu_ms_.push_back(threadCpuMs() - render_cpu0_ms);
   cache_.environment_changed = false;  // the environment never changes while the window is open
+  for (const StageTiming& st : f.stages.stages)
+    if (st.ran) {
+      auto& [ran, sum_ms] = stage_ms_[st.name];
+      ++ran;
+      sum_ms += st.ms;
+    }
   if (!renderer_->drewIntoDefaultFramebuffer()) covered_ = {};  // drawn into its texture, whole
   const auto t_render = Clock::now();
   // The panel first made (no GL), then the frame presented around its opaque rectangle, then the panel drawn.
@@ -293,7 +303,7 @@ void Viewer::frame() {
     const bool worked = io.WantCaptureMouse || io.WantCaptureKeyboard || ImGui::IsAnyItemActive() ||
                         ImGui::IsPopupOpen("", ImGuiPopupFlags_AnyPopupId);
     if (panelDrawn() && !worked)
-      window_.drawPanel(panel_list_, panel_outer_);
+      window_.drawPanel(panel_list_, panel_outer_, /*may_keep=*/panel_screenshots_.empty());
     else
       window_.drawPanel();
   }
@@ -303,7 +313,16 @@ void Viewer::frame() {
     panel_screenshots_.clear();
   }
   const auto t_panel = Clock::now();
+  const int part_shows = window_.partShows();
   window_.swapAndPoll();
+  if (!shown_screenshots_.empty()) {
+    const ImageRGB8 img = window_.readShown(ob.width, ob.height);
+    for (const std::string& file : shown_screenshots_) {
+      writePngAtomic(file, img, MissingFolder::Create);
+      shown_shots_.push_back({{"file", file}, {"frame", frames_ + 1}, {"panel_kept", window_.partShows() > part_shows}});
+    }
+    shown_screenshots_.clear();
+  }
 
   // The mouse: a left-button drag outside the panel turns the head, or moves the wipe's split line.
   double x = 0, y = 0;
@@ -329,8 +348,10 @@ void Viewer::frame() {
     return std::chrono::duration<double, std::milli>(b - a).count();
   };
   render_ms_.push_back(span(t0, t_render));
+  renderer_ms_.push_back(f.frame_ms);
   present_ms_.push_back(span(t_panel_made, t_present));
   panel_ms_.push_back(span(t_render, t_panel_made) + span(t_present, t_panel));
+  panel_make_ms_.push_back(span(t_render, t_panel_made));
   swap_ms_.push_back(span(t_panel, Clock::now()));
   if (tracing) {
     ++frames_while_tracing_;
@@ -550,7 +571,8 @@ void Viewer::run() {
     if (quit_ || window_.closeRequested()) break;
     frame();
   }
-  if (!pending_screenshots_.empty() || !panel_screenshots_.empty()) frame();  // asked for on the last frame
+  if (!pending_screenshots_.empty() || !panel_screenshots_.empty() || !shown_screenshots_.empty())
+    frame();  // asked for on the last frame
   if (reference_ && !reference_->finished()) discardReference("cancelled: the window closed");
 }
 
@@ -605,8 +627,15 @@ json Viewer::stats() const {
           // update), presenting it, the panel (with any screenshot), and the swap with the input.
           {"parts_ms_median",
            {{"render", t.empty() ? 0.0 : median(render_ms_)},
+            // of which the renderer's frame itself, as pvrr render's frame_ms times it
+            {"renderer", t.empty() ? 0.0 : median(renderer_ms_)},
+            // and the window thread's CPU time in it (with LP_NUM_THREADS=0 llvmpipe draws on this thread: the
+            // whole frame's CPU, whatever the load)
+            {"renderer_thread_cpu", t.empty() ? 0.0 : median(renderer_cpu_ms_)},
             {"present", t.empty() ? 0.0 : median(present_ms_)},
             {"panel", t.empty() ? 0.0 : median(panel_ms_)},
+            // of which making it (Dear ImGui's frame and the panel's items, no GL; and a frame drawn again)
+            {"panel_make", t.empty() ? 0.0 : median(panel_make_ms_)},
             {"swap", t.empty() ? 0.0 : median(swap_ms_)}}},
           // Frames presented around the panel's opaque rectangle (the last frame's, window pixels, rows
           // top-down, [x0, x1) x [y0, y1)): the frame under it is not drawn.
@@ -620,9 +649,24 @@ json Viewer::stats() const {
                        {"window_depth_bits", window_.depthBits()},
                        {"window_srgb", window_.srgbCapable()},
                        {"panel_hole_frames", panel_hole_frames_},
+                       {"shows_part", window_.showsPart()},
+                       {"part_shows", window_.partShows()},
                        {"panel_rect", {panel_rect_.x0, panel_rect_.y0, panel_rect_.x1, panel_rect_.y1}}}},
-          // The panel drawn from its picture (app/view/panel_cache.h): pictures made, frames copied from one.
-          {"panel", {{"pictures", window_.panelCache().pictures()}, {"copies", window_.panelCache().copies()}}},
+          // Screenshots of the window as shown ("panel": "shown"): the frame (1 the first) and whether it kept the
+          // panel an earlier frame showed.
+          {"shown_screenshots", shown_shots_},
+          // The panel drawn from its picture (app/view/panel_cache.h): pictures made, frames copied from one, and
+          // frames that kept the panel the window showed (not drawn; the frame shown less its rectangle:
+          // present.part_shows, where the window shows part of its back buffer, present.shows_part).
+          {"panel", {{"pictures", window_.panelCache().pictures()},
+                     {"copies", window_.panelCache().copies()},
+                     {"kept", window_.panelCache().kept()}}},
+          // The renderer's stages that ran, as pvrr render --stats counts them (stage_frames): frames and mean ms.
+          {"stages", [this] {
+             json j = json::object();
+             for (const auto& [name, v] : stage_ms_) j[name] = {{"frames_ran", v.first}, {"mean_ms", v.second / v.first}};
+             return j;
+           }()},
           {"size", {design_.width, design_.height}},
           {"reference", referenceStats()},
           {"lens_probe", probeStats()},

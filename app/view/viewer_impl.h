@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <deque>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -173,12 +174,14 @@ class Viewer {
   bool direct_allowed_ = !std::getenv("PVRR_VIEW_PRESENT_PASS") || std::string(std::getenv("PVRR_VIEW_PRESENT_PASS")) != "1";
   bool panelDrawn() const;     // the panel is in this frame's draw data
   std::optional<PixelRect> panelHole() const;
-  std::vector<std::string> pending_screenshots_, panel_screenshots_;
+  std::vector<std::string> pending_screenshots_, panel_screenshots_, shown_screenshots_;
+  json shown_shots_ = json::array();  // the shown screenshots taken: file, frame, panel_kept
   int frames_ = 0, saved_ = 0;
   std::vector<double> frame_ms_;  // every frame, for --stats
   // Where each frame's time went: the renderer's frame, presenting it, the panel, the swap and input.
-  std::vector<double> render_ms_, present_ms_, panel_ms_, swap_ms_;
+  std::vector<double> render_ms_, renderer_ms_, renderer_cpu_ms_, present_ms_, panel_ms_, panel_make_ms_, swap_ms_;
   std::deque<double> recent_ms_;  // the last frames, for the panel
+  std::map<std::string, std::pair<int, double>> stage_ms_;  // the renderer's stages: frames ran, their ms summed
   enum class Drag { None, Look, Wipe };
   Drag drag_ = Drag::None;
   bool mouse_down_ = false;

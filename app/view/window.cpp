@@ -8,14 +8,31 @@
 #include <backends/imgui_impl_opengl3.h>
 #include <imgui.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdlib>
 #include <vector>
 
+#include "app/view/x11_image.h"
 #include "pvrr/base/error.h"
+
+// GLFW's X11 and GLX natives, declared here rather than through GLFW/glfw3native.h (which includes Xlib's and
+// GLX's headers, their macros and GL/gl.h after glad).
+extern "C" {
+void* glfwGetX11Display(void);
+unsigned long glfwGetGLXWindow(GLFWwindow* window);
+unsigned long glfwGetX11Window(GLFWwindow* window);
+}
 
 namespace pvrr::app::view {
 namespace {
+
+// The window showed nothing of its own or lost it since the last swap (an expose, a resize): set by GLFW's
+// callbacks (one visible window a process), read after each poll.
+bool g_window_lost = false;
+// The window's framebuffer size as the last poll left it (GLFW's callback): glfwGetFramebufferSize asks the X
+// server each call (XGetWindowAttributes, a round trip), and the frame asked it three times.
+int g_framebuffer_width = 0, g_framebuffer_height = 0;
 
 std::string g_glfw_error;  // the last GLFW error, for the messages
 void onGlfwError(int code, const char* text) { g_glfw_error = std::string(text) + " (GLFW error " + std::to_string(code) + ")"; }
@@ -116,6 +133,27 @@ Window::Window(int width, int height, WindowGl api, bool vsync, const std::strin
   }
   glfwMakeContextCurrent(window_);
   glfwSwapInterval(vsync ? 1 : 0);
+  if (api_hint_ == GLFW_NATIVE_CONTEXT_API && glfwExtensionSupported("GLX_MESA_copy_sub_buffer")) {
+    // A copy of part of the back buffer is not synchronised to the display: only where a swap would not wait
+    // for it either.
+    const bool swap_control = glfwExtensionSupported("GLX_EXT_swap_control") ||
+                              glfwExtensionSupported("GLX_MESA_swap_control") ||
+                              glfwExtensionSupported("GLX_SGI_swap_control");
+    const char* whole = std::getenv("PVRR_VIEW_WHOLE_SWAP");
+    if ((!vsync || !swap_control) && !(whole && std::string(whole) == "1")) {
+      copy_sub_buffer_ = reinterpret_cast<decltype(copy_sub_buffer_)>(glfwGetProcAddress("glXCopySubBufferMESA"));
+      x_display_ = glfwGetX11Display();
+      glx_window_ = glfwGetGLXWindow(window_);
+      if (!x_display_ || !glx_window_) copy_sub_buffer_ = nullptr;
+    }
+  }
+  glfwSetWindowRefreshCallback(window_, [](GLFWwindow*) { g_window_lost = true; });
+  glfwGetFramebufferSize(window_, &g_framebuffer_width, &g_framebuffer_height);
+  glfwSetFramebufferSizeCallback(window_, [](GLFWwindow*, int width, int height) {
+    g_window_lost = true;
+    g_framebuffer_width = width;
+    g_framebuffer_height = height;
+  });
   GLFWwindow* w = window_;
   gl::ForeignContext fc;
   fc.backend_name = name;
@@ -192,7 +230,10 @@ gl::ForeignContext WorkerContext::foreign() const {
 
 bool Window::closeRequested() const { return glfwWindowShouldClose(window_); }
 
-void Window::framebufferSize(int* width, int* height) const { glfwGetFramebufferSize(window_, width, height); }
+void Window::framebufferSize(int* width, int* height) const {
+  *width = g_framebuffer_width;
+  *height = g_framebuffer_height;
+}
 
 void beginPresentPass(int width, int height) {
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -216,7 +257,8 @@ void Window::beginPanel() {
 
 void Window::endPanel() { ImGui::Render(); }
 
-void Window::drawPanel(const ImDrawList* panel, const PixelRect& rect) {
+void Window::drawPanel(const ImDrawList* panel, const PixelRect& rect, bool may_keep) {
+  kept_.reset();
   if (!panel) {
     panel_cache_->invalidate();  // the panel may have changed since its picture
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
@@ -224,7 +266,7 @@ void Window::drawPanel(const ImDrawList* panel, const PixelRect& rect) {
   }
   int width = 0, height = 0;
   framebufferSize(&width, &height);
-  panel_cache_->draw(*ImGui::GetDrawData(), panel, rect, width, height);
+  if (panel_cache_->draw(*ImGui::GetDrawData(), panel, rect, width, height, may_keep && showsPart())) kept_ = rect;
 }
 
 ImageRGB8 Window::readBackBuffer(int width, int height) const {
@@ -242,9 +284,34 @@ ImageRGB8 Window::readBackBuffer(int width, int height) const {
   return rgbFromRgba(width, height, flipped);
 }
 
+ImageRGB8 Window::readShown(int width, int height) const {
+  void* display = glfwGetX11Display();
+  const unsigned long window = glfwGetX11Window(window_);
+  if (!display || !window) throw Error("pvrr view: a screenshot of the window as shown needs an X11 window");
+  return readX11Window(display, window, width, height);
+}
+
 void Window::swapAndPoll() {
-  glfwSwapBuffers(window_);
+  int width = 0, height = 0;
+  framebufferSize(&width, &height);
+  if (kept_ && copy_sub_buffer_) {
+    // The window less the kept panel's rectangle, in up to four bands (GL's rows, bottom-up): above it, below
+    // it, left and right of it. The panel's pixels on screen stay those the last whole frame showed.
+    const PixelRect p{std::clamp(kept_->x0, 0, width), std::clamp(kept_->y0, 0, height),
+                      std::clamp(kept_->x1, 0, width), std::clamp(kept_->y1, 0, height)};
+    for (const PixelRect& r : {PixelRect{0, 0, width, p.y0}, PixelRect{0, p.y1, width, height},
+                               PixelRect{0, p.y0, p.x0, p.y1}, PixelRect{p.x1, p.y0, width, p.y1}})
+      if (!r.empty()) copy_sub_buffer_(x_display_, glx_window_, r.x0, height - r.y1, r.x1 - r.x0, r.y1 - r.y0);
+    ++part_shows_;
+    panel_cache_->shown(false);
+  } else {
+    glfwSwapBuffers(window_);
+    panel_cache_->shown(true);
+  }
+  kept_.reset();
+  g_window_lost = false;
   glfwPollEvents();
+  if (g_window_lost) panel_cache_->lost();
 }
 
 }  // namespace pvrr::app::view

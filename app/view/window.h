@@ -67,6 +67,7 @@ class Window {
   gl::GlContext& context() { return *context_; }
   GLFWwindow* handle() { return window_; }
   bool closeRequested() const;
+  // The framebuffer's size as the last poll of events left it (swapAndPoll; a resize shows from the next frame).
   void framebufferSize(int* width, int* height) const;
   // Draws `texture` (a linear colour texture of the framebuffer's size, Renderer::colorTexture) into the default
   // framebuffer, encoded to sRGB as pvrr::srgbPicture encodes a picture, but for the pixels of `hole` (where an
@@ -84,11 +85,26 @@ class Window {
   void beginPanel();
   void endPanel();
   // Draws ImGui's frame over the presented one: all of it anew (`panel` null), or with the panel's draw list
-  // `panel` (its pixels in `rect`) copied from its picture (panel_cache.h).
-  void drawPanel(const ImDrawList* panel = nullptr, const PixelRect& rect = {});
+  // `panel` (its pixels in `rect`) copied from its picture (panel_cache.h). With `may_keep` (the back buffer's
+  // panel need not be read: no screenshot with the panel) and where the window shows part of its back buffer
+  // (showsPart), a panel the window shows already is kept: not drawn, and the next swapAndPoll shows the frame
+  // less `rect`.
+  void drawPanel(const ImDrawList* panel = nullptr, const PixelRect& rect = {}, bool may_keep = false);
+  // Whether the window shows part of its back buffer (GLX_MESA_copy_sub_buffer) in place of a swap where the
+  // panel is kept: GLX only, and where a swap would not wait for the display anyway (no vsync asked, or GLX
+  // without swap control, as Mesa's software drisw under Xvfb). PVRR_VIEW_WHOLE_SWAP=1 turns it off, to
+  // measure the two against each other in one build (docs/performance.md).
+  bool showsPart() const { return copy_sub_buffer_ != nullptr; }
+  // Frames shown less the kept panel's rectangle.
+  int partShows() const { return part_shows_; }
   const PanelCache& panelCache() const { return *panel_cache_; }
   // The back buffer's pixels (after present and before swap), rows top-down.
   ImageRGB8 readBackBuffer(int width, int height) const;
+  // The window's pixels as the display shows them (read from the X server), rows top-down: for the tests of
+  // what a frame shown in part leaves on screen. X11 only; throws pvrr::Error otherwise.
+  ImageRGB8 readShown(int width, int height) const;
+  // Shows the back buffer: whole (a swap), or after a drawPanel that kept the panel, all of it but the panel's
+  // rectangle (copied to the window; the back buffer is not swapped); then polls events.
   void swapAndPoll();
   // The present pass, whose sRGB table passes that present the frame as present() does bind
   // (shaders/srgb_encode.glsl).
@@ -107,6 +123,13 @@ class Window {
   bool imgui_ = false;
   int depth_bits_ = 0;
   bool srgb_ = false;
+  // glXCopySubBufferMESA, where the window shows part of its back buffer (showsPart), and its display and
+  // drawable.
+  void (*copy_sub_buffer_)(void* display, unsigned long drawable, int x, int y, int width, int height) = nullptr;
+  void* x_display_ = nullptr;
+  unsigned long glx_window_ = 0;
+  std::optional<PixelRect> kept_;  // the panel's rectangle this frame kept (drawPanel)
+  int part_shows_ = 0;
 };
 
 }  // namespace pvrr::app::view

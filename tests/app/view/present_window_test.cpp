@@ -55,7 +55,8 @@ void checkFrameAroundThePanel(bool present_pass) {
   // The panel (nobody works it: the pointer is away from it) copied from its picture on the frames after ImGui's
   // first, the picture made on the first of them and again at most every 250 ms (a run of 7 frames under load
   // can take longer than that, hence no upper bound but the frames).
-  EXPECT_GE(all["panel"]["copies"].get<int>(), 5) << all["panel"];
+  // (or kept where the window showed it already: not drawn at all, kept_panel_window_test.cpp).
+  EXPECT_GE(all["panel"]["copies"].get<int>() + all["panel"]["kept"].get<int>(), 5) << all["panel"];
   EXPECT_GE(all["panel"]["pictures"].get<int>(), 1) << all["panel"];
   EXPECT_LE(all["panel"]["pictures"].get<int>(), all["panel"]["copies"].get<int>()) << all["panel"];
   if (present_pass) {

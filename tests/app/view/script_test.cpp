@@ -50,6 +50,25 @@ TEST(ViewScript, ReadsEveryEventInFrameOrder) {
   EXPECT_EQ(s.events[5].where, "events[0]");
 }
 
+TEST(ViewScript, ReadsTheScreenshotsKinds) {
+  const Script s = parseScript(R"({"events": [
+      {"at_frame": 1, "do": "screenshot", "file": "a.png"},
+      {"at_frame": 1, "do": "screenshot", "file": "b.png", "panel": true},
+      {"at_frame": 1, "do": "screenshot", "file": "c.png", "panel": "shown"}]})",
+                               "s.json");
+  ASSERT_EQ(s.events.size(), 3u);
+  EXPECT_FALSE(s.events[0].with_panel || s.events[0].shown);
+  EXPECT_TRUE(s.events[1].with_panel && !s.events[1].shown);
+  EXPECT_TRUE(!s.events[2].with_panel && s.events[2].shown);
+  try {
+    parseScript(R"({"events": [{"at_frame": 1, "do": "screenshot", "file": "a.png", "panel": "yes"}]})", "s.json");
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("events[0].panel"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("\"shown\""), std::string::npos) << e.what();
+  }
+}
+
 TEST(ViewScript, ReadsTheReferenceEvents) {
   const Script s = parseScript(R"({"events": [
       {"at_frame": 1, "do": "reference"},
