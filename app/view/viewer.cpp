@@ -561,7 +561,8 @@ void Viewer::onKey(int key, int action, int mods) {
 }
 
 void Viewer::saveViewTo(const std::string& file) {
-  saveView(file, scene_path_, overrides_, ls_.scene.observer, ls_.desc.unit_m);
+  // The head as it stands now (a turn among the same frame's events included): the view the next frame draws.
+  saveView(file, scene_path_, overrides_, headObserver(design_, pose_), ls_.desc.unit_m);
   std::printf("%s\n", file.c_str());
 }
 

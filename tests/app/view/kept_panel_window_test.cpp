@@ -39,8 +39,8 @@ int maxCodeDiff(const ImageRGB8& a, const ImageRGB8& b, int x, int y) {
 TEST(ViewKeptPanel, ShownWindowIsTheNewFrameAroundTheEarlierPanel) {
   const fs::path dir = freshTestDir("view-kept-panel");
   const fs::path script = dir / "script.json", stats = dir / "stats.json", with_panel = dir / "panel.png";
-  // A shown screenshot after each of these frames' events, and the view that frame drew saved by the next frame's
-  // events (save_view writes the observer of the frame drawn last; a turn in the same events shows in the next).
+  // A shown screenshot after each of these frames' events, and the view that frame draws saved among the same
+  // events, after the turn (save_view writes the head as it stands).
   constexpr int kFirst = 5, kLast = 12;
   std::string events = R"({"at_frame": 2, "do": "turn_head", "yaw_deg": 1.5, "pitch_deg": -0.5},
       {"at_frame": 4, "do": "screenshot", "file": ")" + with_panel.string() + R"(", "panel": true},
@@ -50,7 +50,7 @@ TEST(ViewKeptPanel, ShownWindowIsTheNewFrameAroundTheEarlierPanel) {
     events += R"({"at_frame": )" + n + R"(, "do": "turn_head", "yaw_deg": 0.4},
       {"at_frame": )" + n + R"(, "do": "screenshot", "file": ")" + (dir / ("shown-" + n + ".png")).string() +
               R"(", "panel": "shown"},
-      {"at_frame": )" + std::to_string(i + 1) + R"(, "do": "save_view", "file": ")" +
+      {"at_frame": )" + n + R"(, "do": "save_view", "file": ")" +
               (dir / ("view-" + n + ".json")).string() + R"("},)";
   }
   writeText(script, R"({"size": [800, 450], "events": [)" + events + R"(
