@@ -58,17 +58,18 @@ struct Receiver {
   ReceiverSheet sheet;  // whole unless the mesh is split into sheets
 };
 
-// Mesh m's sheets (none when it is planar or one sheet), each with the scalar power of the photons landing on it.
-std::vector<std::pair<Receiver, double>> sheetsOf(const Scene& scene, int m, const PhotonBundle& b) {
+// The sheets of the meshes split into sheets (none for a planar or one-sheet mesh), each with the scalar power of
+// the photons landing on it: the meshes split once, the photons summed once.
+std::vector<std::pair<Receiver, double>> litSheets(const Scene& scene, const PhotonBundle& b) {
   std::vector<std::pair<Receiver, double>> out;
-  for (const CausticReceiver& c : sheetReceivers(scene)) {
-    if (c.mesh != m) continue;
-    double power = 0;
-    for (const CausticPhoton& p : b.photons)
-      if (p.mesh == m && std::isfinite(p.t_hit) && c.sheet.holds(p.triangle)) power += mean3(p.power);
-    out.push_back({Receiver{m, scene.meshes[size_t(m)].name + "-sheet" + std::to_string(c.sheet.index), c.full,
-                            c.curved, c.sheet},
-                   power});
+  for (const CausticReceiver& c : sheetReceivers(scene))
+    out.push_back({Receiver{c.mesh, scene.meshes[size_t(c.mesh)].name + "-sheet" + std::to_string(c.sheet.index),
+                            c.full, c.curved, c.sheet},
+                   0.0});
+  for (const CausticPhoton& p : b.photons) {
+    if (p.mesh < 0 || !std::isfinite(p.t_hit)) continue;
+    for (auto& [sheet, power] : out)
+      if (sheet.index == p.mesh && sheet.sheet.holds(p.triangle)) power += mean3(p.power);
   }
   return out;
 }
@@ -114,7 +115,10 @@ Receiver chooseReceiver(const SceneDesc& desc, const Scene& scene, const PhotonB
         if (scene.meshes[m].name != *asked) continue;
         if (const std::optional<Receiver> c = curvedReceiver(scene, int(m))) return *c;
         // Split into sheets: the one the most caustic light lands on.
-        const auto sheets = sheetsOf(scene, int(m), b);
+        std::vector<std::pair<Receiver, double>> sheets = litSheets(scene, b);
+        sheets.erase(
+            std::remove_if(sheets.begin(), sheets.end(), [&](const auto& x) { return x.first.index != int(m); }),
+            sheets.end());
         const auto lit = std::max_element(sheets.begin(), sheets.end(),
                                           [](const auto& x, const auto& y) { return x.second < y.second; });
         if (lit != sheets.end() && lit->second > 0) return lit->first;
@@ -143,17 +147,14 @@ Receiver chooseReceiver(const SceneDesc& desc, const Scene& scene, const PhotonB
       curved = Receiver{c.mesh, scene.meshes[size_t(c.mesh)].name, c.full, true, ReceiverSheet{}};
   // A sheet of a split mesh competes with the rest by its own landed power.
   double curved_power = curved ? power[size_t(curved->index)] : 0.0;
-  for (size_t m = 0; m < scene.meshes.size(); ++m) {
-    if (power[m] <= 0) continue;
-    for (const auto& [sheet, sheet_power] : sheetsOf(scene, int(m), b))
-      if (sheet_power > 0 && sheet_power > (best < 0 ? 0.0 : power[size_t(best)]) && sheet_power > curved_power) {
-        curved = sheet;
-        curved_power = sheet_power;
-      }
-  }
+  for (const auto& [sheet, sheet_power] : litSheets(scene, b))
+    if (sheet_power > 0 && sheet_power > (best < 0 ? 0.0 : power[size_t(best)]) && sheet_power > curved_power) {
+      curved = sheet;
+      curved_power = sheet_power;
+    }
   if (curved) return *curved;
   if (best < 0)
-    throw Error(path + ": environment: no quad, ground or height-field mesh receives caustic light (" +
+    throw Error(path + ": environment: no quad, ground, height-field mesh or sheet of a mesh receives caustic light (" +
                 std::to_string(b.photons.size()) + " photons left the elements); name a receiver with --receiver");
   return receiverOf(desc, best);
 }

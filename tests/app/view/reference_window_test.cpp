@@ -33,6 +33,22 @@ json readJson(const fs::path& p) { return json::parse(std::ifstream(p)); }
 // The view traced second (after a reference of the design view, then a head turn): the seen-points worker
 // (app/view/seen_frames.h) draws it with the renderer it built for the first, moved to the new observer. The
 // window's thread builds no program for either: the worker does (structural, not timed).
+// The window's overlay `shot` against compare's heat map `heat`: every pixel compare colours (its colour bar lies to
+// the right: the same x) within kHeatCodes of it in the overlay, and as many of them as the live reference compared.
+void expectOverlayIsTheHeatMap(const ImageRGB8& heat, const ImageRGB8& shot, int compared_by_the_viewer) {
+  int compared = 0, failing = 0;
+  for (int y = 0; y < shot.height; ++y)
+    for (int x = 0; x < shot.width; ++x) {
+      const uint8_t* h = heat.at(x, y);
+      if (h[0] == kNoErrorGrey && h[1] == kNoErrorGrey && h[2] == kNoErrorGrey) continue;
+      ++compared;
+      const uint8_t* s = shot.at(x, y);
+      for (int k = 0; k < 3; ++k) failing += std::abs(int(h[k]) - int(s[k])) > kHeatCodes;
+    }
+  EXPECT_EQ(compared, compared_by_the_viewer);
+  EXPECT_EQ(failing, 0) << "of " << compared << " heat-map pixels";
+}
+
 TEST(ViewReference, MatchesCompareForTheSameView) {
   const fs::path dir = freshTestDir("view-reference");
   const fs::path script = dir / "script.json", overlay = dir / "overlay.png", reference = dir / "reference.png",
@@ -75,18 +91,8 @@ TEST(ViewReference, MatchesCompareForTheSameView) {
   EXPECT_GT(live["pixels"].get<int>(), 1000);  // the mirror fills a good part of the view
 
   // The overlay (wipe at 1: the mode's side everywhere) shows compare's heat map at every pixel with an error.
-  const ImageRGB8 heat = readPng((cmp / "pvrr-error.png").string()), shot = readPng(overlay.string());
-  int compared = 0, failing = 0;
-  for (int y = 0; y < shot.height; ++y)
-    for (int x = 0; x < shot.width; ++x) {
-      const uint8_t* h = heat.at(x, y);  // compare's picture has its colour bar to the right: same x
-      if (h[0] == kNoErrorGrey && h[1] == kNoErrorGrey && h[2] == kNoErrorGrey) continue;
-      ++compared;
-      const uint8_t* s = shot.at(x, y);
-      for (int k = 0; k < 3; ++k) failing += std::abs(int(h[k]) - int(s[k])) > kHeatCodes;
-    }
-  EXPECT_EQ(compared, live["pixels"].get<int>());
-  EXPECT_EQ(failing, 0) << "of " << compared << " heat-map pixels";
+  expectOverlayIsTheHeatMap(readPng((cmp / "pvrr-error.png").string()), readPng(overlay.string()),
+                            live["pixels"].get<int>());
   fs::remove_all(dir);
 }
 
@@ -130,18 +136,8 @@ json depthLimitedAgainstCompare(const std::string& name, const std::string& scen
     EXPECT_NEAR(a, b, kMedianRelTol * b) << q;
   }
   // The heat map colours only the compared pixels, as compare's does: the depth-limited ones are not compared.
-  const ImageRGB8 heat = readPng((cmp / "pvrr-error.png").string()), shot = readPng(overlay.string());
-  int compared = 0, failing = 0;
-  for (int y = 0; y < shot.height; ++y)
-    for (int x = 0; x < shot.width; ++x) {
-      const uint8_t* h = heat.at(x, y);
-      if (h[0] == kNoErrorGrey && h[1] == kNoErrorGrey && h[2] == kNoErrorGrey) continue;
-      ++compared;
-      const uint8_t* s = shot.at(x, y);
-      for (int k = 0; k < 3; ++k) failing += std::abs(int(h[k]) - int(s[k])) > kHeatCodes;
-    }
-  EXPECT_EQ(compared, live["pixels"].get<int>());
-  EXPECT_EQ(failing, 0) << "of " << compared << " heat-map pixels";
+  expectOverlayIsTheHeatMap(readPng((cmp / "pvrr-error.png").string()), readPng(overlay.string()),
+                            live["pixels"].get<int>());
   json out = live;
   out["compare_depth_limit_pixels"] = limited;
   fs::remove_all(dir);
