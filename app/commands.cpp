@@ -107,6 +107,7 @@ json patchQualityJson(const PatchQuality& q) {
           {"max_ray_spread_deg", q.max_ray_spread_deg},
           {"max_normal_spread_deg", q.max_normal_spread_deg},
           {"max_traced_spread_deg", q.max_traced_spread_deg},
+          {"max_edge_spread_deg", q.max_edge_spread_deg},
           {"tir_share", q.tir_share}};
 }
 

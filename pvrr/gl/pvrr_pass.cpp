@@ -226,7 +226,7 @@ void PvrrPass::refineElement(size_t e) {
   if (ctx.grid_cache.refined(int(e))[0] > 0) {
     f.quality.action = "grid refined from " + std::to_string(el.tess_u) + "x" + std::to_string(el.tess_v) + " to " +
                        std::to_string(f.grid.grid_u) + "x" + std::to_string(f.grid.grid_v) +
-                       " where its triangles spanned too much curvature; " + f.quality.action;
+                       " where its triangles spanned too wide a spread of normals or of traced directions; " + f.quality.action;
   }
 }
 

@@ -223,14 +223,14 @@ CubeQuality assessCubeQuality(const RayScene& rays, ElementFrame& f, RenderMode 
                            "mode shows the sky there; pvrr mode or the reference traces those rays");
   f.eye = eye;
   if (mode == RenderMode::Envmap && lens) {
-    // As pvrr mode's vertices (eye_side.h lensEdgeExits): envmap mode looks the cube up in the exit direction
-    // of rays continued through the back surface's extension, where the reference stops them at the edge.
+    // As pvrr mode's vertices (eye_side.h lensEdgeExits): envmap mode draws those vertices dark (no
+    // transmittance: the reference absorbs them at the edge) but interpolates across the band per fragment.
     const LensEdgeExits e = lensEdgeExits(el, f, nullptr);
     if (e.vertices > 0)
       addReason(reasons, std::to_string(e.vertices) + " seen vertex ray(s) leave the glass through the lens's edge (up to " +
                              fixed(1e3 * e.max_beyond_m, 1) + " mm beyond the outline, " + fixed(e.max_band_arcmin, 0) +
-                             "' as seen from the eye): envmap mode continues them through the back surface's "
-                             "extension, the reference draws the edge dark; impostor mode traces the edge");
+                             "' as seen from the eye): envmap mode draws those vertices dark, as the reference "
+                             "does, but blends them into their neighbours across the band; impostor mode traces the edge");
   }
   f.quality.note = eyeSideNote(scene, f);
   if (!reasons.empty()) flag(f, reasons);

@@ -45,22 +45,31 @@ bool lensSeenFromBehind(const Element& el, const ElementFrame& f, size_t i) {
          glm::dot(f.eye - f.world_pos[i], f.world_normal[i]) < 0;
 }
 
+double lensBeyondOutline(const Element& el, const Vec3& back_point) {
+  if (!el.has_outline) return 0.0;
+  const Vec3 q = el.toLocalPoint(back_point);
+  const Vec2 d = Vec2(q.x, q.y) - el.outline.centre();
+  return glm::length(d) - el.outline.boundaryRadius(std::atan2(d.y, d.x));
+}
+
+bool lensEdgeExit(const Element& el, const Vec3& back_point, double distance) {
+  const double beyond = lensBeyondOutline(el, back_point);
+  return beyond > 0 && arcminutes(beyond / std::max(distance, 1e-12)) > kLensEdgeExitLimitArcmin;
+}
+
 LensEdgeExits lensEdgeExits(const Element& el, const ElementFrame& f, const cad::GridPatch* patch) {
   LensEdgeExits e;
   if (el.type != ElementType::Lens || !el.has_outline || f.rays.empty()) return e;
   const std::vector<VertexRay>& rays = f.rays[f.rays.size() / 2];  // the middle channel stands for all
-  const Vec2 c = el.outline.centre();
   auto visit = [&](size_t i) {
     if (i >= rays.size() || (!f.in_view.empty() && f.in_view[i] != 2) || lensSeenFromBehind(el, f, i)) return;
     const VertexRay& r = rays[i];
-    if (glm::length(r.back_normal) == 0.0) return;  // out through the edge band already: flagged as TIR
-    const Vec3 q = el.toLocalPoint(r.back_point);
-    const Vec2 d = Vec2(q.x, q.y) - c;
-    const double beyond = glm::length(d) - el.outline.boundaryRadius(std::atan2(d.y, d.x));
-    // The band of rays that leave through the edge near this vertex is about `beyond` wide on the lens; what
-    // matters is how wide it looks from the eye.
-    const double band_arcmin = arcminutes(beyond / std::max(glm::length(f.world_pos[i] - f.eye), 1e-12));
-    if (beyond > 0 && band_arcmin > kLensEdgeExitLimitArcmin) {
+    // Out through the edge band with no back point at all: flagged as TIR.
+    if (!r.edge_exit && glm::length(r.back_normal) == 0.0) return;
+    const double distance = glm::length(f.world_pos[i] - f.eye);
+    if (r.edge_exit || lensEdgeExit(el, r.back_point, distance)) {
+      const double beyond = lensBeyondOutline(el, r.back_point);
+      const double band_arcmin = arcminutes(beyond / std::max(distance, 1e-12));
       ++e.vertices;
       e.max_beyond_m = std::max(e.max_beyond_m, beyond);
       e.max_band_arcmin = std::max(e.max_band_arcmin, band_arcmin);
@@ -75,36 +84,25 @@ LensEdgeExits lensEdgeExits(const Element& el, const ElementFrame& f, const cad:
 
 namespace {
 
-// Flags (degraded) every seen patch of a lens whose vertex rays leave the glass through its edge: their back
-// points lie beyond the outline, on the back surface's extension (vertex_stage continues them there so that
-// rim triangles interpolate smoothly), while the reference tracer stops them at the edge (drawn dark). A rim
-// vertex's drift of a fraction of a millimetre makes a band narrower than the limit (the burning lens: 0.8 mm
-// at 0.4 m, 6'); a lens turned against the eye (the eye turned 30 deg behind a spectacle lens) sends a band of
-// rays out through the edge that pvrr and envmap modes drew wrong with no flag (hunt-spec-eye-turned-30.json:
-// 186', p95 1384').
-void applyLensEdgeExits(const Element& el, ElementFrame& f) {
+// Says how pvrr mode draws the seen vertex rays that leave a lens through its edge (vertex_stage marks them,
+// VertexRay::edge_exit: their back points lie on the back surface's extension beyond the outline by more than
+// a thin band as seen from the eye): from the reference tracer's colour along their incoming rays, the edge
+// dark as the reference draws it, where the frame traces (tir_trace_depth), else dark; either way interpolated
+// towards the neighbouring vertices across a triangle, which frame_quality's traced-spread check judges (and
+// refines the grid for). They used to be continued through the extension and drawn from the map, showing the
+// room where the reference is dark (hunt-spec-eye-turned-30.json: 6.0' median, p95 1384'; now 0.55' / 1.4').
+void noteLensEdgeExits(const Element& el, ElementFrame& f) {
   const LensEdgeExits all = lensEdgeExits(el, f, nullptr);
   if (all.vertices == 0) return;
   char mm[96];
   std::snprintf(mm, sizeof mm, "%.1f mm beyond the outline, %.0f' as seen from the eye", 1e3 * all.max_beyond_m,
                 all.max_band_arcmin);
-  int marked = 0;
-  for (PatchView& pv : f.views) {
-    if (!pv.in_view) continue;
-    const LensEdgeExits e = lensEdgeExits(el, f, &f.grid_patches[size_t(pv.patch)]);
-    if (e.vertices == 0) continue;
-    pv.quality.verdict = std::max(pv.quality.verdict, QualityVerdict::kDegraded);
-    pv.quality.reasons += std::string(pv.quality.reasons.empty() ? "" : "; ") + std::to_string(e.vertices) +
-                          " seen vertex ray(s) leave the glass through the lens's edge";
-    if (pv.quality.action == "none") pv.quality.action = "flagged";
-    ++marked;
-  }
-  f.quality.verdict = std::max(f.quality.verdict, QualityVerdict::kDegraded);
-  f.quality.action = (f.quality.action == "none" ? "" : f.quality.action + "; ") + std::to_string(marked) +
-                     " patch(es) flagged: " + std::to_string(all.vertices) +
-                     " seen vertex ray(s) leave the glass through the edge of lens '" + el.name + "' (up to " + mm +
-                     "); pvrr mode continues them through the back surface's extension, the reference draws the "
-                     "edge dark; impostor mode traces the edge";
+  f.quality.note += std::string(f.quality.note.empty() ? "" : "; ") + std::to_string(all.vertices) +
+                    " seen vertex ray(s) leave the glass through the edge of lens '" + el.name + "' (up to " + mm +
+                    "): drawn " +
+                    (f.tir_trace_depth > 0 ? "from the reference tracer's colours along their rays (the edge dark)"
+                                           : "dark (the light leaves through the edge)") +
+                    ", as the reference draws them";
 }
 
 // Whether world point h lies on element e's front surface within its outline. A sag surface is solved
@@ -319,10 +317,9 @@ void applyEyeSide(const Scene& scene, ElementFrame& f) {
   if (f.eye != scene.observer.eye) return;
   f.quality.note = eyeSideNote(scene, f);
   const Element& el = scene.elements[size_t(f.element)];
-  applyLensEdgeExits(el, f);
   applyNestedParallax(scene, f);
   applyBehindMirror(scene, f);
-  if (el.type != ElementType::Lens || f.quality.note.empty()) return;
+  if (el.type != ElementType::Lens || f.quality.note.empty()) return noteLensEdgeExits(el, f);
   f.quality.note +=
       ": pvrr mode's vertex rays enter a lens through its front surface, so the patches seen from "
       "behind are drawn from the reference tracer's colours at their vertices";
@@ -342,6 +339,7 @@ void applyEyeSide(const Scene& scene, ElementFrame& f) {
   f.quality.verdict = std::max(f.quality.verdict, QualityVerdict::kFallback);
   f.quality.action = (f.quality.action == "none" ? "" : f.quality.action + "; ") + std::to_string(marked) +
                      " patch(es) seen from behind the lens";
+  noteLensEdgeExits(el, f);
 }
 
 }  // namespace pvrr

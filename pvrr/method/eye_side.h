@@ -2,9 +2,10 @@
 // user's terms). A mirror reflects on its front side only; its back is drawn dark in every mode, as the
 // reference tracer draws it, so an eye behind a mirror sees nothing reflected: the note says why. pvrr mode
 // traces a lens's vertex rays into its front surface; an eye on the lens's back side gets a note and the
-// frame's quality verdict says whether the picture can be trusted. applyEyeSide also flags two pictures found
-// wrong and passed as good (docs/robustness.md, "Held-out-style hunt"): lens rays that leave the glass through
-// its edge, and other elements shown in a patch's map from a viewpoint far off the rays' directions.
+// frame's quality verdict says whether the picture can be trusted. applyEyeSide also flags a picture found
+// wrong and passed as good (docs/robustness.md, "Held-out-style hunt"): other elements shown in a patch's map
+// from a viewpoint far off the rays' directions; and it says how lens rays that leave the glass through its
+// edge are drawn (vertex_stage marks them and draws them from the tracer, as the reference does).
 #pragma once
 #include <string>
 
@@ -38,10 +39,17 @@ std::string eyeSideNote(const Scene& scene, const ElementFrame& f);
 void applyEyeSide(const Scene& scene, ElementFrame& f);
 
 // Seen lens vertices (middle channel, front side facing the eye) whose internal ray leaves the glass through
-// the lens's edge: its back point lies beyond the outline (on the back surface's extension, where vertex_stage
-// continues it), by more than kLensEdgeExitLimitArcmin as seen from the eye (the band of rays that truly leave
-// through the edge is about that wide). Over one patch's vertices, or all when patch is null.
+// the lens's edge: marked so by vertex_stage (VertexRay::edge_exit), or with a back point beyond the outline (on
+// the back surface's extension) by more than kLensEdgeExitLimitArcmin as seen from the eye (the band of rays
+// that truly leave through the edge is about that wide). Over one patch's vertices, or all when patch is null.
 inline constexpr double kLensEdgeExitLimitArcmin = 10.0;
+// How far (m, in the lens's plane) back point `back_point` (world) of lens `el` lies beyond its outline, along
+// the ray from the outline's centre; 0 or less inside it.
+double lensBeyondOutline(const Element& el, const Vec3& back_point);
+// Whether an internal ray whose back point is `back_point`, of a vertex `distance` (m) from the viewer, leaves the
+// glass through the lens's edge by more than kLensEdgeExitLimitArcmin: the band of rays that truly leave through
+// the edge near it is about as wide as its drift beyond the outline, and what matters is how wide it looks.
+bool lensEdgeExit(const Element& el, const Vec3& back_point, double distance);
 struct LensEdgeExits {
   int vertices = 0;
   double max_beyond_m = 0, max_band_arcmin = 0;

@@ -82,8 +82,11 @@ PatchQuality assessPatch(const ElementFrame& f, const PatchView& pv, const Frame
         return glm::normalize((r.status == VertexStatus::Tir && r.traced ? r.traced_seen : r.hit) - f.world_pos[v]);
       };
       const Vec3 da = shown(a), db = shown(b), dc = shown(c);
-      q.max_traced_spread_deg = std::max({q.max_traced_spread_deg, degrees(angleBetween(da, db)),
-                                          degrees(angleBetween(db, dc)), degrees(angleBetween(dc, da))});
+      const auto edge_or_map = [&](uint32_t v) { return rays[v].status != VertexStatus::Tir || rays[v].edge_exit; };
+      const bool edge = edge_or_map(a) && edge_or_map(b) && edge_or_map(c);
+      double& spread = edge ? q.max_edge_spread_deg : q.max_traced_spread_deg;
+      spread = std::max({spread, degrees(angleBetween(da, db)), degrees(angleBetween(db, dc)),
+                         degrees(angleBetween(dc, da))});
       continue;
     }
     const std::vector<Vec3>& n = f.world_normal;
@@ -110,7 +113,8 @@ PatchQuality assessPatch(const ElementFrame& f, const PatchView& pv, const Frame
                              " deg): rays interpolated coarsely");
   if (q.max_traced_spread_deg > lim.max_traced_spread_deg)
     addReason(q.reasons, fixed(100 * q.tir_share, 0) +
-                             " % of seen rays totally reflected, drawn from traced colours whose " +
+                             " % of seen rays totally reflected or out through the lens's edge, drawn from "
+                             "traced colours whose " +
                              "seen directions differ by up to " + fixed(q.max_traced_spread_deg, 1) +
                              " deg across a triangle (limit " + fixed(lim.max_traced_spread_deg, 1) + " deg)");
   if (!pv.fit.accepted) addReason(q.reasons, "viewpoint fit not accepted: " + pv.fit.fallback);
@@ -152,7 +156,8 @@ std::array<int, 2> refinedGridSize(const ElementFrame& f, int max_vertices, cons
   for (const PatchView& pv : f.views)
     if (pv.in_view)
       ratio = std::max({ratio, pv.quality.max_normal_spread_deg / limits.max_normal_spread_deg,
-                        pv.quality.max_traced_spread_deg / limits.max_traced_spread_deg});
+                        pv.quality.max_traced_spread_deg / limits.max_traced_spread_deg,
+                        pv.quality.max_edge_spread_deg / limits.max_traced_spread_deg});
   if (u < 2 || v < 2 || !(ratio > 1.0)) return {u, v};
   // Aimed 10 % below the limit: the spread falls a little less than in proportion on a surface whose
   // curvature varies across a triangle (the toric mirror: 6.1 deg at 31 x 31 where 12.5 deg at 15 x 15

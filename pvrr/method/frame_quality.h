@@ -46,7 +46,12 @@ struct PatchQuality {
   // interpolated with no map between): the largest angle between two corners' directions to what they show
   // (the traced seen point, or the map's hit), each from its own vertex (deg).
   double max_traced_spread_deg = 0;
-  double tir_share = 0;  // seen vertices (all channels) whose ray is totally reflected
+  // The same over the triangles whose every such corner leaves through the lens's edge (VertexRay::edge_exit):
+  // a band that is dark in the reference too, whose border no grid resolves exactly. It drives the grid's
+  // refinement (refinedGridSize) as the traced spread does, but flags nothing: the band is drawn as the reference
+  // draws it, its border blended across one triangle.
+  double max_edge_spread_deg = 0;
+  double tir_share = 0;  // seen vertices (all channels) whose ray is totally reflected or leaves through the edge
   std::string reasons;   // "" when good; otherwise what failed, "; "-separated
   std::string action;    // what was done: "none", "flagged", "drawn from traced vertex colours"
 };

@@ -70,6 +70,13 @@ static void traceTir(const Tracer& tracer, int element, VertexRay& vr, const Vec
   vr.traced_seen = entered ? t.seen : vr.hit;
 }
 
+// Whether world point p lies in the clip volume `clip` widened by a quarter across the view.
+static bool nearlyInView(const Mat4& clip, const Vec3& p) {
+  const Vec4 c = clip * Vec4(p, 1.0);
+  const double m = 1.25 * c.w;
+  return c.w > 0 && std::abs(c.x) <= m && std::abs(c.y) <= m;
+}
+
 // Both traceVertexRays: the incoming ray of vertex i starts at (*origins)[i], or at `eye` when null.
 static void traceVertexRaysFrom(const RayScene& rays, ElementFrame& f, const Vec3& eye,
                                 const std::vector<Vec3>* origins, const VertexStageOptions& opt);
@@ -220,13 +227,22 @@ static void traceVertexRaysFrom(const RayScene& rays, ElementFrame& f, const Vec
         // (cad::makeNurbsSag): its extension is the file's surface itself where it reaches past the outline
         // (a lens blank), then its second-order Taylor continuation.
         if (!back.hit()) back = rays.intersectElementSurface(f.element, 1, p, in.direction, eps, kInf, false);
-        if (!back.hit()) {
-          // The internal ray leaves through the edge band: no back point. Treated like TIR: flagged, and
-          // with a depth budget it shows the tracer's answer for its ray (no map weight).
+        // A back point on the extension farther beyond the outline than a thin band as seen from the viewer
+        // (a lens turned against the eye): the ray truly leaves through the edge, where the tracer stops it.
+        // Only where the viewer sees the vertex or nearly (its clip volume widened by a quarter, as
+        // cube_quality's): a rim vertex well out of view keeps its continuation, which steadies the fit.
+        vr.edge_exit = back.hit() && el.has_outline && (!opt.viewer_clip || nearlyInView(*opt.viewer_clip, p)) &&
+                       lensEdgeExit(el, back.point, glm::length(p - (origins ? (*origins)[i] : eye)));
+        if (vr.edge_exit) vr.back_point = back.point;
+        if (!back.hit() || vr.edge_exit) {
+          // The internal ray leaves through the edge band: no back point (or one beyond the outline). Treated
+          // like TIR: flagged, and with a depth budget it shows the tracer's answer for its ray (no map weight).
           vr.status = VertexStatus::Tir;
           vr.origin = p;
           vr.dir = in.direction;
           vr.hit = p + far * in.direction;
+          // Through the edge the tracer absorbs the light: dark, also where no tracer draws it (envmap mode).
+          if (vr.edge_exit) vr.transmittance = Vec3(0.0);
           if (tracer) {  // its own answer in place of the map's (whose far point says nothing here)
             vr.transmittance = Vec3(0.0);
             traceTir(*tracer, f.element, vr, p, d_in, wl);

@@ -43,6 +43,10 @@ struct VertexRay {
   // neighbouring vertices' map colours, in place of dark.
   bool traced = false;
   Vec3 traced_color{0}, traced_seen{0};
+  // A lens vertex whose internal ray meets the back surface's extension beyond the outline by more than
+  // kLensEdgeExitLimitArcmin as seen from the viewer (eye_side.h lensEdgeExit): it leaves through the edge.
+  // Status Tir as above (traced where a depth budget is given); back_point holds the extension's point.
+  bool edge_exit = false;
 };
 
 // One patch's virtual camera. With dispersion the channels share the viewpoint and the first pass (fitted

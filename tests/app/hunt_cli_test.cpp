@@ -49,7 +49,8 @@ std::vector<HuntCase> huntCases() {
   return {
       // A -4 D spectacle lens with the eye turned 30 deg behind it: a band of rays leaves the glass through the
       // lens's edge. pvrr mode drew it through the back surface's extension, unflagged (p95 1384' at 96 x 72);
-      // now flagged (pvrr/method/eye_side.h, lensEdgeExits), and envmap mode, as wrong, by cube_quality.cpp.
+      // now it draws those vertices from the tracer (LensRaysOutThroughTheEdgeAreDrawnAsTheReference below), and
+      // envmap mode, which blends them across the band, is flagged (cube_quality.cpp).
       {"spectacle lens, eye turned 30 deg", "tests/data/stress/hunt-spec-eye-turned-30.json", small,
        {"pvrr", "envmap", "impostor"}, {"pvrr", "envmap", "impostor"}},
       // A blind-spot door mirror: convex asphere R 1.4 m, conic -0.5, A4 = 25 m^-3 (steeper outboard).
@@ -178,6 +179,37 @@ TEST_F(HuntCli, DepthLimitPixelsAreComparedByColourOnly) {
   // The same lens pixels, now all with seen points.
   EXPECT_EQ(m4["modes"]["pvrr"]["pixels"].get<long>(), limited + j["pixels"].get<long>());
   EXPECT_EQ(r4.out.find("ended at the depth limit"), std::string::npos) << r4.out;
+}
+
+// The hunt's finding 1: the -4 D spectacle lens with the eye turned 30 deg behind it sends a band of rays out
+// through the lens's edge (the reference draws it dark). pvrr mode continued them through the back surface's
+// extension and showed the room there (96 x 72: median 6.0', p95 1384', PSNR 13.6 dB); its vertex stage now marks
+// them (VertexRay::edge_exit, status Tir) and draws them from the tracer's colours along their rays, refining the
+// grid where the traced directions jump (96 x 72: 0.55' / 1.40', PSNR 21.7 dB). The shipped lenses' rims drift
+// under the limit (kLensEdgeExitLimitArcmin): none of their vertices is marked.
+TEST_F(HuntCli, LensRaysOutThroughTheEdgeAreDrawnAsTheReference) {
+  const std::string out = (dir_ / "compare").string();
+  const CliResult r = runPvrr("compare tests/data/stress/hunt-spec-eye-turned-30.json --modes pvrr --gl osmesa "
+                              "--size 64x48 --out '" + out + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json m = nlohmann::json::parse(pvrr::test::slurp(out + "/metrics.json"));
+  const nlohmann::json& j = m["modes"]["pvrr"];
+  ASSERT_GT(j["pixels"].get<long>(), 2000);
+  const double median = j["angular_error_arcmin"]["median"].get<double>();
+  const double p95 = j["angular_error_arcmin"]["p95"].get<double>();
+  std::cout << "[ measured ] edge exits, pvrr: median " << median << "', p95 " << p95 << "', PSNR "
+            << j["psnr_db"].get<double>() << " dB\n";
+  EXPECT_LT(median, 2.0);  // 0.54' (6.0' before)
+  EXPECT_LT(p95, 10.0);    // 1.38' (1384' before: the room shown in the band)
+  EXPECT_GT(j["psnr_db"].get<double>(), 19.0);  // 21.3 dB (13.6 before)
+  EXPECT_NE(r.out.find("leave the glass through the edge of lens 'spectacle-lens'"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("drawn from the reference tracer's colours along their rays"), std::string::npos) << r.out;
+  for (const char* shipped : {"models/spectacle-lens.json", "models/burning-lens.json", "models/reading-lens.json"}) {
+    const CliResult s = runPvrr(std::string("render ") + shipped + " --gl osmesa --size 64x48 --out '" +
+                                (dir_ / "shipped.png").string() + "'");
+    ASSERT_EQ(s.code, 0) << s.err;
+    EXPECT_EQ(s.out.find("through the edge of lens"), std::string::npos) << shipped << "\n" << s.out;
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Hunt, HuntCli, ::testing::ValuesIn(huntCases()),

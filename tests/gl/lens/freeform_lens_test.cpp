@@ -2,6 +2,8 @@
 // tracer, on OSMesa and on EGL, at 160 x 120.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <algorithm>
 #include <iostream>
 #include <vector>
@@ -76,9 +78,18 @@ TEST_P(FreeformLensTest, ProgressiveLensMatchesTheReference) {
   size_t mismatch = 0;
   for (size_t i = 0; i < ref.element.size(); ++i) mismatch += (ref.element[i] >= 0) != (f.element[i] >= 0);
   EXPECT_LE(double(mismatch), kCoverageMismatch * double(ref.element.size()));
-  // No vertex is flagged: the file's 56 x 46 mm blank carries the rim rays past the 50 x 40 mm outline.
+  // No vertex is totally reflected: the file's 56 x 46 mm blank carries the rim rays past the 50 x 40 mm
+  // outline; the few seen ones that land beyond it by more than a thin band as seen from the eye leave through the
+  // edge (eye_side.h lensEdgeExit), as the reference has them, and are drawn from the tracer.
   ASSERT_EQ(f.elements.size(), 1u);
-  for (const VertexRay& v : f.elements[0].rays.at(0)) EXPECT_NE(v.status, VertexStatus::Tir);
+  size_t edge = 0;
+  for (const VertexRay& v : f.elements[0].rays.at(0)) {
+    EXPECT_TRUE(v.status != VertexStatus::Tir || v.edge_exit);
+    edge += v.edge_exit;
+  }
+  // At most the grid's rim (212 of the 64 x 64 grid's 252 rim vertices: the grid is refined where the traced
+  // directions jump across the band).
+  EXPECT_LE(double(edge), 4.0 * std::sqrt(double(f.elements[0].rays.at(0).size())));
 }
 
 PVRR_GL_BACKENDS(FreeformLensTest);

@@ -10,6 +10,7 @@
 #include "pvrr/scene/scene_build.h"
 #include "pvrr/scene/scene_json.h"
 #include "pvrr/trace/tracer.h"
+#include "pvrr/method/eye_side.h"
 #include "pvrr/method/vertex_stage.h"
 
 namespace pvrr {
@@ -43,10 +44,21 @@ TEST(NurbsLens, ProgressiveLensVertexRaysObeySnellOnTheFileSurface) {
   const double z_axis = file.evaluate(0, 0).p.z;
 
   Tracer tracer(rays, TraceOptions{});
-  size_t checked = 0, traced = 0;
+  size_t checked = 0, traced = 0, edge = 0;
   for (size_t i = 0; i < f.world_pos.size(); ++i) {
     const VertexRay& r = f.rays[0][i];
-    // With the 56 x 46 mm blank carrying the rim rays, no vertex is flagged.
+    const int gi = int(i) / f.grid.grid_v, gj = int(i) % f.grid.grid_v;
+    const bool rim = gi == 0 || gj == 0 || gi == f.grid.grid_u - 1 || gj == f.grid.grid_v - 1;
+    // The 56 x 46 mm blank carries the rim rays past the 50 x 40 mm outline; where one lands beyond it by more
+    // than a thin band as seen from the eye (eye_side.h lensEdgeExit), the ray truly leaves through the edge
+    // (the reference absorbs it there): marked, drawn from the tracer. Only rim vertices, and none is TIR.
+    if (r.edge_exit) {
+      EXPECT_EQ(r.status, VertexStatus::Tir) << "vertex " << i;
+      EXPECT_TRUE(rim) << "vertex " << i;
+      EXPECT_GT(lensBeyondOutline(el, r.back_point), 0.0) << "vertex " << i;
+      ++edge;
+      continue;
+    }
     ASSERT_NE(r.status, VertexStatus::Tir) << "vertex " << i;
     const Vec3 d = glm::normalize(f.world_pos[i] - s.observer.eye), n1 = f.world_normal[i];
     EXPECT_NEAR(glm::length(glm::cross(d, n1)), n * glm::length(glm::cross(r.internal_dir, n1)), kVertexLawTol);
@@ -66,14 +78,14 @@ TEST(NurbsLens, ProgressiveLensVertexRaysObeySnellOnTheFileSurface) {
               kNormalAngle_rad);
     ++checked;
     // Inside the rim, the reference tracer's path through the vertex sees the same point.
-    const int gi = int(i) / f.grid.grid_v, gj = int(i) % f.grid.grid_v;
-    if (gi == 0 || gj == 0 || gi == f.grid.grid_u - 1 || gj == f.grid.grid_v - 1) continue;
+    if (rim) continue;
     if (r.status != VertexStatus::Hit) continue;
     const TraceResult t = tracer.trace(s.observer.eye, d, -1);
     EXPECT_LT(glm::length(t.seen - r.hit), kSeenRel * glm::length(r.hit - s.observer.eye)) << "vertex " << i;
     ++traced;
   }
-  EXPECT_EQ(checked, f.world_pos.size());
+  EXPECT_EQ(checked + edge, f.world_pos.size());
+  EXPECT_LE(edge, size_t(4 * f.grid.grid_u));  // rim vertices only
   EXPECT_GT(traced, 100u);
 }
 
