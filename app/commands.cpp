@@ -287,7 +287,8 @@ constexpr int kCpuWarmupFrames = 3;
 }  // namespace
 
 int cmdRender(const std::vector<std::string>& argv) {
-  Args a("render", argv, {"mode", "size", "out", "gl", "set", "stats", "frames", "orbit", "time", "fps"}, {}, {"set"});
+  Args a("render", argv, {"mode", "size", "out", "gl", "set", "stats", "frames", "orbit", "time", "fps", "alternate"}, {},
+         {"set", "alternate"});
   if (a.positional().size() > 1) usageError("render", "expected at most one scene file");
   const std::string scene_path = a.positional().empty() ? kDefaultScene : a.positional()[0];
   const auto size = a.getSize("size");
@@ -302,6 +303,23 @@ int cmdRender(const std::vector<std::string>& argv) {
   const std::string out_path = a.get("out", ls.scene.render.output);
   const std::string gl_name = gl::glBackendName(backendArg(a));
 
+  // --alternate PATH=VALUE: a second copy of the scene with these overrides too, drawn after each frame of the
+  // first in its own session (context, renderer, caches), so that both are timed side by side frame by frame:
+  // the machine's load, which shifts whole runs, falls on both alike.
+  const std::vector<std::string> alt_sets = a.all("alternate");
+  std::unique_ptr<LoadedScene> alt;
+  RenderSession alt_session;
+  std::vector<double> alt_cpu_ms;
+  if (!alt_sets.empty()) {
+    if (orbit_deg != 0 || isAnimated(ls.desc) || mode == RenderMode::Raytrace)
+      usageError("render", "--alternate: only for a raster mode's steady frames (no --orbit, no animated scene)");
+    std::vector<std::string> sets = a.all("set");
+    sets.insert(sets.end(), alt_sets.begin(), alt_sets.end());
+    alt = std::make_unique<LoadedScene>(loadScene(scene_path, sets, size ? size->first : 0, size ? size->second : 0));
+    alt_session.seen_points = false;
+    alt_session.read_back = false;
+    alt_cpu_ms.reserve(size_t(frames));
+  }
   RenderSession session;
   RenderedFrame last;
   std::vector<double> frame_times, frame_cpu_ms;
@@ -344,6 +362,12 @@ int cmdRender(const std::vector<std::string>& argv) {
     const double cpu0 = processCpuMs();
     last = renderFrame(ls, mode, gl_name, &session);
     frame_cpu_ms.push_back(processCpuMs() - cpu0);
+    if (alt) {
+      if (i > 0) alt_session.cache.environment_changed = false;
+      const double alt0 = processCpuMs();
+      renderFrame(*alt, mode, gl_name, &alt_session);
+      alt_cpu_ms.push_back(processCpuMs() - alt0);
+    }
     if (i + 1 == rss_frame) rss_baseline_mb = currentRssMb();
     if ((i + 1) % sample_every == 0 || i + 1 == frames) rss_samples.push_back({i + 1, currentRssMb()});
     frame_times.push_back(last.frame_ms);
@@ -384,6 +408,21 @@ int cmdRender(const std::vector<std::string>& argv) {
   const std::vector<double> cpu_steady(frame_cpu_ms.begin() + cpu_first, frame_cpu_ms.begin() + cpu_end);
   const double cpu_p10 = quantile(cpu_steady, 0.1), cpu_median = quantile(cpu_steady, 0.5),
                cpu_p90 = quantile(cpu_steady, 0.9);
+  json alternate;
+  if (alt) {
+    const std::vector<double> steady(alt_cpu_ms.begin() + cpu_first, alt_cpu_ms.begin() + cpu_end);
+    std::vector<double> paired;  // each frame's time over the first scene's frame just before it
+    for (int i = cpu_first; i < cpu_end; ++i) paired.push_back(alt_cpu_ms[size_t(i)] / frame_cpu_ms[size_t(i)]);
+    const double p10 = quantile(steady, 0.1), med = quantile(steady, 0.5);
+    alternate = {{"sets", alt_sets},
+                 {"frame_cpu_ms", {{"p10", p10}, {"median", med}, {"p90", quantile(steady, 0.9)},
+                                   {"first", cpu_first + 1}, {"last", cpu_end}, {"first_frame", alt_cpu_ms.front()}}},
+                 {"ratio_p10", p10 / cpu_p10}, {"ratio_median", med / cpu_median}, {"ratio_paired_median", median(paired)}};
+    // Its renderer released while its own context is current; then the first session's context again.
+    alt_session.context->makeCurrent();
+    alt_session.renderer.reset();
+    session.context->makeCurrent();
+  }
   std::printf("%s\n", out_path.c_str());
   // With several frames the mean and the slowest too: a frame that renders its maps again (map reuse) or
   // re-traces its vertices stands out from the median.
@@ -403,6 +442,14 @@ int cmdRender(const std::vector<std::string>& argv) {
     std::printf("frame CPU time: p10 %.3f ms, median %.3f ms, p90 %.3f ms (process CPU, every thread; frames %d to %d of "
                 "%d)\n",
                 cpu_p10, cpu_median, cpu_p90, cpu_first + 1, cpu_end, frames);
+  std::string alt_text;
+  for (const std::string& set : alt_sets) alt_text += (alt_text.empty() ? "" : " --alternate ") + set;
+  if (alt)
+    std::printf("alternate frames (--alternate %s): frame CPU time p10 %.3f ms, median %.3f ms; over the scene as given: "
+                "p10 %.3f, median %.3f, frame by frame (median) %.3f\n",
+                alt_text.c_str(), alternate["frame_cpu_ms"]["p10"].get<double>(),
+                alternate["frame_cpu_ms"]["median"].get<double>(), alternate["ratio_p10"].get<double>(),
+                alternate["ratio_median"].get<double>(), alternate["ratio_paired_median"].get<double>());
   if (animated && frames == 1) std::printf("animation: t = %.4g s\n", time0_s);
   if (animated && frames > 1)
     std::printf("animation: t = %.4g s to %.4g s at %.4g fps; in %d of %d frame(s) after the first something moved "
@@ -445,6 +492,7 @@ int cmdRender(const std::vector<std::string>& argv) {
       j["orbit_deg"] = orbit_deg;
     }
     if (steady_ms >= 0) j["frame_ms_steady"] = steady_ms;
+    if (alt) j["alternate"] = alternate;
     writeFileAtomic(*stats, j.dump(2) + "\n");
   }
   return 0;
