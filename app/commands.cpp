@@ -12,6 +12,7 @@
 #include <fstream>
 #include <glm/gtc/matrix_transform.hpp>
 #include <random>
+#include <time.h>
 
 #include "app/args.h"
 #include "app/progress.h"
@@ -274,8 +275,21 @@ bool poseSceneAt(LoadedScene& ls, double t_s, RenderSession* session) {
   return true;
 }
 
+namespace {
+// The process's CPU time (every thread: llvmpipe's rasterizer threads too), ms.
+double processCpuMs() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
+}
+// Frames left out of the per-frame CPU figures at the start of a run: the first is cold (shaders compiled, data
+// uploaded), the next few still settle (caches filled, a split's parts drawn once, driver allocations).
+constexpr int kCpuWarmupFrames = 3;
+}  // namespace
+
 int cmdRender(const std::vector<std::string>& argv) {
-  Args a("render", argv, {"mode", "size", "out", "gl", "set", "stats", "frames", "orbit", "time", "fps"}, {}, {"set"});
+  Args a("render", argv, {"mode", "size", "out", "gl", "set", "stats", "frames", "orbit", "time", "fps", "alternate"}, {},
+         {"set", "alternate"});
   if (a.positional().size() > 1) usageError("render", "expected at most one scene file");
   const std::string scene_path = a.positional().empty() ? kDefaultScene : a.positional()[0];
   const auto size = a.getSize("size");
@@ -290,10 +304,28 @@ int cmdRender(const std::vector<std::string>& argv) {
   const std::string out_path = a.get("out", ls.scene.render.output);
   const std::string gl_name = gl::glBackendName(backendArg(a));
 
+  // --alternate PATH=VALUE: a second copy of the scene with these overrides too, drawn after each frame of the
+  // first in its own session (context, renderer, caches), so that both are timed side by side frame by frame:
+  // the machine's load, which shifts whole runs, falls on both alike.
+  const std::vector<std::string> alt_sets = a.all("alternate");
+  std::unique_ptr<LoadedScene> alt;
+  RenderSession alt_session;
+  std::vector<double> alt_cpu_ms;
+  if (!alt_sets.empty()) {
+    if (orbit_deg != 0 || isAnimated(ls.desc) || mode == RenderMode::Raytrace)
+      usageError("render", "--alternate: only for a raster mode's steady frames (no --orbit, no animated scene)");
+    std::vector<std::string> sets = a.all("set");
+    sets.insert(sets.end(), alt_sets.begin(), alt_sets.end());
+    alt = std::make_unique<LoadedScene>(loadScene(scene_path, sets, size ? size->first : 0, size ? size->second : 0));
+    alt_session.seen_points = false;
+    alt_session.read_back = false;
+    alt_cpu_ms.reserve(size_t(frames));
+  }
   RenderSession session;
   RenderedFrame last;
-  std::vector<double> frame_times;
+  std::vector<double> frame_times, frame_cpu_ms;
   frame_times.reserve(size_t(frames));
+  frame_cpu_ms.reserve(size_t(frames));
   std::map<std::string, std::pair<int, int>> stage_counts;  // name -> (ran, skipped)
   std::map<std::string, double> stage_ms_sum;  // running sums: the bookkeeping of a long run stays O(1) a frame
   // Per stage, its skip reasons by kind (the text before the first ':', e.g. "map reuse", "eye-fixed cache"):
@@ -328,7 +360,15 @@ int cmdRender(const std::vector<std::string>& argv) {
     // Time advances by 1 / fps a frame from --time (after the orbit: attached elements take both).
     if (poseSceneAt(ls, time0_s + double(i) / fps, &session) && i > 0) ++moved_frames;
     session.read_back = i + 1 == frames;  // only the last frame is written out
+    const double cpu0 = processCpuMs();
     last = renderFrame(ls, mode, gl_name, &session);
+    frame_cpu_ms.push_back(processCpuMs() - cpu0);
+    if (alt) {
+      if (i > 0) alt_session.cache.environment_changed = false;
+      const double alt0 = processCpuMs();
+      renderFrame(*alt, mode, gl_name, &alt_session);
+      alt_cpu_ms.push_back(processCpuMs() - alt0);
+    }
     if (i + 1 == rss_frame) rss_baseline_mb = currentRssMb();
     if ((i + 1) % sample_every == 0 || i + 1 == frames) rss_samples.push_back({i + 1, currentRssMb()});
     frame_times.push_back(last.frame_ms);
@@ -361,6 +401,29 @@ int cmdRender(const std::vector<std::string>& argv) {
   for (double t : frame_times) mean_ms += t;
   mean_ms /= double(frame_times.size());
   const double max_ms = *std::max_element(frame_times.begin(), frame_times.end());
+  // The frames' CPU time (process CPU around each frame: the calling thread and llvmpipe's), over the frames
+  // after the first kCpuWarmupFrames and before the last (which reads the picture back): without start-up, and
+  // a preempted or cache-thrashed frame lands above the 10th percentile, which a loaded machine moves least.
+  const int cpu_first = frames > kCpuWarmupFrames + 1 ? kCpuWarmupFrames : 0;
+  const int cpu_end = frames > kCpuWarmupFrames + 1 ? frames - 1 : frames;
+  const std::vector<double> cpu_steady(frame_cpu_ms.begin() + cpu_first, frame_cpu_ms.begin() + cpu_end);
+  const double cpu_p10 = quantile(cpu_steady, 0.1), cpu_median = quantile(cpu_steady, 0.5),
+               cpu_p90 = quantile(cpu_steady, 0.9);
+  json alternate;
+  if (alt) {
+    const std::vector<double> steady(alt_cpu_ms.begin() + cpu_first, alt_cpu_ms.begin() + cpu_end);
+    std::vector<double> paired;  // each frame's time over the first scene's frame just before it
+    for (int i = cpu_first; i < cpu_end; ++i) paired.push_back(alt_cpu_ms[size_t(i)] / frame_cpu_ms[size_t(i)]);
+    const double p10 = quantile(steady, 0.1), med = quantile(steady, 0.5);
+    alternate = {{"sets", alt_sets},
+                 {"frame_cpu_ms", {{"p10", p10}, {"median", med}, {"p90", quantile(steady, 0.9)},
+                                   {"first", cpu_first + 1}, {"last", cpu_end}, {"first_frame", alt_cpu_ms.front()}}},
+                 {"ratio_p10", p10 / cpu_p10}, {"ratio_median", med / cpu_median}, {"ratio_paired_median", median(paired)}};
+    // Its renderer released while its own context is current; then the first session's context again.
+    alt_session.context->makeCurrent();
+    alt_session.renderer.reset();
+    session.context->makeCurrent();
+  }
   std::printf("%s\n", out_path.c_str());
   // With several frames the mean and the slowest too: a frame that renders its maps again (map reuse) or
   // re-traces its vertices stands out from the median.
@@ -376,6 +439,18 @@ int cmdRender(const std::vector<std::string>& argv) {
                 last.height, nameOf(mode), spread.c_str(),
                 (frames > 1 ? "; first frame " + fmt("%.3f", first_ms) + " ms (cold)" : std::string()).c_str());
   }
+  if (frames > 1)
+    std::printf("frame CPU time: p10 %.3f ms, median %.3f ms, p90 %.3f ms (process CPU, every thread; frames %d to %d of "
+                "%d)\n",
+                cpu_p10, cpu_median, cpu_p90, cpu_first + 1, cpu_end, frames);
+  std::string alt_text;
+  for (const std::string& set : alt_sets) alt_text += (alt_text.empty() ? "" : " --alternate ") + set;
+  if (alt)
+    std::printf("alternate frames (--alternate %s): frame CPU time p10 %.3f ms, median %.3f ms; over the scene as given: "
+                "p10 %.3f, median %.3f, frame by frame (median) %.3f\n",
+                alt_text.c_str(), alternate["frame_cpu_ms"]["p10"].get<double>(),
+                alternate["frame_cpu_ms"]["median"].get<double>(), alternate["ratio_p10"].get<double>(),
+                alternate["ratio_median"].get<double>(), alternate["ratio_paired_median"].get<double>());
   if (animated && frames == 1) std::printf("animation: t = %.4g s\n", time0_s);
   if (animated && frames > 1)
     std::printf("animation: t = %.4g s to %.4g s at %.4g fps; in %d of %d frame(s) after the first something moved "
@@ -387,6 +462,9 @@ int cmdRender(const std::vector<std::string>& argv) {
               {"frame_ms", frame_ms}, {"frame_ms_mean", mean_ms}, {"frame_ms_max", max_ms}, {"frames", frames},
               {"frame_ms_first", first_ms}, {"time_s", time0_s}, {"fps", fps}, {"animated", animated},
               {"frames_moved", moved_frames},
+              // Per frame, process CPU time (every thread), over frames first..last (1-based) of the run.
+              {"frame_cpu_ms", {{"p10", cpu_p10}, {"median", cpu_median}, {"p90", cpu_p90},
+                                {"first", cpu_first + 1}, {"last", cpu_end}, {"first_frame", frame_cpu_ms.front()}}},
               {"stages", stagesJson(last.stages)},
               {"elements", last.elements}, {"peak_rss_mb", peakRssMb()}};
     // Resident memory (MB) after frame `after_frame` and after the last frame, before the PNG is written.
@@ -415,6 +493,7 @@ int cmdRender(const std::vector<std::string>& argv) {
       j["orbit_deg"] = orbit_deg;
     }
     if (steady_ms >= 0) j["frame_ms_steady"] = steady_ms;
+    if (alt) j["alternate"] = alternate;
     writeFileAtomic(*stats, j.dump(2) + "\n");
   }
   return 0;

@@ -93,8 +93,9 @@ class PvrrPass : public ModePass {
   };
   size_t uploadQuadraticPatch(MeshBuffers& quadratic, std::vector<RefineTri>* searched, RefineSplitCounts* counts,
                               int levels, const ElementFrame& f, const PatchView& pv, const Vec3& anchor) const;
-  // Draws patch view v of refined mirror f in the second pass, split: its quadratic triangles by `quadratic`,
-  // the others by `search` (in use on entry and on return, its view's uniforms set). The split's meshes are
+  // Draws patch view v of refined mirror f in the second pass, split: its quadratic triangles and parts by
+  // `quadratic`, then the triangles with a searched part whole by `search` (in use on entry and on return, its
+  // view's uniforms set), behind the quadratic parts: the depth test leaves it the searched parts' pixels. The split's meshes are
   // kept while the nodes are (refine_split): a frame in which nothing moved draws them as they are.
   void drawRefinedSplit(const Program& search, const Program& quadratic, const ElementFrame& f, size_t v,
                         const Vec3& anchor, const glm::vec3& seen_offset, const glm::vec2& st_scale,

@@ -188,6 +188,62 @@ TEST(Reports, RenderFramesDoesNotGrowResidentMemory) {
   fs::remove_all(dir);
 }
 
+// The frames' CPU time (render --frames N, stats frame_cpu_ms): taken around each frame, summarised over frames
+// 4 to N - 1, so the cold first frame (shaders compiled, vertex stage, fit and maps) is left out; with fewer
+// frames, over all of them; and with --alternate, the same for a second copy of the scene drawn in turn.
+// Timings themselves are not asserted, only what must hold of any run.
+TEST(Reports, RenderFramesReportsTheFramesCpuTime) {
+  const fs::path dir = pvrr::test::freshTestDir("frame-cpu");
+  struct Run {
+    int frames, first, last;
+  };
+  for (const Run& run : {Run{10, 4, 9}, Run{3, 1, 3}}) {
+    const auto r = runPvrr("render models/car-mirror.json --size 64x48 --frames " + std::to_string(run.frames) +
+                           " --gl osmesa --set render.refine=2 --out '" + (dir / "f.png").string() + "' --stats '" +
+                           (dir / "s.json").string() + "'");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("frame CPU time: p10 "), std::string::npos) << r.out;
+    const auto c = readJson(dir / "s.json")["frame_cpu_ms"];
+    ASSERT_TRUE(c.is_object()) << c.dump();
+    EXPECT_EQ(c["first"].get<int>(), run.first) << c.dump();
+    EXPECT_EQ(c["last"].get<int>(), run.last) << c.dump();
+    EXPECT_GT(c["p10"].get<double>(), 0) << c.dump();
+    EXPECT_LE(c["p10"].get<double>(), c["median"].get<double>()) << c.dump();
+    EXPECT_LE(c["median"].get<double>(), c["p90"].get<double>()) << c.dump();
+    // The first frame runs every CPU stage and compiles the programs: above every steady frame's time.
+    if (run.first > 1) {
+      EXPECT_GT(c["first_frame"].get<double>(), c["p90"].get<double>()) << c.dump();
+    }
+  }
+  // --alternate: the scene with render.refine off, and with refine 2, their frames drawn in turn; the picture
+  // written is the scene as given (off): the same as a render without --alternate.
+  const std::string common = "render models/car-mirror.json --size 64x48 --frames 10 --gl osmesa --set render.refine=off";
+  ASSERT_EQ(runPvrr(common + " --out '" + (dir / "plain.png").string() + "'").code, 0);
+  const auto r = runPvrr(common + " --alternate render.refine=2 --out '" + (dir / "f.png").string() + "' --stats '" +
+                         (dir / "s.json").string() + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("alternate frames (--alternate render.refine=2): frame CPU time p10 "), std::string::npos) << r.out;
+  EXPECT_EQ(pvrr::test::slurp(dir / "f.png"), pvrr::test::slurp(dir / "plain.png"));
+  const auto s = readJson(dir / "s.json");
+  const auto& alt = s["alternate"];
+  ASSERT_TRUE(alt.is_object()) << s.dump();
+  EXPECT_EQ(alt["sets"], nlohmann::json::array({"render.refine=2"}));
+  const auto& c = alt["frame_cpu_ms"];
+  EXPECT_EQ(c["first"].get<int>(), 4);
+  EXPECT_EQ(c["last"].get<int>(), 9);
+  EXPECT_GT(c["p10"].get<double>(), 0) << c.dump();
+  EXPECT_LE(c["p10"].get<double>(), c["median"].get<double>()) << c.dump();
+  EXPECT_LE(c["median"].get<double>(), c["p90"].get<double>()) << c.dump();
+  EXPECT_NEAR(alt["ratio_p10"].get<double>(), c["p10"].get<double>() / s["frame_cpu_ms"]["p10"].get<double>(), 1e-9);
+  EXPECT_NEAR(alt["ratio_median"].get<double>(), c["median"].get<double>() / s["frame_cpu_ms"]["median"].get<double>(),
+              1e-9);
+  EXPECT_GT(alt["ratio_paired_median"].get<double>(), 0);
+  // Only for steady frames: refused with a turning head.
+  const auto refused = runPvrr(common + " --orbit 5 --alternate render.refine=2 --out '" + (dir / "f.png").string() + "'");
+  pvrr::test::expectOneLineError(refused, "--alternate");
+  fs::remove_all(dir);
+}
+
 // Spectral dispersion as a user asks for it (--set render.dispersion=spectral): render draws the lens with
 // one channel per spectral sample (stats "colour-channels" count), and vertices writes one row per vertex
 // and sample, each patch/channel in the JSON with its own wavelength and the material's index there.

@@ -272,6 +272,17 @@ TEST_P(RefineTest, SplitsOnceTheViewSettles) {
   EXPECT_GT(counts[2].split, 0) << notes[2];
   EXPECT_EQ(counts[2].searched_whole, 0) << notes[2];
   EXPECT_LT(counts[2].searched_area, double(counts[2].split)) << notes[2];
+  // The same pose drawn split (the failing parts' triangles whole, behind the quadratic parts) and whole: the
+  // mirror's fragments counted alike, so the triangles drawn behind add none over the quadratic parts (they
+  // would add about the split triangles' area less the searched area) and hide none of their own. kDrawnTol:
+  // pixels on the parts' edges, whose midpoint corners are rounded to float.
+  constexpr double kDrawnTol = 0.002;
+  auto drawn = [](const std::string& note) {
+    std::smatch m;
+    return std::regex_search(note, m, std::regex(R"((\d+) fragments drawn)")) ? std::stod(m[1]) : -1.0;
+  };
+  ASSERT_GT(drawn(notes[1]), 0) << notes[1];
+  EXPECT_NEAR(drawn(notes[2]), drawn(notes[1]), kDrawnTol * drawn(notes[1])) << notes[1] << "\n" << notes[2];
 }
 
 // Off draws the unrefined pixels (the default, the paper's method), and so does refinement of an element it
