@@ -11,6 +11,7 @@
 #include <string>
 
 #include "pvrr/gl/ao_fields.h"
+#include "pvrr/gl/ao_vertex_receivers.h"
 #include "pvrr/gl/context.h"
 #include "pvrr/gl/renderer.h"
 #include "pvrr/scene/scene_build.h"
@@ -258,6 +259,90 @@ TEST_P(AmbientOcclusionTest, AFaceTurnedAwayFromTheCarIsDrawnWithout) {
       EXPECT_EQ(equal, pixels);
     }
   }
+}
+
+// The mesh drawn in one draw (AoVertexReceivers::merged, issue 24's cost): its buffer holds each face's grid
+// exactly as the face's own grid (the same vertices and occlusions, the indices offset), the faces drawn without
+// occlusion with their own vertices and zeros on both sides, and it is made again with the grids when the car
+// moves.
+TEST_P(AmbientOcclusionTest, AMeshsMergedBufferHoldsItsFacesGridsAndZeros) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  const std::string wall =
+      R"(, {"type": "box", "name": "wall", "centre": [3, 1, 0], "size": [0.2, 2, 6], "material": {"color": [0.7, 0.7, 0.7]}})";
+  const SceneDesc desc =
+      carDesc(R"({"keys": [{"time_s": 0}, {"time_s": 1, "offset": [1.2, 0, -1], "rotation_deg": [0, 30, 0]}]})", "", "true", wall);
+  Scene s = buildScene(desc);
+  applyAnimation(s, desc, 0.0);
+  const std::vector<AoField> fields = buildAoFields(s);
+  ASSERT_FALSE(fields.empty());
+  gl::AoVertexReceivers receivers(s, fields);
+  size_t m = 0;
+  while (m < s.meshes.size() && s.meshes[m].name != "wall") ++m;
+  ASSERT_LT(m, s.meshes.size());
+  const EnvMesh& mesh = s.meshes[m];
+  // The box's faces: its triangles grouped by normal; the face toward the car and the top as grids.
+  std::vector<std::vector<uint32_t>> triangles;
+  std::vector<Vec3> normals;
+  for (uint32_t t = 0; t < mesh.triangles.size(); ++t) {
+    const Vec3 n(mesh.normals[mesh.triangles[t].x]);
+    size_t g = 0;
+    while (g < normals.size() && normals[g] != n) ++g;
+    if (g == normals.size()) normals.push_back(n), triangles.emplace_back();
+    triangles[g].push_back(t);
+  }
+  ASSERT_EQ(normals.size(), 6u);
+  std::vector<gl::AoVertexReceivers::Face> faces;
+  for (size_t g = 0; g < normals.size(); ++g) faces.push_back({&triangles[g], normals[g], normals[g].x < -0.5 || normals[g].y > 0.5});
+  constexpr int kStride = gl::AoVertexReceivers::kAoStride;
+  for (const double t : {0.0, 1.0}) {
+    applyAnimation(s, desc, t);
+    const gl::AoVertexReceivers::Merged* merged = receivers.merged(m, faces);
+    ASSERT_TRUE(merged);
+    EXPECT_EQ(merged->grids, 2);
+    ASSERT_EQ(merged->face.size() * 3, merged->indices.size());
+    EXPECT_EQ(merged->buffers.count, int(merged->indices.size()));
+    // The triangles face after face; each grid's own indices, offset, read the same vertices.
+    size_t at = 0, grid_vertices = 0;
+    double toward_max = 0;
+    for (size_t g = 0; g < faces.size(); ++g) {
+      if (!faces[g].grid) {
+        for (const uint32_t tri : triangles[g]) {
+          ASSERT_EQ(merged->face[at / 3], int(g));
+          for (int k = 0; k < 3; ++k) {
+            const uint32_t v = merged->indices[at + size_t(k)];
+            EXPECT_EQ(v, mesh.triangles[tri][k]);
+            const float* d = &merged->data[size_t(v) * kStride];
+            EXPECT_EQ(Vec3(d[0], d[1], d[2]), Vec3(mesh.positions[v]));
+            EXPECT_EQ(d[8], 0.0f);  // drawn without occlusion, on both sides
+            EXPECT_EQ(d[9], 0.0f);
+          }
+          at += 3;
+        }
+        continue;
+      }
+      const std::vector<float>* data = receivers.gridData(m, g);
+      const std::vector<uint32_t>* indices = receivers.gridIndices(m, g);
+      ASSERT_TRUE(data && indices);
+      grid_vertices += data->size() / kStride;
+      for (const uint32_t i : *indices) {
+        ASSERT_EQ(merged->face[at / 3], int(g));
+        const uint32_t v = merged->indices[at++];
+        for (int k = 0; k < kStride; ++k) ASSERT_EQ(merged->data[size_t(v) * kStride + size_t(k)], (*data)[size_t(i) * kStride + size_t(k)]);
+        if (normals[g].x < -0.5) toward_max = std::max(toward_max, double(merged->data[size_t(v) * kStride + 8]));
+      }
+    }
+    EXPECT_EQ(at, merged->indices.size());
+    EXPECT_EQ(merged->data.size() / kStride, mesh.positions.size() + grid_vertices);
+    std::printf("[ ambient occlusion ] merged wall at t = %.0f: %zu triangles, the face toward the car up to %.3f\n", t,
+                merged->face.size(), toward_max);
+    EXPECT_GT(toward_max, 0.02);
+  }
+  // Made again for the car where it is now: its face toward the car is not the one of t = 0.
+  applyAnimation(s, desc, 0.0);
+  const std::vector<float> before = receivers.merged(m, faces)->data;
+  applyAnimation(s, desc, 1.0);
+  EXPECT_NE(receivers.merged(m, faces)->data, before);
 }
 
 TEST_P(AmbientOcclusionTest, OffChangesNoPixel) {
