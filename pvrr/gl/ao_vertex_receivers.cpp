@@ -1,5 +1,6 @@
 #include "pvrr/gl/ao_vertex_receivers.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <set>
 
@@ -74,7 +75,6 @@ const AoVertexReceivers::Merged* AoVertexReceivers::merged(size_t m, const std::
   e.key = std::move(now);
   e.data.clear();
   e.indices.clear();
-  e.face.clear();
   e.grids = 0;
   const EnvMesh& mesh = scene_.meshes[m];
   if (mask + 1 != 1u << faces.size()) {  // some face drawn as it is: the mesh's vertices, without occlusion
@@ -85,22 +85,40 @@ const AoVertexReceivers::Merged* AoVertexReceivers::merged(size_t m, const std::
       e.data.insert(e.data.end(), {pos.x, pos.y, pos.z, n.x, n.y, n.z, uv.x, uv.y, 0.0f, 0.0f});
     }
   }
+  // Face after face, each triangle into the plain part or the occluded one.
+  std::vector<uint32_t> plain, occluded;
+  std::vector<int> plain_face, plain_source, occluded_face, occluded_source;
+  auto add = [&](uint32_t a, uint32_t b, uint32_t c, int g, int source) {
+    float most = 0;
+    for (const uint32_t v : {a, b, c}) most = std::max({most, e.data[size_t(v) * kAoStride + 8], e.data[size_t(v) * kAoStride + 9]});
+    const bool is_plain = most < kAoValueNegligible;
+    (is_plain ? plain : occluded).insert((is_plain ? plain : occluded).end(), {a, b, c});
+    (is_plain ? plain_face : occluded_face).push_back(g);
+    (is_plain ? plain_source : occluded_source).push_back(source);
+  };
   for (size_t g = 0; g < faces.size(); ++g) {
     if (!faces[g].grid) {
+      int source = 0;
       for (const uint32_t t : *faces[g].triangles) {
         const auto& tri = mesh.triangles[t];
-        e.indices.insert(e.indices.end(), {tri.x, tri.y, tri.z});
-        e.face.push_back(int(g));
+        add(tri.x, tri.y, tri.z, int(g), source++);
       }
       continue;
     }
     const Entry& grid_entry = entries_.at({m, g});
     const uint32_t base = uint32_t(e.data.size() / kAoStride);
     e.data.insert(e.data.end(), grid_entry.data.begin(), grid_entry.data.end());
-    for (const uint32_t i : grid_entry.indices) e.indices.push_back(base + i);
-    e.face.insert(e.face.end(), grid_entry.indices.size() / 3, int(g));
+    const std::vector<uint32_t>& gi = grid_entry.indices;
+    for (size_t t = 0; t + 2 < gi.size(); t += 3) add(base + gi[t], base + gi[t + 1], base + gi[t + 2], int(g), int(t / 3));
     ++e.grids;
   }
+  e.plain = int(plain.size());
+  e.indices = std::move(plain);
+  e.indices.insert(e.indices.end(), occluded.begin(), occluded.end());
+  e.face = std::move(plain_face);
+  e.face.insert(e.face.end(), occluded_face.begin(), occluded_face.end());
+  e.source = std::move(plain_source);
+  e.source.insert(e.source.end(), occluded_source.begin(), occluded_source.end());
   uploadMesh(e.buffers, e.data, {3, 3, 2, 2}, e.indices);
   checkGlError("uploading a mesh's ambient occlusion grids");
   ++merges_;
@@ -130,9 +148,17 @@ std::string AoVertexReceivers::note() const {
                 last_build_ms_);
   std::string out = text;
   std::set<size_t> one_draw;
-  for (const auto& [k, e] : merged_) one_draw.insert(k.first);
-  std::snprintf(text, sizeof text, "; %zu mesh%s drawn as one draw holding its faces' grids (%d buffer%s made)",
-                one_draw.size(), one_draw.size() == 1 ? "" : "es", merges_, merges_ == 1 ? "" : "s");
+  size_t merged_triangles = 0, plain_triangles = 0;
+  for (const auto& [k, e] : merged_) {
+    one_draw.insert(k.first);
+    merged_triangles += e.face.size();
+    plain_triangles += size_t(e.plain / 3);
+  }
+  std::snprintf(text, sizeof text,
+                "; %zu mesh%s drawn as one buffer holding its faces' grids (%d buffer%s made, %zu triangles, %zu of them "
+                "drawn without the values: below %.1f/255)",
+                one_draw.size(), one_draw.size() == 1 ? "" : "es", merges_, merges_ == 1 ? "" : "s", merged_triangles,
+                plain_triangles, kAoValueNegligible * 255);
   out += text;
   if (!without.empty()) {
     out += "; per fragment (occlusion image or fields):";

@@ -18,6 +18,11 @@
 
 namespace pvrr::gl {
 
+// Occlusion below this at a triangle's three vertices (both sides) is left out of its fragments: the program
+// without ambient occlusion draws the triangle (issue 24's cost: an interpolated value costs llvmpipe per
+// fragment). It darkens a pixel by at most albedo * ambient * 0.5/255.
+inline constexpr float kAoValueNegligible = 2.0f / 255;
+
 class AoVertexReceivers {
  public:
   AoVertexReceivers(const Scene& scene, const std::vector<AoField>& fields) : scene_(scene), fields_(fields) {}
@@ -45,7 +50,12 @@ class AoVertexReceivers {
     std::vector<float> data;        // as uploaded: kAoStride floats a vertex
     std::vector<uint32_t> indices;  // as uploaded
     std::vector<int> face;          // per triangle: its face
+    std::vector<int> source;        // per triangle: its index among its face's grid's (or the face's) triangles
     int grids = 0;                  // faces drawn as grids
+    // The triangles whose three vertices hold less than kAoValueNegligible on both sides come first, indices
+    // [0, plain): drawn with the program without ambient occlusion (no value interpolated per fragment), the
+    // rest, [plain, size), with the vertex values.
+    int plain = 0;
   };
   const Merged* merged(size_t m, const std::vector<Face>& faces);
   // The data grid() uploaded for face g of mesh m (kAoStride floats a vertex) and its indices; null if none.

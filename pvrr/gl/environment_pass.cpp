@@ -340,9 +340,12 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
         const AoVertexReceivers::Merged* merged = ao_->vertexReceivers()->merged(m, faces);
         it->second.draw = AoFields::Draw{AoReceiver::Vertex, {}};
         it->second.grid = merged ? &merged->buffers : nullptr;
+        it->second.plain = merged ? merged->plain : 0;
       }
-      if (it->second.grid) {
-        parts.push_back({m, cull, it->second.draw, 0, it->second.grid->count, it->second.grid});
+      if (const AoChoice& c = it->second; c.grid) {
+        // Its triangles without occlusion (below kAoValueNegligible) first, drawn without the values.
+        if (c.plain > 0) parts.push_back({m, cull, AoFields::Draw{}, 0, c.plain, c.grid});
+        if (c.plain < c.grid->count) parts.push_back({m, cull, c.draw, c.plain, c.grid->count - c.plain, c.grid});
         continue;
       }
     }

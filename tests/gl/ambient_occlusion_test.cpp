@@ -6,6 +6,7 @@
 // With render.ambient_occlusion off, the picture is the one without any occluder.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -302,40 +303,54 @@ TEST_P(AmbientOcclusionTest, AMeshsMergedBufferHoldsItsFacesGridsAndZeros) {
     EXPECT_EQ(merged->grids, 2);
     ASSERT_EQ(merged->face.size() * 3, merged->indices.size());
     EXPECT_EQ(merged->buffers.count, int(merged->indices.size()));
-    // The triangles face after face; each grid's own indices, offset, read the same vertices.
-    size_t at = 0, grid_vertices = 0;
+    // Each triangle is its face's own (grid or mesh triangle `source`), read through offset indices; the ones
+    // without occlusion first.
+    ASSERT_EQ(merged->source.size(), merged->face.size());
+    std::vector<std::vector<int>> seen(faces.size());
+    size_t grid_vertices = 0;
+    for (size_t g = 0; g < faces.size(); ++g)
+      if (faces[g].grid) grid_vertices += receivers.gridData(m, g)->size() / kStride;
     double toward_max = 0;
-    for (size_t g = 0; g < faces.size(); ++g) {
-      if (!faces[g].grid) {
-        for (const uint32_t tri : triangles[g]) {
-          ASSERT_EQ(merged->face[at / 3], int(g));
-          for (int k = 0; k < 3; ++k) {
-            const uint32_t v = merged->indices[at + size_t(k)];
-            EXPECT_EQ(v, mesh.triangles[tri][k]);
-            const float* d = &merged->data[size_t(v) * kStride];
-            EXPECT_EQ(Vec3(d[0], d[1], d[2]), Vec3(mesh.positions[v]));
-            EXPECT_EQ(d[8], 0.0f);  // drawn without occlusion, on both sides
-            EXPECT_EQ(d[9], 0.0f);
-          }
-          at += 3;
+    int plain_most = 0;
+    for (size_t t = 0; t < merged->face.size(); ++t) {
+      const size_t g = size_t(merged->face[t]);
+      const int src = merged->source[t];
+      seen[g].push_back(src);
+      float most = 0;
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t v = merged->indices[3 * t + size_t(k)];
+        const float* d = &merged->data[size_t(v) * kStride];
+        most = std::max({most, d[8], d[9]});
+        if (!faces[g].grid) {
+          EXPECT_EQ(v, mesh.triangles[triangles[g][size_t(src)]][k]);
+          EXPECT_EQ(Vec3(d[0], d[1], d[2]), Vec3(mesh.positions[v]));
+          EXPECT_EQ(d[8], 0.0f);  // drawn without occlusion, on both sides
+          EXPECT_EQ(d[9], 0.0f);
+          continue;
         }
-        continue;
+        const std::vector<float>& data = *receivers.gridData(m, g);
+        const uint32_t i = (*receivers.gridIndices(m, g))[3 * size_t(src) + size_t(k)];
+        for (int c = 0; c < kStride; ++c) ASSERT_EQ(d[c], data[size_t(i) * kStride + size_t(c)]);
+        if (normals[g].x < -0.5) toward_max = std::max(toward_max, double(d[8]));
       }
-      const std::vector<float>* data = receivers.gridData(m, g);
-      const std::vector<uint32_t>* indices = receivers.gridIndices(m, g);
-      ASSERT_TRUE(data && indices);
-      grid_vertices += data->size() / kStride;
-      for (const uint32_t i : *indices) {
-        ASSERT_EQ(merged->face[at / 3], int(g));
-        const uint32_t v = merged->indices[at++];
-        for (int k = 0; k < kStride; ++k) ASSERT_EQ(merged->data[size_t(v) * kStride + size_t(k)], (*data)[size_t(i) * kStride + size_t(k)]);
-        if (normals[g].x < -0.5) toward_max = std::max(toward_max, double(merged->data[size_t(v) * kStride + 8]));
+      // The plain triangles, drawn without the values, hold less than kAoValueNegligible; the others more.
+      if (3 * t < size_t(merged->plain)) {
+        EXPECT_LT(most, gl::kAoValueNegligible);
+        ++plain_most;
+      } else {
+        EXPECT_GE(most, gl::kAoValueNegligible);
       }
     }
-    EXPECT_EQ(at, merged->indices.size());
+    for (size_t g = 0; g < faces.size(); ++g) {  // every triangle once
+      std::sort(seen[g].begin(), seen[g].end());
+      const size_t n = faces[g].grid ? receivers.gridIndices(m, g)->size() / 3 : triangles[g].size();
+      ASSERT_EQ(seen[g].size(), n);
+      for (size_t k = 0; k < n; ++k) EXPECT_EQ(seen[g][k], int(k));
+    }
+    EXPECT_GE(plain_most, 6);  // at least the three faces drawn without grids
     EXPECT_EQ(merged->data.size() / kStride, mesh.positions.size() + grid_vertices);
-    std::printf("[ ambient occlusion ] merged wall at t = %.0f: %zu triangles, the face toward the car up to %.3f\n", t,
-                merged->face.size(), toward_max);
+    std::printf("[ ambient occlusion ] merged wall at t = %.0f: %zu triangles (%d without the values), the face toward the car up to %.3f\n", t,
+                merged->face.size(), plain_most, toward_max);
     EXPECT_GT(toward_max, 0.02);
   }
   // Made again for the car where it is now: its face toward the car is not the one of t = 0.
