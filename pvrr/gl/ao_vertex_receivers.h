@@ -6,7 +6,9 @@
 // made on first use and kept while its mesh and every occluder stay where they are; when one moves it is made
 // and uploaded again (its CPU cost falls in that frame). What cannot be tessellated so (a mesh that is not
 // faceted, a face that is not a rectangle) keeps the per-fragment paths (the pass's occlusion image for a static
-// receiver, the fields for a moving one): the stage note says which, and why.
+// receiver, the fields for a moving one): the stage note says which, and why. A mesh whose every face with
+// occlusion has a grid is drawn from one buffer (merged(): its grids and its other faces, holding zeros), its
+// triangles without occlusion first, drawn with the program without ambient occlusion.
 #pragma once
 #include <map>
 #include <string>
@@ -20,8 +22,9 @@ namespace pvrr::gl {
 
 // Occlusion below this at a triangle's three vertices (both sides) is left out of its fragments: the program
 // without ambient occlusion draws the triangle (issue 24's cost: an interpolated value costs llvmpipe per
-// fragment). It darkens a pixel by at most albedo * ambient * 0.5/255.
-inline constexpr float kAoValueNegligible = 2.0f / 255;
+// fragment). kAoNegligible's bound (which already leaves whole meshes and faces out): it darkens a pixel by at
+// most albedo * ambient * 2/255.
+inline constexpr float kAoValueNegligible = float(kAoNegligible);
 
 class AoVertexReceivers {
  public:
