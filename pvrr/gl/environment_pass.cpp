@@ -12,6 +12,11 @@
 
 namespace pvrr::gl {
 
+namespace {
+// The centre of projection this far (m) behind a face's plane: the face is back-facing for the rasterizer too.
+constexpr double kHiddenFaceMargin = 1e-3;
+}  // namespace
+
 void setLights(const Program& p, const Scene& scene, const Vec3& origin) {
   Vec3 ambient(0.0);
   std::vector<float> dir_vec, dir_rad, point_pos, point_rad;
@@ -321,8 +326,16 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
     std::vector<const AoChoice*> chosen(groups.size());
     bool any_grid = false, all_grids = true;  // some face has a grid; every face a field counts for has one
     uint32_t mask = 0;
+    static const AoChoice kHidden{};  // no occlusion, no grid
     for (size_t gi = 0; gi < groups.size(); ++gi) {
       const FaceGroup& g = groups[gi];
+      // A face of a culled mesh with the centre of projection behind its plane (by more than a millimetre, so
+      // that the sign agrees with the rasterizer's) is culled whole: its grid would buy nothing, so it keeps its
+      // own triangles (issue 24's cost: the kerbs' and buildings' hidden faces, about a fifth of the triangles).
+      if (cull && glm::dot(g.normal, g.point + mesh.anchor - origin) > kHiddenFaceMargin) {
+        chosen[gi] = &kHidden;
+        continue;
+      }
       const double side = glm::dot(g.normal, g.point + mesh.anchor - viewer);
       chosen[gi] = &choice(m, int(gi), side > 0 ? 1 : side < 0 ? -1 : 0);
       any_grid |= chosen[gi]->grid != nullptr;

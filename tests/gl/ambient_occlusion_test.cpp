@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 
 #include "pvrr/gl/ao_fields.h"
@@ -260,6 +261,47 @@ TEST_P(AmbientOcclusionTest, AFaceTurnedAwayFromTheCarIsDrawnWithout) {
       EXPECT_EQ(equal, pixels);
     }
   }
+}
+
+// Issue 24's cost: a face of a culled box with the camera behind its plane gets no grid (it keeps its two
+// triangles, culled whole), and the picture of the faces in view is the same as with every face drawn. The wall
+// stands 2.9 m beside the car; from the car's side its far face (x = 3.1), seen from behind, is turned to the car
+// by the two-sided shading and would have a grid.
+TEST_P(AmbientOcclusionTest, AHiddenFaceOfACulledBoxGetsNoGrid) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  const std::string wall =
+      R"(, {"type": "box", "name": "wall", "centre": [3, 1, 0], "size": [0.2, 2, 6], "material": {"color": [0.7, 0.7, 0.7]}})";
+  const Scene scene = buildScene(carDesc("", "", "true", wall, "[-3, 2.5, 8]"));
+  RayScene rays(scene);
+  gl::RendererOptions culling, every_face;
+  every_face.cull_back_faces = false;
+  gl::Renderer r_cull(scene, rays, culling), r_all(scene, rays, every_face);
+  r_cull.render(RenderMode::Raster);  // the grids are made while the first frame draws: noted from the second
+  r_all.render(RenderMode::Raster);
+  const gl::RasterFrame a = r_cull.render(RenderMode::Raster), b = r_all.render(RenderMode::Raster);
+  auto faces = [](const gl::RasterFrame& f) {
+    const StageTiming* stage = f.stages.find(gl::kAmbientOcclusionStage);
+    const size_t at = stage ? stage->note.find("vertex values (faces drawn so far) on ") : std::string::npos;
+    return at == std::string::npos ? -1 : std::atoi(stage->note.c_str() + at + 38);
+  };
+  int pixels = 0, equal = 0;
+  double darkening = 0;
+  for (size_t i = 0; i < b.seen.size(); ++i) {
+    const Vec3 p = b.seen[i];
+    if (std::abs(p.x - 2.9) > 1e-3 || std::abs(p.z) > 2.9 || p.y < 0.1 || p.y > 1.9) continue;  // the face in view
+    ++pixels;
+    equal += a.color[i] == b.color[i];
+    darkening += 1 - a.color[i].x / (kGroundAlbedo * kAmbient);
+  }
+  std::printf("[ ambient occlusion ] hidden faces: %d faces with grids culling (%d drawing every face); the face in "
+              "view %d pixels, %d unchanged, mean occlusion %.4f\n", faces(a), faces(b), pixels, equal,
+              pixels ? darkening / pixels : 0.0);
+  ASSERT_GT(pixels, 1000);
+  EXPECT_GT(darkening / pixels, 0.02);  // the face in view is occluded (it has a grid)
+  EXPECT_EQ(equal, pixels);
+  ASSERT_GT(faces(a), 0);
+  EXPECT_LT(faces(a), faces(b));
 }
 
 // The mesh drawn in one draw (AoVertexReceivers::merged, issue 24's cost): its buffer holds each face's grid
