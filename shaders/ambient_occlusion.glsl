@@ -11,13 +11,12 @@
 // A faceted face drawn as a grid whose vertices hold its occlusion (pvrr/gl/ao_vertex_receivers.h): for its
 // normal as uploaded and for the opposite one; the side facing the viewer is chosen per vertex (one per face),
 // and the value interpolated across the triangles: no texture read.
+// The value rides in the w of the position's varying (env.vert, env.frag: v_pos_ao).
 #if defined(AO_VERTEX)
 layout(location = 3) in vec2 a_ao;
-out float v_ao_value;
-void aoValues(vec3 n_facing, vec3 n_uploaded) { v_ao_value = dot(n_facing, n_uploaded) > 0.0 ? a_ao.x : a_ao.y; }
+void aoValues(vec3 n_facing, vec3 n_uploaded) { v_pos_ao.w = dot(n_facing, n_uploaded) > 0.0 ? a_ao.x : a_ao.y; }
 #else
-in float v_ao_value;
-float ambientOcclusion(vec3 x, vec3 n) { return v_ao_value; }
+float ambientOcclusion(vec3 x, vec3 n) { return v_pos_ao.w; }
 #endif
 #elif defined(AMBIENT_OCCLUSION) && defined(AO_SCREEN)
 // A static receiver in a pass that drew the occlusion image first (pvrr/gl/environment_pass.cpp): its occlusion,

@@ -1,7 +1,12 @@
 #version 330 core
 // Output 0: linear colour. Output 1: the shaded point relative to the camera origin (w = 1), which the
 // accuracy reports read as the pixel's "seen point". Output 2: no element (w = 0).
+#if defined(AMBIENT_OCCLUSION) && defined(AO_VALUES)
+in vec4 v_pos_ao;  // the position, and the occlusion value in w (env.vert)
+#define v_pos v_pos_ao.xyz
+#else
 in vec3 v_pos;
+#endif
 in vec3 v_normal;
 in vec2 v_uv;
 uniform vec3 u_albedo;

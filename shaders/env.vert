@@ -11,7 +11,14 @@ layout(location = 2) in vec2 a_uv;
 uniform mat4 u_view_proj;  // projection * view, with the view's translation removed (camera at the origin)
 uniform vec3 u_offset;
 uniform vec4 u_clip_plane;  // camera-relative: clipped where dot(xyz, v_pos) + w < 0, while GL_CLIP_DISTANCE0 is on
+#if defined(AMBIENT_OCCLUSION) && defined(AO_VALUES)
+// The occlusion value rides in the position's spare component (shaders/ambient_occlusion.glsl AO_VALUES): no
+// varying of its own (on llvmpipe within the noise of one: docs/performance.md "Ambient occlusion").
+out vec4 v_pos_ao;
+#define v_pos v_pos_ao.xyz
+#else
 out vec3 v_pos;            // relative to the camera origin
+#endif
 out vec3 v_normal;
 out vec2 v_uv;
 #include "shading.glsl"

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "pvrr/gl/ao_fields.h"
+#include "pvrr/gl/ao_vertex_receivers.h"
 #include "pvrr/gl/gl.h"
 #include "pvrr/gl/impostor_maps.h"
 #include "pvrr/gl/caustic_pass.h"
@@ -10,6 +11,11 @@
 #include "pvrr/method/view_volume.h"
 
 namespace pvrr::gl {
+
+namespace {
+// The centre of projection this far (m) behind a face's plane: the face is back-facing for the rasterizer too.
+constexpr double kHiddenFaceMargin = 1e-3;
+}  // namespace
 
 void setLights(const Program& p, const Scene& scene, const Vec3& origin) {
   Vec3 ambient(0.0);
@@ -316,10 +322,49 @@ CullCount EnvironmentPass::draw(const Mat4& view, const Mat4& proj, const Vec3& 
       parts.push_back({m, cull, ao_ ? choice(m, -1, 0).draw : AoFields::Draw{}, 0, env_meshes[m].count});
       continue;
     }
-    for (size_t gi = 0; gi < env_groups[m].size(); ++gi) {
-      const FaceGroup& g = env_groups[m][gi];
+    const std::vector<FaceGroup>& groups = env_groups[m];
+    std::vector<const AoChoice*> chosen(groups.size());
+    bool any_grid = false, all_grids = true;  // some face has a grid; every face a field counts for has one
+    uint32_t mask = 0;
+    static const AoChoice kHidden{};  // no occlusion, no grid
+    for (size_t gi = 0; gi < groups.size(); ++gi) {
+      const FaceGroup& g = groups[gi];
+      // A face of a culled mesh with the centre of projection behind its plane (by more than a millimetre, so
+      // that the sign agrees with the rasterizer's) is culled whole: its grid would buy nothing, so it keeps its
+      // own triangles (issue 24's cost: the kerbs' and buildings' hidden faces, about a fifth of the triangles).
+      if (cull && glm::dot(g.normal, g.point + mesh.anchor - origin) > kHiddenFaceMargin) {
+        chosen[gi] = &kHidden;
+        continue;
+      }
       const double side = glm::dot(g.normal, g.point + mesh.anchor - viewer);
-      const AoChoice& c = choice(m, int(gi), side > 0 ? 1 : side < 0 ? -1 : 0);
+      chosen[gi] = &choice(m, int(gi), side > 0 ? 1 : side < 0 ? -1 : 0);
+      any_grid |= chosen[gi]->grid != nullptr;
+      all_grids &= chosen[gi]->grid != nullptr || chosen[gi]->draw.kind == AoReceiver::None;
+      mask |= chosen[gi]->grid ? 1u << gi : 0u;
+    }
+    // Every face with occlusion has a grid: the mesh in one draw, its faces' grids and the other faces (holding
+    // zeros) in one buffer (AoVertexReceivers::merged), kept per set of faces drawn as grids.
+    if (any_grid && all_grids) {
+      const auto [it, added] = ao_choices.try_emplace({m, -2, int(mask)});
+      if (added) {
+        std::vector<AoVertexReceivers::Face> faces(groups.size());
+        for (size_t gi = 0; gi < groups.size(); ++gi)
+          faces[gi] = {&groups[gi].triangles, groups[gi].normal, chosen[gi]->grid != nullptr};
+        const AoVertexReceivers::Merged* merged = ao_->vertexReceivers()->merged(m, faces);
+        it->second.draw = AoFields::Draw{AoReceiver::Vertex, {}};
+        it->second.grid = merged ? &merged->buffers : nullptr;
+        it->second.plain = merged ? merged->plain : 0;
+      }
+      if (const AoChoice& c = it->second; c.grid) {
+        // Its triangles without occlusion (below kAoValueNegligible) first, drawn without the values.
+        if (c.plain > 0) parts.push_back({m, cull, AoFields::Draw{}, 0, c.plain, c.grid});
+        if (c.plain < c.grid->count) parts.push_back({m, cull, c.draw, c.plain, c.grid->count - c.plain, c.grid});
+        continue;
+      }
+    }
+    for (size_t gi = 0; gi < groups.size(); ++gi) {
+      const FaceGroup& g = groups[gi];
+      const AoChoice& c = *chosen[gi];
       if (c.grid) {
         parts.push_back({m, cull, c.draw, 0, c.grid->count, c.grid});
         continue;

@@ -104,6 +104,7 @@ class EnvironmentPass {
   struct AoChoice {
     AoFields::Draw draw;
     const MeshBuffers* grid = nullptr;
+    int plain = 0;  // a mesh drawn as one buffer (AoVertexReceivers::Merged): its indices drawn without the values
   };
   mutable std::map<std::tuple<size_t, int, int>, AoChoice> ao_choices;
   mutable std::vector<Mat4> ao_choices_motion;

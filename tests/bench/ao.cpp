@@ -3,7 +3,8 @@
 //
 // BM_AoFrame: the same frame with and without ambient occlusion, interleaved in one run (A B A B ...), so that
 // the machine's load affects both alike; counters: the median frame of each and their difference (ao_ms), in
-// wall-clock and in CPU time of the whole process (cpu_*: llvmpipe's threads included).
+// wall-clock and in CPU time of the whole process (cpu_*: llvmpipe's threads included), and the median of the
+// pairs' CPU differences (cpu_ao_pair_ms). 60 pairs (20 until the fourth round).
 // BM_AoFieldBuild: one occluder's field (the overtaking car's six boxes) at the default sampling.
 #include <benchmark/benchmark.h>
 
@@ -74,6 +75,11 @@ void BM_AoFrame(benchmark::State& state, const char* name, RenderMode mode, std:
   state.counters["cpu_frame_ms"] = median(cpu_without);
   state.counters["cpu_frame_ao_ms"] = median(cpu_with);
   state.counters["cpu_ao_ms"] = median(cpu_with) - median(cpu_without);
+  // The median of the pairs' differences (each frame with against the frame without just before it): steadier
+  // than the difference of the medians where the load drifts during the run.
+  std::vector<double> pairs(cpu_with.size());
+  for (size_t i = 0; i < pairs.size(); ++i) pairs[i] = cpu_with[i] - cpu_without[i];
+  state.counters["cpu_ao_pair_ms"] = median(pairs);
   state.counters["fields"] = stage && stage->ran ? stage->count : 0;
   state.SetLabel(ctx->backendName() + " " + ctx->glRenderer() + (stage ? "; " + stage->note + stage->reason : ""));
 }
@@ -81,9 +87,34 @@ const std::vector<std::string> kOvertaking = {};
 // The driver looking at the overtaking car beside the mirror (its ground fills a quarter of the image).
 const std::vector<std::string> kLookAtCar = {"observer.target=[-3.2, 0.5, 4]", "observer.fov_y_deg=60"};
 BENCHMARK_CAPTURE(BM_AoFrame, overtaking_pvrr, "overtaking-car", RenderMode::Pvrr, kOvertaking)
-    ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(20);
+    ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(60);
 BENCHMARK_CAPTURE(BM_AoFrame, overtaking_raster_car_in_view, "overtaking-car", RenderMode::Raster, kLookAtCar)
-    ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(20);
+    ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(60);
+
+// One renderer alone (with or without ambient occlusion), for a profiler (perf record, one run each): not part of
+// the measured figures.
+void BM_AoProfile(benchmark::State& state, const char* name, RenderMode mode, std::vector<std::string> sets, bool ao) {
+  auto ctx = gl::GlContext::create(gl::glBackendFromEnvironment(gl::GlBackend::Auto));
+  sets.push_back("observer.image_size=[1280,720]");
+  if (ao) sets.push_back("render.ambient_occlusion=true");
+  Scene s = load(name, sets);
+  RayScene rays(s);
+  gl::RendererOptions opt;
+  opt.read_back = false;
+  opt.seen_points = false;
+  gl::Renderer r(s, rays, opt);
+  r.render(mode);
+  r.render(mode);
+  for (auto _ : state) r.render(mode);
+}
+BENCHMARK_CAPTURE(BM_AoProfile, pvrr_on, "overtaking-car", RenderMode::Pvrr, kOvertaking, true)
+    ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(200);
+BENCHMARK_CAPTURE(BM_AoProfile, pvrr_off, "overtaking-car", RenderMode::Pvrr, kOvertaking, false)
+    ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(200);
+BENCHMARK_CAPTURE(BM_AoProfile, raster_on, "overtaking-car", RenderMode::Raster, kLookAtCar, true)
+    ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(200);
+BENCHMARK_CAPTURE(BM_AoProfile, raster_off, "overtaking-car", RenderMode::Raster, kLookAtCar, false)
+    ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(200);
 
 void BM_AoFieldBuild(benchmark::State& state) {
   Scene s = load("overtaking-car", {"render.ambient_occlusion=true"});

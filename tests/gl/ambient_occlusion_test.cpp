@@ -6,11 +6,14 @@
 // With render.ambient_occlusion off, the picture is the one without any occluder.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 
 #include "pvrr/gl/ao_fields.h"
+#include "pvrr/gl/ao_vertex_receivers.h"
 #include "pvrr/gl/context.h"
 #include "pvrr/gl/renderer.h"
 #include "pvrr/scene/scene_build.h"
@@ -258,6 +261,145 @@ TEST_P(AmbientOcclusionTest, AFaceTurnedAwayFromTheCarIsDrawnWithout) {
       EXPECT_EQ(equal, pixels);
     }
   }
+}
+
+// Issue 24's cost: a face of a culled box with the camera behind its plane gets no grid (it keeps its two
+// triangles, culled whole), and the picture of the faces in view is the same as with every face drawn. The wall
+// stands 2.9 m beside the car; from the car's side its far face (x = 3.1), seen from behind, is turned to the car
+// by the two-sided shading and would have a grid.
+TEST_P(AmbientOcclusionTest, AHiddenFaceOfACulledBoxGetsNoGrid) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  const std::string wall =
+      R"(, {"type": "box", "name": "wall", "centre": [3, 1, 0], "size": [0.2, 2, 6], "material": {"color": [0.7, 0.7, 0.7]}})";
+  const Scene scene = buildScene(carDesc("", "", "true", wall, "[-3, 2.5, 8]"));
+  RayScene rays(scene);
+  gl::RendererOptions culling, every_face;
+  every_face.cull_back_faces = false;
+  gl::Renderer r_cull(scene, rays, culling), r_all(scene, rays, every_face);
+  r_cull.render(RenderMode::Raster);  // the grids are made while the first frame draws: noted from the second
+  r_all.render(RenderMode::Raster);
+  const gl::RasterFrame a = r_cull.render(RenderMode::Raster), b = r_all.render(RenderMode::Raster);
+  auto faces = [](const gl::RasterFrame& f) {
+    const StageTiming* stage = f.stages.find(gl::kAmbientOcclusionStage);
+    const size_t at = stage ? stage->note.find("vertex values (faces drawn so far) on ") : std::string::npos;
+    return at == std::string::npos ? -1 : std::atoi(stage->note.c_str() + at + 38);
+  };
+  int pixels = 0, equal = 0;
+  double darkening = 0;
+  for (size_t i = 0; i < b.seen.size(); ++i) {
+    const Vec3 p = b.seen[i];
+    if (std::abs(p.x - 2.9) > 1e-3 || std::abs(p.z) > 2.9 || p.y < 0.1 || p.y > 1.9) continue;  // the face in view
+    ++pixels;
+    equal += a.color[i] == b.color[i];
+    darkening += 1 - a.color[i].x / (kGroundAlbedo * kAmbient);
+  }
+  std::printf("[ ambient occlusion ] hidden faces: %d faces with grids culling (%d drawing every face); the face in "
+              "view %d pixels, %d unchanged, mean occlusion %.4f\n", faces(a), faces(b), pixels, equal,
+              pixels ? darkening / pixels : 0.0);
+  ASSERT_GT(pixels, 1000);
+  EXPECT_GT(darkening / pixels, 0.02);  // the face in view is occluded (it has a grid)
+  EXPECT_EQ(equal, pixels);
+  ASSERT_GT(faces(a), 0);
+  EXPECT_LT(faces(a), faces(b));
+}
+
+// The mesh drawn in one draw (AoVertexReceivers::merged, issue 24's cost): its buffer holds each face's grid
+// exactly as the face's own grid (the same vertices and occlusions, the indices offset), the faces drawn without
+// occlusion with their own vertices and zeros on both sides, and it is made again with the grids when the car
+// moves.
+TEST_P(AmbientOcclusionTest, AMeshsMergedBufferHoldsItsFacesGridsAndZeros) {
+  const auto ctx = test::glContextOrFail(GetParam());
+  if (!ctx) return;
+  const std::string wall =
+      R"(, {"type": "box", "name": "wall", "centre": [3, 1, 0], "size": [0.2, 2, 6], "material": {"color": [0.7, 0.7, 0.7]}})";
+  const SceneDesc desc =
+      carDesc(R"({"keys": [{"time_s": 0}, {"time_s": 1, "offset": [1.2, 0, -1], "rotation_deg": [0, 30, 0]}]})", "", "true", wall);
+  Scene s = buildScene(desc);
+  applyAnimation(s, desc, 0.0);
+  const std::vector<AoField> fields = buildAoFields(s);
+  ASSERT_FALSE(fields.empty());
+  gl::AoVertexReceivers receivers(s, fields);
+  size_t m = 0;
+  while (m < s.meshes.size() && s.meshes[m].name != "wall") ++m;
+  ASSERT_LT(m, s.meshes.size());
+  const EnvMesh& mesh = s.meshes[m];
+  // The box's faces: its triangles grouped by normal; the face toward the car and the top as grids.
+  std::vector<std::vector<uint32_t>> triangles;
+  std::vector<Vec3> normals;
+  for (uint32_t t = 0; t < mesh.triangles.size(); ++t) {
+    const Vec3 n(mesh.normals[mesh.triangles[t].x]);
+    size_t g = 0;
+    while (g < normals.size() && normals[g] != n) ++g;
+    if (g == normals.size()) normals.push_back(n), triangles.emplace_back();
+    triangles[g].push_back(t);
+  }
+  ASSERT_EQ(normals.size(), 6u);
+  std::vector<gl::AoVertexReceivers::Face> faces;
+  for (size_t g = 0; g < normals.size(); ++g) faces.push_back({&triangles[g], normals[g], normals[g].x < -0.5 || normals[g].y > 0.5});
+  constexpr int kStride = gl::AoVertexReceivers::kAoStride;
+  for (const double t : {0.0, 1.0}) {
+    applyAnimation(s, desc, t);
+    const gl::AoVertexReceivers::Merged* merged = receivers.merged(m, faces);
+    ASSERT_TRUE(merged);
+    EXPECT_EQ(merged->grids, 2);
+    ASSERT_EQ(merged->face.size() * 3, merged->indices.size());
+    EXPECT_EQ(merged->buffers.count, int(merged->indices.size()));
+    // Each triangle is its face's own (grid or mesh triangle `source`), read through offset indices; the ones
+    // without occlusion first.
+    ASSERT_EQ(merged->source.size(), merged->face.size());
+    std::vector<std::vector<int>> seen(faces.size());
+    size_t grid_vertices = 0;
+    for (size_t g = 0; g < faces.size(); ++g)
+      if (faces[g].grid) grid_vertices += receivers.gridData(m, g)->size() / kStride;
+    double toward_max = 0;
+    int plain_most = 0;
+    for (size_t t = 0; t < merged->face.size(); ++t) {
+      const size_t g = size_t(merged->face[t]);
+      const int src = merged->source[t];
+      seen[g].push_back(src);
+      float most = 0;
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t v = merged->indices[3 * t + size_t(k)];
+        const float* d = &merged->data[size_t(v) * kStride];
+        most = std::max({most, d[8], d[9]});
+        if (!faces[g].grid) {
+          EXPECT_EQ(v, mesh.triangles[triangles[g][size_t(src)]][k]);
+          EXPECT_EQ(Vec3(d[0], d[1], d[2]), Vec3(mesh.positions[v]));
+          EXPECT_EQ(d[8], 0.0f);  // drawn without occlusion, on both sides
+          EXPECT_EQ(d[9], 0.0f);
+          continue;
+        }
+        const std::vector<float>& data = *receivers.gridData(m, g);
+        const uint32_t i = (*receivers.gridIndices(m, g))[3 * size_t(src) + size_t(k)];
+        for (int c = 0; c < kStride; ++c) ASSERT_EQ(d[c], data[size_t(i) * kStride + size_t(c)]);
+        if (normals[g].x < -0.5) toward_max = std::max(toward_max, double(d[8]));
+      }
+      // The plain triangles, drawn without the values, hold less than kAoValueNegligible; the others more.
+      if (3 * t < size_t(merged->plain)) {
+        EXPECT_LT(most, gl::kAoValueNegligible);
+        ++plain_most;
+      } else {
+        EXPECT_GE(most, gl::kAoValueNegligible);
+      }
+    }
+    for (size_t g = 0; g < faces.size(); ++g) {  // every triangle once
+      std::sort(seen[g].begin(), seen[g].end());
+      const size_t n = faces[g].grid ? receivers.gridIndices(m, g)->size() / 3 : triangles[g].size();
+      ASSERT_EQ(seen[g].size(), n);
+      for (size_t k = 0; k < n; ++k) EXPECT_EQ(seen[g][k], int(k));
+    }
+    EXPECT_GE(plain_most, 6);  // at least the three faces drawn without grids
+    EXPECT_EQ(merged->data.size() / kStride, mesh.positions.size() + grid_vertices);
+    std::printf("[ ambient occlusion ] merged wall at t = %.0f: %zu triangles (%d without the values), the face toward the car up to %.3f\n", t,
+                merged->face.size(), plain_most, toward_max);
+    EXPECT_GT(toward_max, 0.02);
+  }
+  // Made again for the car where it is now: its face toward the car is not the one of t = 0.
+  applyAnimation(s, desc, 0.0);
+  const std::vector<float> before = receivers.merged(m, faces)->data;
+  applyAnimation(s, desc, 1.0);
+  EXPECT_NE(receivers.merged(m, faces)->data, before);
 }
 
 TEST_P(AmbientOcclusionTest, OffChangesNoPixel) {
