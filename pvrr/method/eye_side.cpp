@@ -52,9 +52,14 @@ double lensBeyondOutline(const Element& el, const Vec3& back_point) {
   return glm::length(d) - el.outline.boundaryRadius(std::atan2(d.y, d.x));
 }
 
+namespace {
+// How wide (arcmin) the band of rays leaving through the edge near a vertex `distance` from the viewer looks:
+// about as wide on the lens as its back point lies beyond the outline; 0 or less inside it.
+double edgeBandArcmin(double beyond, double distance) { return arcminutes(beyond / std::max(distance, 1e-12)); }
+}  // namespace
+
 bool lensEdgeExit(const Element& el, const Vec3& back_point, double distance) {
-  const double beyond = lensBeyondOutline(el, back_point);
-  return beyond > 0 && arcminutes(beyond / std::max(distance, 1e-12)) > kLensEdgeExitLimitArcmin;
+  return edgeBandArcmin(lensBeyondOutline(el, back_point), distance) > kLensEdgeExitLimitArcmin;
 }
 
 LensEdgeExits lensEdgeExits(const Element& el, const ElementFrame& f, const cad::GridPatch* patch) {
@@ -66,10 +71,9 @@ LensEdgeExits lensEdgeExits(const Element& el, const ElementFrame& f, const cad:
     const VertexRay& r = rays[i];
     // Out through the edge band with no back point at all: flagged as TIR.
     if (!r.edge_exit && glm::length(r.back_normal) == 0.0) return;
-    const double distance = glm::length(f.world_pos[i] - f.eye);
-    if (r.edge_exit || lensEdgeExit(el, r.back_point, distance)) {
-      const double beyond = lensBeyondOutline(el, r.back_point);
-      const double band_arcmin = arcminutes(beyond / std::max(distance, 1e-12));
+    const double beyond = lensBeyondOutline(el, r.back_point);
+    const double band_arcmin = edgeBandArcmin(beyond, glm::length(f.world_pos[i] - f.eye));
+    if (r.edge_exit || band_arcmin > kLensEdgeExitLimitArcmin) {
       ++e.vertices;
       e.max_beyond_m = std::max(e.max_beyond_m, beyond);
       e.max_band_arcmin = std::max(e.max_band_arcmin, band_arcmin);

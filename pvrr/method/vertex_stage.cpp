@@ -241,12 +241,10 @@ static void traceVertexRaysFrom(const RayScene& rays, ElementFrame& f, const Vec
           vr.origin = p;
           vr.dir = in.direction;
           vr.hit = p + far * in.direction;
-          // Through the edge the tracer absorbs the light: dark, also where no tracer draws it (envmap mode).
-          if (vr.edge_exit) vr.transmittance = Vec3(0.0);
-          if (tracer) {  // its own answer in place of the map's (whose far point says nothing here)
-            vr.transmittance = Vec3(0.0);
-            traceTir(*tracer, f.element, vr, p, d_in, wl);
-          }
+          // No map weight: with a tracer its own answer in place of the map's (whose far point says nothing
+          // here); out through the edge dark even without one (envmap mode), as the tracer absorbs the light.
+          if (tracer || vr.edge_exit) vr.transmittance = Vec3(0.0);
+          if (tracer) traceTir(*tracer, f.element, vr, p, d_in, wl);
           return;
         }
         vr.back_point = back.point;
