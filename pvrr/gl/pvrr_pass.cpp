@@ -6,6 +6,7 @@
 #include "pvrr/base/error.h"
 #include "pvrr/gl/gl.h"
 #include "pvrr/gl/impostor_maps.h"
+#include "pvrr/base/format.h"
 #include "pvrr/method/local_split.h"
 #include "pvrr/method/map_footprint.h"
 #include "pvrr/method/refine_plan.h"
@@ -185,7 +186,7 @@ void PvrrPass::refineElement(size_t e) {
   ElementFrame& f = frames[e];
   const Element& el = ctx.scene.elements[e];
   bool again = false;
-  std::string budget;
+  std::string budget, broad;
   const int max_vertices = opts[e].refine_max_vertices;
   if (max_vertices > 0 && !f.grid.locallyRefined()) {
     const std::array<int, 2> size = refinedGridSize(f, max_vertices);
@@ -202,12 +203,17 @@ void PvrrPass::refineElement(size_t e) {
   }
   if (max_vertices > 0 && opts[e].refine_locally) {
     const LocalSplit ls =
-        chooseLocalSplitByMapError(ctx.rays, f, max_vertices, {}, 0.9, ctx.grid_cache.refined(int(e))[0] > 0);
+        chooseLocalSplitByMapError(ctx.rays, f, max_vertices, {}, 0.9, ctx.grid_cache.refined(int(e))[0] > 0,
+                                   el.type == ElementType::Lens ? kBroadLensMapErrorArcmin : kInf);
     if (ls.changed) {
       ctx.grid_cache.refineLocally(ctx.scene, int(e), ls.levels);
       again = true;
     }
     if (ls.budget_limited) budget = " (vertex budget " + std::to_string(max_vertices) + " reached)";
+    if (ls.changed && ls.broad_map_error)
+      broad = " (no spread limit was reached, but a sample of its quads erred by " + fmt("%.1f", ls.sampled_median_arcmin) +
+              "' median, over the " +
+              fmt("%.1f", kBroadLensMapErrorArcmin) + "' limit)";
   }
   if (again) {
     f = prepareElement(ctx.scene, int(e), &ctx.grid_cache.get(ctx.scene, int(e)));
@@ -221,7 +227,7 @@ void PvrrPass::refineElement(size_t e) {
                        std::to_string(f.grid.grid_u) + "x" + std::to_string(f.grid.grid_v) +
                        " grid split locally to level " + std::to_string(level) + ", " +
                        std::to_string(f.grid.vertexCount()) + " vertices, where the map's interpolation erred" +
-                       budget + "; " + f.quality.action;
+                       broad + budget + "; " + f.quality.action;
   }
   if (ctx.grid_cache.refined(int(e))[0] > 0) {
     f.quality.action = "grid refined from " + std::to_string(el.tess_u) + "x" + std::to_string(el.tess_v) + " to " +

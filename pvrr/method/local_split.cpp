@@ -131,7 +131,7 @@ LocalSplit chooseLocalSplit(const ElementFrame& f, int max_vertices, const Frame
   return chooseLevels(f, ratio, trigger, max_vertices, target);
 }
 
-std::vector<double> quadMapErrors(const RayScene& rays, const ElementFrame& f) {
+std::vector<double> quadMapErrors(const RayScene& rays, const ElementFrame& f, size_t max_probes) {
   const int gu = f.grid.grid_u, gv = f.grid.grid_v;
   std::vector<double> err(size_t(std::max(gu - 1, 0)) * size_t(std::max(gv - 1, 0)), 0.0);
   if (gu < 2 || gv < 2 || f.rays.empty()) return err;
@@ -188,6 +188,12 @@ std::vector<double> quadMapErrors(const RayScene& rays, const ElementFrame& f) {
       }
     }
   }
+  if (max_probes > 0 && probes.size() > max_probes) {
+    const size_t stride = (probes.size() + max_probes - 1) / max_probes;
+    size_t kept = 0;
+    for (size_t i = stride / 2; i < probes.size(); i += stride) probes[kept++] = probes[i];
+    probes.resize(kept);
+  }
   TraceOptions to;
   to.max_depth = f.tir_trace_depth > 0 ? f.tir_trace_depth : to.max_depth;
   const Tracer tracer(rays, to);
@@ -222,16 +228,34 @@ std::vector<double> quadMapErrors(const RayScene& rays, const ElementFrame& f) {
 }
 
 LocalSplit chooseLocalSplitByMapError(const RayScene& rays, const ElementFrame& f, int max_vertices,
-                                      const FrameQualityLimits& limits, double target, bool refined) {
+                                      const FrameQualityLimits& limits, double target, bool refined,
+                                      double broad_limit_arcmin) {
   const std::vector<double> spread = quadSpreadRatios(f, limits);
   const bool trigger = refined || std::any_of(spread.begin(), spread.end(), [](double r) { return r > 1.0; });
-  if (!trigger) return chooseLevels(f, spread, false, max_vertices, target);
+  double sampled_median = 0;
+  if (!trigger && !f.grid.locallyRefined() && std::isfinite(broad_limit_arcmin)) {
+    // No spread limit sees it: a sample of the quads' map errors, the trigger if their median is over the limit.
+    std::vector<double> sample = quadMapErrors(rays, f, kBroadMapErrorProbes);
+    sample.erase(std::remove_if(sample.begin(), sample.end(), [](double e) { return !(e > 0); }), sample.end());
+    if (!sample.empty()) {
+      std::nth_element(sample.begin(), sample.begin() + ptrdiff_t(sample.size() / 2), sample.end());
+      sampled_median = sample[sample.size() / 2];
+    }
+  }
+  if (!trigger && !(sampled_median > broad_limit_arcmin)) {
+    LocalSplit ls = chooseLevels(f, spread, false, max_vertices, target);
+    ls.sampled_median_arcmin = sampled_median;
+    return ls;
+  }
   const std::vector<double> err = quadMapErrors(rays, f);
+  // The error a quad may keep: kLocalSplitMapErrorArcmin, or where a broad error triggered the split, its limit
+  // (the quads over it are what the median measured).
+  const double quad_limit = trigger ? kLocalSplitMapErrorArcmin : broad_limit_arcmin;
   // As a ratio that halves with each level (the map error falls 4 x): sqrt. Quads without a map error (TIR
   // triangles, drawn from traced colours) keep their spread ratio, which is the traced spread's there.
   std::vector<double> ratio(err.size(), 0.0);
   for (size_t q = 0; q < err.size(); ++q)
-    ratio[q] = err[q] > 0 ? std::sqrt(err[q] / kLocalSplitMapErrorArcmin) : 0.0;
+    ratio[q] = err[q] > 0 ? std::sqrt(err[q] / quad_limit) : 0.0;
   std::vector<uint8_t> has_tir(err.size(), 0);
   const std::vector<VertexRay>& vr = f.rays[f.rays.size() / 2];
   for (size_t t = 0; t < f.grid.triangles.size(); ++t) {
@@ -243,7 +267,10 @@ LocalSplit chooseLocalSplitByMapError(const RayScene& rays, const ElementFrame& 
   }
   for (size_t q = 0; q < ratio.size(); ++q)
     if (has_tir[q]) ratio[q] = std::max(ratio[q], spread[q]);
-  return chooseLevels(f, ratio, true, max_vertices, target);
+  LocalSplit ls = chooseLevels(f, ratio, true, max_vertices, target);
+  ls.sampled_median_arcmin = sampled_median;
+  ls.broad_map_error = !trigger;
+  return ls;
 }
 
 }  // namespace pvrr
