@@ -65,7 +65,8 @@ inline constexpr double kLocalSplitMapErrorArcmin = 6.0;
 // a sample of its seen quads' map errors measured (at most kBroadMapErrorProbes traced rays a frame), and when
 // their median is over kBroadLensMapErrorArcmin its interpolation errs broadly, not only at the picture's edges
 // (where single quads err by tens of minutes in good pictures), and the map-error split runs, to that limit.
-// The shipped lenses' medians: 0.01-1.1' (turned 10 deg: 2.7'). Not for mirrors: a mirror whose map errs
+// The shipped lenses' medians: 0.01-1.1' in 4:3 pictures (turned 10 deg: 2.7'); the spectacle lens in a 16:9
+// picture 4.9', whose wider view takes in the periphery (pictures 4.1' -> 0.47' median). Not for mirrors: a mirror whose map errs
 // broadly without a spread limit reached is one whose map shows another mirror from the wrong point (the
 // concave mirror facing the wall mirror: 5' and up), which no split mends and whose split would hide the
 // nested-parallax flag (eye_side.h) in smaller patches (measured: 39' -> 48' median, unflagged); the shipped
