@@ -218,13 +218,13 @@ TEST_F(HuntCli, LensRaysOutThroughTheEdgeAreDrawnAsTheReference) {
   }
 }
 
-// pvrr mode of `pvrr compare models/spectacle-lens.json` with `args` (size, overrides) within the given median and
-// p95, its element split locally by the broad map-error trigger (pvrr/method/local_split.h,
-// kBroadLensMapErrorArcmin), which its stats' action names.
-void expectSplitByItsMapError(const fs::path& dir, const std::string& what, const std::string& args, double max_median,
-                              double max_p95) {
+// pvrr mode of `pvrr compare SCENE` with `args` (size, overrides) within the given median and p95, its element
+// split locally by the broad map-error trigger (pvrr/method/local_split.h, kBroadLensMapErrorArcmin), which its
+// stats' action names.
+void expectSplitByItsMapError(const fs::path& dir, const std::string& what, const std::string& scene,
+                              const std::string& args, double max_median, double max_p95) {
   CliResult r;
-  const nlohmann::json j = comparePvrr(dir, "models/spectacle-lens.json", args, r);
+  const nlohmann::json j = comparePvrr(dir, scene, args, r);
   ASSERT_GT(j.value("pixels", 0L), 2000) << r.err;
   const double median = j["angular_error_arcmin"]["median"].get<double>();
   const double p95 = j["angular_error_arcmin"]["p95"].get<double>();
@@ -242,7 +242,7 @@ void expectSplitByItsMapError(const fs::path& dir, const std::string& what, cons
 // 64 x 48: 0.64' / 1.38'.
 TEST_F(HuntCli, ALensTurnedOffTheGazeIsSplitWhereItsMapErrs) {
   expectSplitByItsMapError(
-      dir_, "lens turned 15 deg",
+      dir_, "lens turned 15 deg", "models/spectacle-lens.json",
       R"(--size 64x48 --set 'elements[0].pose={"position":[-0.0066,0,-0.011131],"normal":[0.258819,0,0.965926],"up":[0,1,0]}')",
       1.2, 2.5);
 }
@@ -251,7 +251,10 @@ TEST_F(HuntCli, ALensTurnedOffTheGazeIsSplitWhereItsMapErrs) {
 // rays the 24 x 24 grid interpolated poorly (4.14' median, p95 8.11', good); the same trigger splits it: 0.47' /
 // 1.24'.
 TEST_F(HuntCli, TheSpectacleLensInAWidePictureIsSplitWhereItsMapErrs) {
-  expectSplitByItsMapError(dir_, "spectacle lens at 128 x 72", "--size 128x72", 1.0, 2.5);
+  expectSplitByItsMapError(dir_, "spectacle lens at 128 x 72", "models/spectacle-lens.json", "--size 128x72", 1.0, 2.5);
+  // A -10 D lens so: 15.8' / 30.1' before (192 x 108), 0.39' / 1.1' split to level 3.
+  expectSplitByItsMapError(dir_, "-10 D lens at 128 x 72", "tests/data/stress/hunt-spec-minus10.json", "--size 128x72",
+                           1.0, 3.0);
 }
 
 INSTANTIATE_TEST_SUITE_P(Hunt, HuntCli, ::testing::ValuesIn(huntCases()),
