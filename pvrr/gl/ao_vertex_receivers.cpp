@@ -9,6 +9,14 @@
 
 namespace pvrr::gl {
 
+namespace {
+// One vertex in the layout of the grids' and the merged buffers (AoVertexReceivers::kAoStride floats): position,
+// normal, texture coordinates, the occlusion for the normal and for its opposite.
+void appendVertex(std::vector<float>& data, const glm::vec3& p, const glm::vec3& n, const glm::vec2& uv, float o, float o_back) {
+  data.insert(data.end(), {p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y, o, o_back});
+}
+}  // namespace
+
 AoVertexReceivers::~AoVertexReceivers() {
   for (auto& [k, e] : entries_) e.buffers.release();
   for (auto& [k, e] : merged_) e.buffers.release();
@@ -36,11 +44,8 @@ const MeshBuffers* AoVertexReceivers::grid(size_t m, size_t g, const std::vector
   data.clear();
   data.reserve(grid.positions.size() * kAoStride);
   const glm::vec3 n(normal);
-  for (size_t i = 0; i < grid.positions.size(); ++i) {
-    const glm::vec3 p(grid.positions[i]);
-    const glm::vec2 uv(grid.uvs[i]);
-    data.insert(data.end(), {p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y, grid.occlusion[i][0], grid.occlusion[i][1]});
-  }
+  for (size_t i = 0; i < grid.positions.size(); ++i)
+    appendVertex(data, glm::vec3(grid.positions[i]), n, glm::vec2(grid.uvs[i]), grid.occlusion[i][0], grid.occlusion[i][1]);
   e.indices = grid.indices;
   uploadMesh(e.buffers, data, {3, 3, 2, 2}, grid.indices);
   checkGlError("uploading an ambient occlusion grid");
@@ -79,11 +84,8 @@ const AoVertexReceivers::Merged* AoVertexReceivers::merged(size_t m, const std::
   const EnvMesh& mesh = scene_.meshes[m];
   if (mask + 1 != 1u << faces.size()) {  // some face drawn as it is: the mesh's vertices, without occlusion
     e.data.reserve(mesh.positions.size() * kAoStride);
-    for (size_t i = 0; i < mesh.positions.size(); ++i) {
-      const glm::vec3 pos = mesh.positions[i], n = mesh.normals[i];
-      const glm::vec2 uv = mesh.uvs[i];
-      e.data.insert(e.data.end(), {pos.x, pos.y, pos.z, n.x, n.y, n.z, uv.x, uv.y, 0.0f, 0.0f});
-    }
+    for (size_t i = 0; i < mesh.positions.size(); ++i)
+      appendVertex(e.data, mesh.positions[i], mesh.normals[i], mesh.uvs[i], 0.0f, 0.0f);
   }
   // Face after face, each triangle into the plain part or the occluded one.
   std::vector<uint32_t> plain, occluded;

@@ -4,9 +4,9 @@
 #include <atomic>
 
 #include "pvrr/base/error.h"
+#include "pvrr/base/format.h"
 #include "pvrr/gl/gl.h"
 #include "pvrr/gl/impostor_maps.h"
-#include "pvrr/base/format.h"
 #include "pvrr/method/local_split.h"
 #include "pvrr/method/map_footprint.h"
 #include "pvrr/method/refine_plan.h"
@@ -202,9 +202,10 @@ void PvrrPass::refineElement(size_t e) {
     }
   }
   if (max_vertices > 0 && opts[e].refine_locally) {
-    const LocalSplit ls =
-        chooseLocalSplitByMapError(ctx.rays, f, max_vertices, {}, 0.9, ctx.grid_cache.refined(int(e))[0] > 0,
-                                   el.type == ElementType::Lens ? kBroadLensMapErrorArcmin : kInf);
+    // A lens whose map errs broadly is split on that alone (kBroadLensMapErrorArcmin); a mirror never.
+    const double broad_limit = el.type == ElementType::Lens ? kBroadLensMapErrorArcmin : kInf;
+    const LocalSplit ls = chooseLocalSplitByMapError(ctx.rays, f, max_vertices, {}, 0.9,
+                                                     ctx.grid_cache.refined(int(e))[0] > 0, broad_limit);
     if (ls.changed) {
       ctx.grid_cache.refineLocally(ctx.scene, int(e), ls.levels);
       again = true;
@@ -212,8 +213,7 @@ void PvrrPass::refineElement(size_t e) {
     if (ls.budget_limited) budget = " (vertex budget " + std::to_string(max_vertices) + " reached)";
     if (ls.changed && ls.broad_map_error)
       broad = " (no spread limit was reached, but a sample of its quads erred by " + fmt("%.1f", ls.sampled_median_arcmin) +
-              "' median, over the " +
-              fmt("%.1f", kBroadLensMapErrorArcmin) + "' limit)";
+              "' median, over the " + fmt("%.1f", broad_limit) + "' limit)";
   }
   if (again) {
     f = prepareElement(ctx.scene, int(e), &ctx.grid_cache.get(ctx.scene, int(e)));
