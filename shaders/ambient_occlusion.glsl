@@ -11,11 +11,15 @@
 // A faceted face drawn as a grid whose vertices hold its occlusion (pvrr/gl/ao_vertex_receivers.h): for its
 // normal as uploaded and for the opposite one; the side facing the viewer is chosen per vertex (one per face),
 // and the value interpolated across the triangles: no texture read.
-// The value rides in the w of the position's varying (env.vert, env.frag: v_pos_ao).
+// Where the face's light is computed per vertex (FACETED, no shadows: env.vert's AO_LIGHT) the occluded ambient is
+// subtracted from it there and the light interpolated instead of flat: the fragments do nothing for the occlusion
+// (the same value, as the face's light is constant over it; llvmpipe pays per interpolated component and per
+// fragment instruction: docs/performance.md "Ambient occlusion", seventh round). Otherwise the value rides in
+// the w of the position's varying (env.vert, env.frag: v_pos_ao) and the fragment subtracts it.
 #if defined(AO_VERTEX)
 layout(location = 3) in vec2 a_ao;
-void aoValues(vec3 n_facing, vec3 n_uploaded) { v_pos_ao.w = dot(n_facing, n_uploaded) > 0.0 ? a_ao.x : a_ao.y; }
-#else
+float aoValue(vec3 n_facing, vec3 n_uploaded) { return dot(n_facing, n_uploaded) > 0.0 ? a_ao.x : a_ao.y; }
+#elif !defined(AO_LIGHT)
 float ambientOcclusion(vec3 x, vec3 n) { return v_pos_ao.w; }
 #endif
 #elif defined(AMBIENT_OCCLUSION) && defined(AO_SCREEN)

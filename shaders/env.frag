@@ -1,7 +1,10 @@
 #version 330 core
 // Output 0: linear colour. Output 1: the shaded point relative to the camera origin (w = 1), which the
 // accuracy reports read as the pixel's "seen point". Output 2: no element (w = 0).
-#if defined(AMBIENT_OCCLUSION) && defined(AO_VALUES)
+#if defined(AMBIENT_OCCLUSION) && defined(AO_VALUES) && defined(FACETED) && !defined(SHADOWS) && !defined(AO_IMAGE)
+#define AO_LIGHT  // the occlusion folded into v_face_light per vertex (env.vert)
+#endif
+#if defined(AMBIENT_OCCLUSION) && defined(AO_VALUES) && !defined(AO_LIGHT)
 in vec4 v_pos_ao;  // the position, and the occlusion value in w (env.vert)
 #define v_pos v_pos_ao.xyz
 #else
@@ -21,7 +24,11 @@ uniform vec3 u_view_origin;    // the point rays come from (the camera, or the v
 #include "ambient_occlusion.glsl"
 #if defined(FACETED)
 flat in vec3 v_face_normal;
+#if defined(AO_LIGHT)
+in vec3 v_face_light;  // the occluded ambient already subtracted, interpolated
+#else
 flat in vec3 v_face_light;
+#endif
 #endif
 void main() {
   peel(v_pos);
@@ -45,7 +52,9 @@ void main() {
 #if defined(CAUSTICS)
   o_color.rgb += albedo * causticIrradiance(v_pos);
 #endif
-#if defined(AMBIENT_OCCLUSION) && defined(FACETED)
+#if defined(AO_LIGHT)
+  // (the occluded ambient was subtracted from v_face_light per vertex)
+#elif defined(AMBIENT_OCCLUSION) && defined(FACETED)
   o_color.rgb -= albedo * u_ambient * ambientOcclusion(v_pos, v_face_normal);  // the ambient term's occluded part
 #elif defined(AMBIENT_OCCLUSION)
   o_color.rgb -= albedo * u_ambient * ambientOcclusion(v_pos, n);

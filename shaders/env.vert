@@ -11,7 +11,10 @@ layout(location = 2) in vec2 a_uv;
 uniform mat4 u_view_proj;  // projection * view, with the view's translation removed (camera at the origin)
 uniform vec3 u_offset;
 uniform vec4 u_clip_plane;  // camera-relative: clipped where dot(xyz, v_pos) + w < 0, while GL_CLIP_DISTANCE0 is on
-#if defined(AMBIENT_OCCLUSION) && defined(AO_VALUES)
+#if defined(AMBIENT_OCCLUSION) && defined(AO_VALUES) && defined(FACETED) && !defined(SHADOWS) && !defined(AO_IMAGE)
+#define AO_LIGHT  // the occlusion folded into the face's light per vertex (ambient_occlusion.glsl AO_VALUES)
+#endif
+#if defined(AMBIENT_OCCLUSION) && defined(AO_VALUES) && !defined(AO_LIGHT)
 // The occlusion value rides in the position's spare component (shaders/ambient_occlusion.glsl AO_VALUES): no
 // varying of its own (on llvmpipe within the noise of one: docs/performance.md "Ambient occlusion").
 out vec4 v_pos_ao;
@@ -27,7 +30,11 @@ out vec2 v_uv;
 #if defined(FACETED)
 uniform vec3 u_view_origin;
 flat out vec3 v_face_normal;  // facing the viewer
+#if defined(AO_LIGHT)
+out vec3 v_face_light;        // ambientAndDirectional(v_face_normal) less the occluded ambient, interpolated
+#else
 flat out vec3 v_face_light;   // ambientAndDirectional(v_face_normal)
+#endif
 #endif
 void main() {
   v_pos = a_pos + u_offset;
@@ -41,8 +48,10 @@ void main() {
 #if defined(AO_PER_VERTEX) && !defined(AO_GROUND)
   aoVertexNormal(n);
 #endif
-#if defined(AMBIENT_OCCLUSION) && defined(AO_VALUES)
-  aoValues(n, a_normal);
+#if defined(AO_LIGHT)
+  v_face_light -= u_ambient * aoValue(n, a_normal);
+#elif defined(AMBIENT_OCCLUSION) && defined(AO_VALUES)
+  v_pos_ao.w = aoValue(n, a_normal);
 #endif
 #endif
 #if defined(AO_PER_VERTEX)
