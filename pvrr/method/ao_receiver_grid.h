@@ -27,7 +27,7 @@
 namespace pvrr {
 
 inline constexpr double kAoGridRootCell = 8.0;  // m: the largest cell, where no field reaches
-inline constexpr double kAoGridNear = 1.0;      // forced cell size over distance from a field's centre
+inline constexpr double kAoGridNear = 2.0;      // forced cell size over distance from a field's centre
 
 struct AoGridOptions {
   double tolerance = 0.04;  // occlusion: the interpolation's largest error where a cell is left unsplit
