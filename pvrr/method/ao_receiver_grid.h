@@ -13,7 +13,7 @@
 // - where the occlusion at the cell's edge midpoints or centre differs from the two triangles' interpolation of
 //   its corners by more than AoGridOptions::tolerance (either side).
 // Neighbouring leaves differ by at most one level (balanced), and a leaf beside finer ones is triangulated as a
-// fan about its centre through their shared edges' midpoints: no T-junction, so no crack.
+// fan from the midpoint of an edge it shares with them through the rest of its outline: no T-junction, so no crack.
 #pragma once
 #include <array>
 #include <cstdint>

@@ -81,10 +81,13 @@ void groundAgrees(const Mat4& motion, const char* what) {
   const AoReceiverGrid g = buildAoReceiverGrid(*r, ground.anchor, -1, fields, s);
   // Closed: the triangles' area is the rectangle's, and every edge not on its border is shared by two.
   double area = 0;
+  int flat = 0;  // triangles without area, or wound against the rectangle
   std::map<std::pair<uint32_t, uint32_t>, int> edges;
   for (size_t t = 0; t < g.indices.size(); t += 3) {
     const Vec3 a = g.positions[g.indices[t]], b = g.positions[g.indices[t + 1]], c = g.positions[g.indices[t + 2]];
-    area += glm::dot(glm::cross(b - a, c - a), r->normal) / 2 * (r->ccw ? 1 : -1);
+    const double signed_area = glm::dot(glm::cross(b - a, c - a), r->normal) / 2 * (r->ccw ? 1 : -1);
+    area += signed_area;
+    flat += signed_area < 1e-6;
     for (int k = 0; k < 3; ++k) {
       const uint32_t i = g.indices[t + size_t(k)], j = g.indices[t + size_t((k + 1) % 3)];
       ++edges[{std::min(i, j), std::max(i, j)}];
@@ -100,6 +103,7 @@ void groundAgrees(const Mat4& motion, const char* what) {
     open += !border && count != 2;
   }
   EXPECT_EQ(open, 0) << what;
+  EXPECT_EQ(flat, 0) << what;
   EXPECT_LT(g.indices.size() / 3, kMaxTriangles) << what;
   double sum = 0, worst = 0, darkest = 1;
   int count = 0;
